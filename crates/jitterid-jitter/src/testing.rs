@@ -1,0 +1,559 @@
+//! Contract checks that every [`JitterModel`] must pass.
+//!
+//! Run [`check_contract`] in a test of any new family (see `docs/extending.md`):
+//!
+//! ```
+//! use jitterid_jitter::{testing::check_contract, UniformSum};
+//! check_contract(&UniformSum::new(2, 0.2887).unwrap(), 1).unwrap();
+//! ```
+//!
+//! The checks fall in two groups. [`check_closed_forms`] is deterministic: it holds the closed
+//! forms (`cf`, `cf_gradient`, `mgf`, `mean`, `variance`) against each other and against
+//! quadrature over `pdf`, `atoms` and `pieces`, with tolerances set by floating-point
+//! rounding. [`check_sampler`] holds `sample` against the closed forms with Monte Carlo
+//! tolerances derived from the number of draws. [`check_contract`] runs both.
+//!
+//! Frequencies and steps are scaled by the model's own spread `s` (its standard deviation, or
+//! the size of its reach if that is zero), so the same checks work for `σ = 1e-9` and `σ = 5`.
+
+use crate::{JitterError, JitterModel};
+use num_complex::Complex64;
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+use std::f64::consts::PI;
+use std::fmt::Write as _;
+
+/// Number of draws of the Monte Carlo checks.
+pub const MC_DRAWS: usize = 20_000;
+
+/// Width of the Monte Carlo acceptance band, in standard errors. A correct model lands
+/// outside with probability about `6e-7` per comparison (normal two-sided tail at 5).
+pub const MC_SIGMAS: f64 = 5.0;
+
+/// Rounding tolerance for quantities that closed forms and quadrature give to near machine
+/// precision (mass, mean, variance, `M(-i2πf)` against `γ(f)`).
+const EXACT_TOL: f64 = 1e-12;
+
+/// Tolerance of quadrature against `γ(f)` at moderate frequency, where the integrand
+/// oscillates over many nodes.
+const RULE_CF_TOL: f64 = 1e-10;
+
+/// Relative finite-difference step for `cf_gradient`.
+const FD_STEP: f64 = 1e-6;
+
+/// Tolerance of `cf_gradient` against central differences, relative to the natural size
+/// `|∂γ/∂θ| + |γ|/θ` of a derivative. With step `δ = 1e-6 θ` the rounding error of the
+/// difference is `≈ ε|γ|/δ ≈ 2e-10 |γ|/θ` and the truncation error `δ²|γ'''|/6` is
+/// `≈ 1e-12 (2πfs)³|γ|/θ` for the frequencies used (`2πfs ≤ 3`); `1e-6` sits far above both
+/// and far below any error a wrong formula makes.
+const FD_TOL: f64 = 1e-6;
+
+/// Moderate frequencies, as `2πf·s`: where `γ` varies most.
+const MODERATE: [f64; 3] = [0.3, 1.0, 3.0];
+
+/// Frequencies for the quadrature check, as `2πf·s`, up to many oscillations over the spread.
+const RULE_FREQS: [f64; 5] = [0.3, 1.0, 3.0, 10.0, 30.0];
+
+/// Frequencies, as `2πf·s`, for the bounds `|γ| ≤ 1` and `γ(-f) = conj γ(f)`.
+const RELATIVE_FREQS: [f64; 11] = [1e-9, 1e-3, 0.1, 0.3, 1.0, 3.0, 10.0, 1e2, 1e4, 1e8, 1e12];
+
+/// Absolute frequencies (Hz) for the same bounds, down to the edge of overflow.
+const ABSOLUTE_FREQS: [f64; 7] = [1e-3, 1.0, 1e3, 1e9, 1e15, 1e300, f64::MAX];
+
+/// Runs [`check_closed_forms`] and [`check_sampler`] (with `seed`) and reports every failure
+/// of either, one per line.
+pub fn check_contract<J: JitterModel + Clone>(model: &J, seed: u64) -> Result<(), String> {
+    let mut fails = Vec::new();
+    closed_forms(model, &mut fails);
+    sampler(model, seed, &mut fails);
+    report(model, fails)
+}
+
+/// The deterministic part of the contract:
+///
+/// * parameter names, values and count agree; `with_params(params())` rebuilds the model
+///   (same `Debug` output); a parameter vector of the wrong length is rejected with
+///   [`JitterError::WrongParamCount`]; a NaN or infinite parameter is rejected;
+/// * `γ(0) = 1`; `γ` and its gradient are finite, `|γ| ≤ 1 + 1e-12` and
+///   `γ(-f) = conj γ(f)` over frequencies from `1e-9/s` to `f64::MAX`;
+/// * `M(0) = 1`, and where `M` is defined, `M(-i2πf) = γ(f)` and `M(z)` equals the quadrature
+///   of `e^{zτ}` for a few real and complex `z` of size about `1/s`;
+/// * pieces are sorted, non-empty and disjoint; atoms have masses in `(0, 1]`; the density is
+///   finite and non-negative;
+/// * the rule `model.rule(&[], 0.0)` has mass 1, mean `mean()` and variance `variance()`
+///   within `1e-12` (relative to the spread), also when cut at extra breakpoints;
+/// * the rule at rate `2π|f|` reproduces `γ(f)` within `1e-10` for `2πfs` up to 30: this is
+///   the check that the pieces are fine enough;
+/// * `cf_gradient` matches central differences of `cf` through `with_params`.
+pub fn check_closed_forms<J: JitterModel + Clone>(model: &J) -> Result<(), String> {
+    let mut fails = Vec::new();
+    closed_forms(model, &mut fails);
+    report(model, fails)
+}
+
+/// The Monte Carlo part of the contract, with [`MC_DRAWS`] draws from
+/// `StdRng::seed_from_u64(seed)`: draws are finite and inside [`reach`](JitterModel::reach);
+/// their mean, variance and empirical `E[e^{-i2πfτ}]` agree with `mean()`, `variance()` and
+/// `cf(f)` within [`MC_SIGMAS`] standard errors.
+pub fn check_sampler<J: JitterModel + ?Sized>(model: &J, seed: u64) -> Result<(), String> {
+    let mut fails = Vec::new();
+    sampler(model, seed, &mut fails);
+    report(model, fails)
+}
+
+fn report<J: JitterModel + ?Sized>(model: &J, fails: Vec<String>) -> Result<(), String> {
+    if fails.is_empty() {
+        return Ok(());
+    }
+    let mut msg = format!(
+        "jitter model {:?} breaks {} contract check(s):",
+        model,
+        fails.len()
+    );
+    for f in fails {
+        let _ = write!(msg, "\n  - {f}");
+    }
+    Err(msg)
+}
+
+/// The spread `s` that sets frequency and step scales: the standard deviation, or for a
+/// degenerate law the size of its reach, or 1.
+fn spread<J: JitterModel + ?Sized>(model: &J) -> f64 {
+    let sd = model.std_dev();
+    if sd.is_finite() && sd > 0.0 {
+        return sd;
+    }
+    let (lo, hi) = model.reach();
+    let r = lo.abs().max(hi.abs());
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        1.0
+    }
+}
+
+/// Frequency (Hz) at which `2πf·s = c`.
+fn freq(c: f64, s: f64) -> f64 {
+    c / (2.0 * PI * s)
+}
+
+/// `E[e^{zτ}]` by a quadrature rule.
+fn rule_expect_exp(rule: &crate::QuadratureRule, z: Complex64) -> Complex64 {
+    let re = rule.expect(|t| (z * t).exp().re);
+    let im = rule.expect(|t| (z * t).exp().im);
+    Complex64::new(re, im)
+}
+
+fn closed_forms<J: JitterModel + Clone>(model: &J, fails: &mut Vec<String>) {
+    let s = spread(model);
+    check_params(model, fails);
+    check_cf_bounds(model, s, fails);
+    check_mgf(model, s, fails);
+    check_structure(model, fails);
+    check_rule(model, s, fails);
+    check_gradient(model, s, fails);
+}
+
+fn check_params<J: JitterModel + Clone>(model: &J, fails: &mut Vec<String>) {
+    let p = model.params();
+    let names = model.param_names();
+    if names.len() != p.len() || model.num_params() != p.len() {
+        fails.push(format!(
+            "{} parameter names, {} parameters, num_params() = {}",
+            names.len(),
+            p.len(),
+            model.num_params()
+        ));
+    }
+    if p.iter().any(|v| !v.is_finite()) {
+        fails.push(format!("non-finite parameters {p:?}"));
+    }
+    match model.with_params(&p) {
+        Ok(m) if format!("{m:?}") == format!("{model:?}") => {}
+        Ok(m) => fails.push(format!("with_params(params()) gave {m:?}")),
+        Err(e) => fails.push(format!("with_params(params()) failed: {e}")),
+    }
+    let mut longer = p.clone();
+    longer.push(1.0);
+    let mut wrong = vec![longer];
+    if !p.is_empty() {
+        wrong.push(p[..p.len() - 1].to_vec());
+    }
+    for w in wrong {
+        if !matches!(
+            model.with_params(&w),
+            Err(JitterError::WrongParamCount { .. })
+        ) {
+            fails.push(format!(
+                "with_params accepted {} parameter(s) instead of {} (or gave another error)",
+                w.len(),
+                p.len()
+            ));
+        }
+    }
+    for j in 0..p.len() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut q = p.clone();
+            q[j] = bad;
+            if model.with_params(&q).is_ok() {
+                fails.push(format!("with_params accepted {} = {bad}", names[j]));
+            }
+        }
+    }
+}
+
+fn check_cf_bounds<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<String>) {
+    let g0 = model.cf(0.0);
+    if (g0 - 1.0).norm() > 1e-15 {
+        fails.push(format!("γ(0) = {g0}, not 1"));
+    }
+    let freqs = RELATIVE_FREQS
+        .iter()
+        .map(|&c| freq(c, s))
+        .chain(ABSOLUTE_FREQS);
+    let mut grad = vec![Complex64::new(0.0, 0.0); model.num_params()];
+    for f in freqs {
+        let (g, gm) = (model.cf(f), model.cf(-f));
+        if !(g.re.is_finite() && g.im.is_finite()) {
+            fails.push(format!("γ({f:e}) = {g} is not finite"));
+            continue;
+        }
+        if g.norm() > 1.0 + 1e-12 {
+            fails.push(format!("|γ({f:e})| = {} > 1", g.norm()));
+        }
+        // Rounding only: both are the same closed form at ±f.
+        if (gm - g.conj()).norm() > 1e-15 {
+            fails.push(format!("γ(-f) = {gm} but conj γ(f) = {} at f = {f:e}", g.conj()));
+        }
+        model.cf_gradient(f, &mut grad);
+        if grad.iter().any(|d| !(d.re.is_finite() && d.im.is_finite())) {
+            fails.push(format!("cf_gradient({f:e}) = {grad:?} is not finite"));
+        }
+    }
+}
+
+fn check_mgf<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<String>) {
+    match model.mgf(Complex64::new(0.0, 0.0)) {
+        Some(m) if (m - 1.0).norm() <= 1e-15 => {}
+        other => fails.push(format!("M(0) = {other:?}, not 1")),
+    }
+    for c in RULE_FREQS {
+        for f in [freq(c, s), -freq(c, s)] {
+            if let Some(m) = model.mgf(Complex64::new(0.0, -2.0 * PI * f)) {
+                let g = model.cf(f);
+                if (m - g).norm() > EXACT_TOL {
+                    fails.push(format!("M(-i2πf) = {m} but γ(f) = {g} at f = {f:e}"));
+                }
+            }
+        }
+    }
+    // Off the imaginary axis, against quadrature of e^{zτ} (relative: |M| may be large).
+    for z in [
+        Complex64::new(0.5, 0.0),
+        Complex64::new(-0.5, 0.0),
+        Complex64::new(-0.3, 0.7),
+        Complex64::new(0.2, -2.0),
+    ] {
+        let z = z / s;
+        if let Some(m) = model.mgf(z) {
+            let e = rule_expect_exp(&model.rule(&[], z.norm()), z);
+            if (m - e).norm() > RULE_CF_TOL * m.norm().max(1.0) {
+                fails.push(format!("M({z}) = {m} but quadrature gives {e}"));
+            }
+        }
+    }
+}
+
+fn check_structure<J: JitterModel + ?Sized>(model: &J, fails: &mut Vec<String>) {
+    let pieces = model.pieces();
+    for (k, &(lo, hi)) in pieces.iter().enumerate() {
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            fails.push(format!("piece {k} = [{lo}, {hi}] is empty or not finite"));
+        }
+        if k > 0 && pieces[k - 1].1 > lo {
+            fails.push(format!("pieces {} and {k} overlap or are unsorted", k - 1));
+        }
+    }
+    let mut atom_mass = 0.0;
+    for a in model.atoms() {
+        if !(a.position.is_finite() && a.mass > 0.0 && a.mass <= 1.0) {
+            fails.push(format!("bad atom {a:?}"));
+        }
+        atom_mass += a.mass;
+    }
+    if atom_mass > 1.0 + EXACT_TOL {
+        fails.push(format!("atoms carry mass {atom_mass} > 1"));
+    }
+    if pieces.is_empty() && model.atoms().is_empty() {
+        fails.push("no pieces and no atoms".into());
+    }
+    // The density on a grid over and beyond the reach.
+    let (lo, hi) = model.reach();
+    let w = (hi - lo).max(1e-300);
+    for k in 0..=200 {
+        let t = lo - 0.1 * w + 1.2 * w * f64::from(k) / 200.0;
+        let p = model.pdf(t);
+        if !(p.is_finite() && p >= 0.0) {
+            fails.push(format!("pdf({t}) = {p}"));
+            break;
+        }
+    }
+}
+
+fn check_rule<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<String>) {
+    let (mean, var) = (model.mean(), model.variance());
+    if !(mean.is_finite() && var.is_finite() && var >= 0.0) {
+        fails.push(format!("mean {mean} or variance {var} not finite and valid"));
+        return;
+    }
+    let sd = var.sqrt();
+    // Nodes are stored as τ, so an offset mean costs about ε|mean| in τ - mean.
+    let mean_tol = EXACT_TOL * (mean.abs() + sd);
+    let var_tol = EXACT_TOL * (var + mean.abs() * sd);
+    let (lo, hi) = model.reach();
+    let breaks_sets: [Vec<f64>; 2] = [Vec::new(), vec![mean, lo + 0.3 * (hi - lo), hi + 1.0]];
+    for breaks in &breaks_sets {
+        let rule = model.rule(breaks, 0.0);
+        let bad = rule
+            .nodes
+            .iter()
+            .zip(&rule.weights)
+            .any(|(&t, &w)| !(t.is_finite() && t >= lo && t <= hi && w >= 0.0 && w.is_finite()));
+        if bad {
+            fails.push(format!(
+                "rule(breaks = {breaks:?}) has a node outside [{lo}, {hi}] or a negative weight"
+            ));
+        }
+        // Mass of the density over the pieces plus the atoms.
+        let mass = rule.mass();
+        if (mass - 1.0).abs() > EXACT_TOL {
+            fails.push(format!(
+                "continuous mass plus atoms = {mass} (breaks {breaks:?}), not 1"
+            ));
+        }
+        let m = rule.expect(|t| t);
+        if (m - mean).abs() > mean_tol {
+            fails.push(format!("rule mean {m} but mean() = {mean} (breaks {breaks:?})"));
+        }
+        let v = rule.expect(|t| (t - mean) * (t - mean));
+        if (v - var).abs() > var_tol {
+            fails.push(format!("rule variance {v} but variance() = {var} (breaks {breaks:?})"));
+        }
+    }
+    for c in RULE_FREQS {
+        let f = freq(c, s);
+        let rule = model.rule(&[], 2.0 * PI * f);
+        let e = rule_expect_exp(&rule, Complex64::new(0.0, -2.0 * PI * f));
+        let g = model.cf(f);
+        if (e - g).norm() > RULE_CF_TOL {
+            fails.push(format!(
+                "quadrature gives E[e^(-i2πfτ)] = {e} but γ = {g} at 2πf·s = {c}"
+            ));
+        }
+    }
+}
+
+fn check_gradient<J: JitterModel + Clone>(model: &J, s: f64, fails: &mut Vec<String>) {
+    let p = model.params();
+    let names = model.param_names();
+    let mut grad = vec![Complex64::new(0.0, 0.0); p.len()];
+    for c in MODERATE {
+        let f = freq(c, s);
+        let g = model.cf(f);
+        model.cf_gradient(f, &mut grad);
+        for j in 0..p.len() {
+            // A location parameter may be 0: scale its step by the spread instead.
+            let scale = p[j].abs().max(s);
+            let h = FD_STEP * scale;
+            let (mut up, mut down) = (p.clone(), p.clone());
+            up[j] += h;
+            down[j] -= h;
+            let (Ok(mu), Ok(md)) = (model.with_params(&up), model.with_params(&down)) else {
+                fails.push(format!(
+                    "with_params rejected {} = {} ± {h:e}",
+                    names.get(j).unwrap_or(&"?"),
+                    p[j]
+                ));
+                continue;
+            };
+            let fd = (mu.cf(f) - md.cf(f)) / (up[j] - down[j]);
+            let tol = FD_TOL * (grad[j].norm() + g.norm() / scale);
+            if (fd - grad[j]).norm() > tol {
+                fails.push(format!(
+                    "∂γ/∂{} = {} but central difference gives {fd} at 2πf·s = {c}",
+                    names.get(j).unwrap_or(&"?"),
+                    grad[j]
+                ));
+            }
+        }
+    }
+}
+
+fn sampler<J: JitterModel + ?Sized>(model: &J, seed: u64, fails: &mut Vec<String>) {
+    let mut rng = StdRng::seed_from_u64(seed);
+    let draws: Vec<f64> = (0..MC_DRAWS).map(|_| model.sample(&mut rng)).collect();
+    let n = MC_DRAWS as f64;
+    let s = spread(model);
+    let (mean, var) = (model.mean(), model.variance());
+    let (lo, hi) = model.reach();
+    // Outside the reach with probability < TAIL_MASS per draw: never, for a correct model.
+    // The slack only absorbs rounding of a sum of terms that each stay inside.
+    let slack = 1e-12 * (s + lo.abs().max(hi.abs()));
+    if let Some(t) = draws
+        .iter()
+        .find(|t| !(t.is_finite() && **t >= lo - slack && **t <= hi + slack))
+    {
+        fails.push(format!("draw {t} is outside the reach [{lo}, {hi}]"));
+    }
+    // Sample mean: standard error √(var/n) from the exact variance, plus rounding.
+    let m = draws.iter().sum::<f64>() / n;
+    let tol = MC_SIGMAS * (var / n).sqrt() + EXACT_TOL * (mean.abs() + s);
+    if (m - mean).abs() > tol {
+        fails.push(format!(
+            "sample mean {m} but mean() = {mean} (allowed ±{tol:e})"
+        ));
+    }
+    // Variance about the exact mean, v̂ = mean((τ-μ)²), is unbiased with
+    // Var v̂ = (μ₄ - σ⁴)/n; μ₄ and σ⁴ are estimated from the same draws.
+    let v = draws.iter().map(|t| (t - mean).powi(2)).sum::<f64>() / n;
+    let m4 = draws.iter().map(|t| (t - mean).powi(4)).sum::<f64>() / n;
+    let se = ((m4 - v * v).max(0.0) / n).sqrt();
+    let tol = MC_SIGMAS * se + EXACT_TOL * (var + mean.abs() * s);
+    if (v - var).abs() > tol {
+        fails.push(format!(
+            "sample variance {v} but variance() = {var} (allowed ±{tol:e})"
+        ));
+    }
+    // Empirical characteristic function: each component is a mean of n bounded terms whose
+    // standard error, from their sample variance, is at most √(1/n) ≈ 0.007.
+    for c in MODERATE {
+        let f = freq(c, s);
+        let w = 2.0 * PI * f;
+        let g = model.cf(f);
+        let (re_mean, re_se) = mean_se(draws.iter().map(|t| (w * t).cos()));
+        let (im_mean, im_se) = mean_se(draws.iter().map(|t| -(w * t).sin()));
+        let (re_tol, im_tol) = (MC_SIGMAS * re_se + 1e-12, MC_SIGMAS * im_se + 1e-12);
+        if (re_mean - g.re).abs() > re_tol || (im_mean - g.im).abs() > im_tol {
+            fails.push(format!(
+                "empirical E[e^(-i2πfτ)] = {re_mean} + {im_mean}i but γ = {g} at 2πf·s = {c} \
+                 (allowed ±{re_tol:e}, ±{im_tol:e})"
+            ));
+        }
+    }
+}
+
+/// Sample mean and its standard error.
+fn mean_se(values: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
+    let n = values.clone().count() as f64;
+    let mean = values.clone().sum::<f64>() / n;
+    let var = values.map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Atom, Gaussian, UniformSum};
+    use rand::RngCore;
+
+    /// A deliberately broken family: right closed forms but the paper's misprinted
+    /// `πfa` in `cf`, so the quadrature and sampler checks must catch it.
+    #[derive(Debug, Clone)]
+    struct Misprinted(UniformSum);
+
+    impl JitterModel for Misprinted {
+        fn name(&self) -> &'static str {
+            "misprinted"
+        }
+        fn param_names(&self) -> Vec<&'static str> {
+            self.0.param_names()
+        }
+        fn params(&self) -> Vec<f64> {
+            self.0.params()
+        }
+        fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
+            self.0.with_params(params).map(Misprinted)
+        }
+        fn cf(&self, f: f64) -> Complex64 {
+            self.0.cf(0.5 * f)
+        }
+        fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+            self.0.cf_gradient(0.5 * f, grad)
+        }
+        fn mgf(&self, _z: Complex64) -> Option<Complex64> {
+            None
+        }
+        fn pdf(&self, tau: f64) -> f64 {
+            self.0.pdf(tau)
+        }
+        fn atoms(&self) -> Vec<Atom> {
+            Vec::new()
+        }
+        fn pieces(&self) -> Vec<(f64, f64)> {
+            self.0.pieces()
+        }
+        fn mean(&self) -> f64 {
+            0.0
+        }
+        fn variance(&self) -> f64 {
+            self.0.variance()
+        }
+        fn sample(&self, rng: &mut dyn RngCore) -> f64 {
+            self.0.sample(rng)
+        }
+    }
+
+    #[test]
+    fn a_misprinted_characteristic_function_is_caught() {
+        let m = Misprinted(UniformSum::new(2, 0.5).unwrap());
+        let err = check_contract(&m, 7).unwrap_err();
+        assert!(err.contains("quadrature gives E[e^(-i2πfτ)]"), "{err}");
+        assert!(err.contains("empirical E[e^(-i2πfτ)]"), "{err}");
+    }
+
+    #[test]
+    fn a_wrong_variance_is_caught() {
+        #[derive(Debug, Clone)]
+        struct Wide(Gaussian);
+        impl JitterModel for Wide {
+            fn name(&self) -> &'static str {
+                "wide"
+            }
+            fn param_names(&self) -> Vec<&'static str> {
+                self.0.param_names()
+            }
+            fn params(&self) -> Vec<f64> {
+                self.0.params()
+            }
+            fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
+                self.0.with_params(params).map(Wide)
+            }
+            fn cf(&self, f: f64) -> Complex64 {
+                self.0.cf(f)
+            }
+            fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+                self.0.cf_gradient(f, grad)
+            }
+            fn mgf(&self, z: Complex64) -> Option<Complex64> {
+                self.0.mgf(z)
+            }
+            fn pdf(&self, tau: f64) -> f64 {
+                self.0.pdf(tau)
+            }
+            fn pieces(&self) -> Vec<(f64, f64)> {
+                self.0.pieces()
+            }
+            fn mean(&self) -> f64 {
+                0.0
+            }
+            fn variance(&self) -> f64 {
+                1.001 * self.0.variance()
+            }
+            fn sample(&self, rng: &mut dyn RngCore) -> f64 {
+                self.0.sample(rng)
+            }
+        }
+        let err = check_closed_forms(&Wide(Gaussian::new(0.1).unwrap())).unwrap_err();
+        assert!(err.contains("rule variance"), "{err}");
+    }
+}

@@ -1,0 +1,146 @@
+use thiserror::Error;
+
+/// Why a signal model, input or sampling grid could not be built.
+///
+/// Every variant names what is wrong and the offending value.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SignalError {
+    /// A value was NaN or infinite.
+    #[error("`{name}` must be finite, got {value}")]
+    NotFinite {
+        /// What the value is.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A value that must be strictly positive was not.
+    #[error("`{name}` must be > 0, got {value}")]
+    NotPositive {
+        /// What the value is.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A count that must be at least one was zero.
+    #[error("`{name}` must be at least {min}, got {value}")]
+    TooFew {
+        /// What is counted.
+        name: &'static str,
+        /// The smallest allowed count.
+        min: usize,
+        /// The count given.
+        value: usize,
+    },
+    /// Times that must increase strictly did not.
+    #[error("`{name}` must be strictly increasing: element {index} ({value}) is not above the one before ({previous})")]
+    NotIncreasing {
+        /// What the times are.
+        name: &'static str,
+        /// Index of the first offending element.
+        index: usize,
+        /// Its value.
+        value: f64,
+        /// The value before it.
+        previous: f64,
+    },
+    /// Two lengths that must agree did not.
+    #[error("`{name}` has length {got}, expected {expected}")]
+    WrongLength {
+        /// What has the wrong length.
+        name: &'static str,
+        /// The length expected.
+        expected: usize,
+        /// The length given.
+        got: usize,
+    },
+    /// A pole with a non-negative real part: the model is not stable, so its spectrum and its
+    /// steady state are not defined.
+    #[error("pole {re}{im:+}i is not stable (its real part must be < 0)")]
+    Unstable {
+        /// Real part of the pole.
+        re: f64,
+        /// Imaginary part of the pole.
+        im: f64,
+    },
+    /// More zeros than poles: the transfer function is improper.
+    #[error("improper transfer function: {zeros} zeros but only {poles} poles")]
+    Improper {
+        /// Number of zeros (numerator degree).
+        zeros: usize,
+        /// Number of poles (denominator degree).
+        poles: usize,
+    },
+    /// Two poles coincide (within a relative `1e-9`); the modal form used for exact responses
+    /// needs distinct poles.
+    #[error("repeated pole near {re}{im:+}i: the exact response needs distinct poles")]
+    RepeatedPole {
+        /// Real part of the pole.
+        re: f64,
+        /// Imaginary part of the pole.
+        im: f64,
+    },
+    /// A complex pair was given with a non-positive imaginary part.
+    #[error("complex pair `{name}` must have imaginary part > 0, got {value}")]
+    BadPair {
+        /// Which root.
+        name: &'static str,
+        /// The imaginary part given.
+        value: f64,
+    },
+    /// The leading denominator coefficient was zero.
+    #[error("the leading coefficient of `{name}` must be non-zero")]
+    ZeroLeading {
+        /// Which polynomial.
+        name: &'static str,
+    },
+    /// A parameter vector of the wrong length.
+    #[error("signal model takes {expected} parameter(s), got {got}")]
+    WrongParamCount {
+        /// How many it takes.
+        expected: usize,
+        /// How many were given.
+        got: usize,
+    },
+    /// The roots of a polynomial could not be found to the required accuracy.
+    #[error("could not find the roots of `{name}`")]
+    Roots {
+        /// Which polynomial.
+        name: &'static str,
+    },
+}
+
+pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SignalError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(SignalError::NotFinite { name, value })
+    }
+}
+
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, SignalError> {
+    if finite(name, value)? > 0.0 {
+        Ok(value)
+    } else {
+        Err(SignalError::NotPositive { name, value })
+    }
+}
+
+pub(crate) fn all_finite(name: &'static str, values: &[f64]) -> Result<(), SignalError> {
+    values.iter().try_for_each(|&v| finite(name, v).map(|_| ()))
+}
+
+pub(crate) fn increasing(name: &'static str, values: &[f64]) -> Result<(), SignalError> {
+    all_finite(name, values)?;
+    for (i, w) in values.windows(2).enumerate() {
+        if !(w[1] > w[0]) {
+            return Err(SignalError::NotIncreasing {
+                name,
+                index: i + 1,
+                value: w[1],
+                previous: w[0],
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,50 @@
+//! Continuous-time signal models for **jitterid**.
+//!
+//! A [`Signal`] is a model `s(t; θ)` that can be evaluated exactly at any time, with its
+//! gradient, and whose Fourier transform `S_c(f) = ∫ s(t) e^{-i2πft} dt` is known in closed form
+//! as a density plus spectral lines. What identification needs from it under jitter is the
+//! first moment of the samples, `m_k = E[s(t_k + τ)]` ([`Signal::expected_values`]), and for
+//! the second moment `E[s(t_k + τ)²]`.
+//!
+//! # Conventions
+//!
+//! * Time in seconds, frequency in Hz; the Laplace variable `s` is in rad/s as usual, so a
+//!   transfer function's frequency response is `G(i2πf)`.
+//! * Requested instants `t_k = t0 + kT` ([`SampleGrid`]).
+//! * Responses are exact: an LTI system driven by a piecewise-constant input is evaluated in
+//!   modal (partial-fraction) form, `s(t) = Σ_j Δu_j [G(0) + Σ_i (r_i/p_i) e^{p_i (t − t_j)}]`
+//!   over the input's steps; no time stepping.
+//!
+//! # Models
+//!
+//! * [`TransferFunction`] (polynomial coefficients) and [`Zpk`] (zeros, poles, gain; real roots
+//!   and complex pairs), both [`RationalModel`]s, driven by an [`Input`] in [`LtiResponse`].
+//! * [`Sinusoid`]: `A sin(2πf0 t + φ)` with parameters `(A, f0, φ)`, spectral lines only.
+//! * [`PulseResponse`]: a discrete-time pulse response `g(t) = Σ h_l δ(t − lT_s)` driven by a
+//!   piecewise-constant input.
+//! * Inputs: [`PiecewiseConstant`] (and [`RandomBinary`], the paper's input, and zero-order
+//!   hold), [`Multisine`].
+//!
+//! The exact jittered simulator [`simulate`] draws `y_k = s(t_k + τ_k) + v_k`.
+#![warn(missing_docs)]
+
+mod error;
+mod grid;
+mod input;
+mod lti;
+pub mod poly;
+mod pulse;
+mod rational;
+mod signal;
+mod simulate;
+mod sinusoid;
+
+pub use error::SignalError;
+pub use grid::SampleGrid;
+pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone};
+pub use lti::LtiResponse;
+pub use pulse::PulseResponse;
+pub use rational::{Modal, RationalModel, Root, TransferFunction, Zpk};
+pub use signal::{local_breaks, Jacobian, Signal, SpectralLine};
+pub use simulate::{simulate, Simulation};
+pub use sinusoid::Sinusoid;

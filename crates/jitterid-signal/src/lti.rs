@@ -1,0 +1,426 @@
+//! The exact response of a rational model to a known input, and its exact jittered moments.
+
+use crate::input::Input;
+use crate::rational::{Modal, RationalModel};
+use crate::signal::{Jacobian, Signal, SpectralLine};
+use crate::{SampleGrid, SignalError};
+use jitterid_jitter::JitterModel;
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+
+/// The output `s(t) = (g ∗ u)(t)` of a rational model `G` driven by a known input, exactly.
+///
+/// For a piecewise-constant input, written as steps `u(t) = Σ_j Δu_j H(t − t_j)`,
+/// `s(t) = Σ_j Δu_j [G(0) + Σ_i (r_i/p_i) e^{p_i (t − t_j)}]` for `t ≥ t_j` (the modal form);
+/// the system is at rest before the first step. For tones the response is the steady state.
+///
+/// The first moment `m_k = E[s(t_k + τ)]` is computed exactly and in `O(N + J·Q)` for `N`
+/// samples, `J` steps and `Q` quadrature nodes: a step that lies before the jitter's reach of a
+/// sample acts through `E[e^{p_i(τ − lo)}]`, carried from sample to sample by the recursion
+/// `x ← e^{p_i T} x`; only steps inside a sample's reach `[t_k + lo, t_k + hi]` need the
+/// piecewise quadrature of the jitter's [`rule`](JitterModel::rule).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LtiResponse<M> {
+    model: M,
+    input: Input,
+    steps: Vec<(f64, f64)>,
+}
+
+impl<M: RationalModel> LtiResponse<M> {
+    /// The response of `model` to `input`.
+    pub fn new(model: M, input: impl Into<Input>) -> Self {
+        let input = input.into();
+        let steps = match &input {
+            Input::Piecewise(p) => p.steps(),
+            Input::Tones(_) => Vec::new(),
+        };
+        Self {
+            model,
+            input,
+            steps,
+        }
+    }
+
+    /// The model `G`.
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// The input.
+    pub fn input(&self) -> &Input {
+        &self.input
+    }
+
+    /// The input's steps `(t_j, Δu_j)` (empty for tones).
+    pub fn steps(&self) -> &[(f64, f64)] {
+        &self.steps
+    }
+
+    fn modal(&self) -> &Modal {
+        self.model.modal()
+    }
+
+    /// One representative per conjugate pair (upper half plane) and each real pole, with its
+    /// multiplicity in `Re Σ`: the sum over all poles of a real quantity is `Σ w·Re(term)`.
+    fn representatives(&self) -> Vec<(usize, f64)> {
+        self.modal()
+            .poles
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| match p.im.partial_cmp(&0.0) {
+                Some(std::cmp::Ordering::Greater) => Some((i, 2.0)),
+                Some(std::cmp::Ordering::Equal) => Some((i, 1.0)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Per sample: `C_k = E[Σ_j Δu_j 1{x ≥ 0}]`, and per representative pole
+    /// `A_ik = E[Σ_j Δu_j e^{p_i x} 1{x ≥ 0}]`, `B_ik = E[Σ_j Δu_j x e^{p_i x} 1{x ≥ 0}]`, with
+    /// `x = t_k + τ − t_j`. `B` only when `with_b`.
+    fn modal_expectations(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+        reps: &[(usize, f64)],
+        with_b: bool,
+    ) -> ModalExpectations {
+        let n = grid.len();
+        let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| self.modal().poles[i]).collect();
+        let np = poles.len();
+        let (lo, hi) = jitter.reach();
+        let rate = self.rate();
+        // E[e^{p(τ − lo)}] and E[(τ − lo) e^{p(τ − lo)}] over the reach: bounded because
+        // Re p < 0 and τ − lo ≥ 0.
+        let full = jitter.rule(&[], rate);
+        let mut m0 = vec![Complex64::new(0.0, 0.0); np];
+        let mut m1 = vec![Complex64::new(0.0, 0.0); np];
+        for (&tau, &w) in full.nodes.iter().zip(&full.weights) {
+            let sigma = tau - lo;
+            for (i, p) in poles.iter().enumerate() {
+                let e = (p * sigma).exp() * w;
+                m0[i] += e;
+                m1[i] += e * sigma;
+            }
+        }
+        let mass: f64 = full.mass();
+        let decay: Vec<Complex64> = poles.iter().map(|p| (p * grid.interval()).exp()).collect();
+
+        let mut out = ModalExpectations {
+            c: vec![0.0; n],
+            a: vec![vec![Complex64::new(0.0, 0.0); n]; np],
+            b: if with_b {
+                vec![vec![Complex64::new(0.0, 0.0); n]; np]
+            } else {
+                Vec::new()
+            },
+        };
+        // State over the steps already fully past: u_past = Σ Δu_j,
+        // x_i = Σ Δu_j e^{p_i a_j}, y_i = Σ Δu_j a_j e^{p_i a_j}, a_j = t_k + lo − t_j ≥ 0.
+        let mut u_past = 0.0;
+        let mut x = vec![Complex64::new(0.0, 0.0); np];
+        let mut y = vec![Complex64::new(0.0, 0.0); np];
+        let mut next_past = 0usize;
+        let steps = &self.steps;
+        for k in 0..n {
+            let t = grid.time(k);
+            if k > 0 {
+                for i in 0..np {
+                    y[i] = decay[i] * (y[i] + grid.interval() * x[i]);
+                    x[i] *= decay[i];
+                }
+            }
+            while next_past < steps.len() && steps[next_past].0 <= t + lo {
+                let (tj, du) = steps[next_past];
+                let a = t + lo - tj;
+                u_past += du;
+                for i in 0..np {
+                    let e = (poles[i] * a).exp() * du;
+                    x[i] += e;
+                    y[i] += e * a;
+                }
+                next_past += 1;
+            }
+            out.c[k] = u_past * mass;
+            for i in 0..np {
+                out.a[i][k] = x[i] * m0[i];
+                if with_b {
+                    out.b[i][k] = y[i] * m0[i] + x[i] * m1[i];
+                }
+            }
+            // Steps inside the reach: quadrature over τ ≥ c = t_j − t_k.
+            for &(tj, du) in steps[next_past..]
+                .iter()
+                .take_while(|(tj, _)| *tj < t + hi)
+            {
+                let c = tj - t;
+                let rule = jitter.rule(&[c], rate);
+                for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                    if tau < c {
+                        continue;
+                    }
+                    let xj = tau - c;
+                    out.c[k] += w * du;
+                    for i in 0..np {
+                        let e = (poles[i] * xj).exp() * (w * du);
+                        out.a[i][k] += e;
+                        if with_b {
+                            out.b[i][k] += e * xj;
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn tones_expectation(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+        grad: Option<&mut Jacobian>,
+    ) -> Vec<f64> {
+        let Input::Tones(m) = &self.input else {
+            return vec![0.0; grid.len()];
+        };
+        let np = self.model.params().len();
+        let mut out = vec![0.0; grid.len()];
+        let mut dg = vec![Complex64::new(0.0, 0.0); np];
+        let mut grad = grad;
+        for tone in m.tones() {
+            let s = Complex64::new(0.0, TAU * tone.frequency);
+            let g = self.model.response(s);
+            self.model.rational().response_gradient(s, &mut dg);
+            // E[e^{i2πf τ}] = γ(−f).
+            let damp = jitter.cf(-tone.frequency);
+            for (k, t) in grid.times().enumerate() {
+                let e = Complex64::from_polar(tone.amplitude, TAU * tone.frequency * t + tone.phase)
+                    * damp;
+                out[k] += (g * e).im;
+                if let Some(cols) = grad.as_deref_mut() {
+                    for (col, d) in cols.iter_mut().zip(&dg) {
+                        col[k] += (d * e).im;
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+struct ModalExpectations {
+    c: Vec<f64>,
+    a: Vec<Vec<Complex64>>,
+    b: Vec<Vec<Complex64>>,
+}
+
+impl<M: RationalModel> Signal for LtiResponse<M> {
+    fn param_names(&self) -> Vec<String> {
+        self.model.param_names()
+    }
+
+    fn params(&self) -> Vec<f64> {
+        self.model.params()
+    }
+
+    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
+        Ok(Self {
+            model: self.model.with_params(params)?,
+            input: self.input.clone(),
+            steps: self.steps.clone(),
+        })
+    }
+
+    fn value(&self, t: f64) -> f64 {
+        match &self.input {
+            Input::Tones(m) => m
+                .tones()
+                .iter()
+                .map(|c| {
+                    let g = self.model.frequency_response(c.frequency);
+                    (g * Complex64::from_polar(c.amplitude, TAU * c.frequency * t + c.phase)).im
+                })
+                .sum(),
+            Input::Piecewise(_) => {
+                let m = self.modal();
+                let reps = self.representatives();
+                let mut s = 0.0;
+                for &(tj, du) in self.steps.iter().take_while(|(tj, _)| *tj <= t) {
+                    let x = t - tj;
+                    let mut step = m.dc_gain;
+                    for &(i, w) in &reps {
+                        let (p, r) = (m.poles[i], m.residues[i]);
+                        step += w * (r / p * (p * x).exp()).re;
+                    }
+                    s += du * step;
+                }
+                s
+            }
+        }
+    }
+
+    fn value_gradient(&self, t: f64, grad: &mut [f64]) {
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        match &self.input {
+            Input::Tones(m) => {
+                let mut dg = vec![Complex64::new(0.0, 0.0); grad.len()];
+                for c in m.tones() {
+                    let s = Complex64::new(0.0, TAU * c.frequency);
+                    self.model.rational().response_gradient(s, &mut dg);
+                    let e = Complex64::from_polar(c.amplitude, TAU * c.frequency * t + c.phase);
+                    for (g, d) in grad.iter_mut().zip(&dg) {
+                        *g += (d * e).im;
+                    }
+                }
+            }
+            Input::Piecewise(_) => {
+                let m = self.modal();
+                let reps = self.representatives();
+                for &(tj, du) in self.steps.iter().take_while(|(tj, _)| *tj <= t) {
+                    let x = t - tj;
+                    for (j, g) in grad.iter_mut().enumerate() {
+                        let mut d = m.d_dc_gain[j];
+                        for &(i, w) in &reps {
+                            let (p, r) = (m.poles[i], m.residues[i]);
+                            let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
+                            let e = (p * x).exp();
+                            let d_rp = dr / p - r * dp / (p * p);
+                            d += w * (d_rp * e + r / p * x * e * dp).re;
+                        }
+                        *g += du * d;
+                    }
+                }
+            }
+        }
+    }
+
+    fn density(&self, f: f64) -> Complex64 {
+        match &self.input {
+            Input::Piecewise(p) => self.model.frequency_response(f) * p.spectrum(f),
+            Input::Tones(_) => Complex64::new(0.0, 0.0),
+        }
+    }
+
+    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        match &self.input {
+            Input::Piecewise(p) => {
+                let s = Complex64::new(0.0, TAU * f);
+                self.model.rational().response_gradient(s, grad);
+                let u = p.spectrum(f);
+                grad.iter_mut().for_each(|g| *g *= u);
+            }
+            Input::Tones(_) => grad.iter_mut().for_each(|g| *g = Complex64::new(0.0, 0.0)),
+        }
+    }
+
+    fn lines(&self) -> Vec<SpectralLine> {
+        let Input::Tones(m) = &self.input else {
+            return Vec::new();
+        };
+        let mut out = Vec::with_capacity(2 * m.tones().len());
+        for c in m.tones() {
+            // A sin(θ) = (A e^{iθ} − A e^{−iθ}) / (2i), each side scaled by G at its frequency.
+            let g = self.model.frequency_response(c.frequency);
+            let pos = g * Complex64::from_polar(c.amplitude, c.phase) / Complex64::new(0.0, 2.0);
+            out.push(SpectralLine {
+                frequency: c.frequency,
+                coefficient: pos,
+            });
+            out.push(SpectralLine {
+                frequency: -c.frequency,
+                coefficient: pos.conj(),
+            });
+        }
+        out
+    }
+
+    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
+        let Input::Tones(m) = &self.input else {
+            return Vec::new();
+        };
+        let np = self.model.params().len();
+        let mut dg = vec![Complex64::new(0.0, 0.0); np];
+        let mut out = Vec::new();
+        for c in m.tones() {
+            let s = Complex64::new(0.0, TAU * c.frequency);
+            self.model.rational().response_gradient(s, &mut dg);
+            let k = Complex64::from_polar(c.amplitude, c.phase) / Complex64::new(0.0, 2.0);
+            out.push(dg.iter().map(|d| (d * k, 0.0)).collect());
+            out.push(dg.iter().map(|d| ((d * k).conj(), 0.0)).collect());
+        }
+        out
+    }
+
+    fn breakpoints(&self) -> Vec<f64> {
+        self.steps.iter().map(|s| s.0).collect()
+    }
+
+    fn rate(&self) -> f64 {
+        let poles = self.modal().poles.iter().map(|p| p.norm());
+        let tones = match &self.input {
+            Input::Tones(m) => m.tones().iter().map(|c| TAU * c.frequency).collect(),
+            Input::Piecewise(_) => Vec::new(),
+        };
+        poles.chain(tones).fold(0.0, f64::max)
+    }
+
+    fn expected_values(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        if let Input::Tones(_) = self.input {
+            return self.tones_expectation(grid, jitter, None);
+        }
+        let m = self.modal();
+        let reps = self.representatives();
+        let e = self.modal_expectations(grid, jitter, &reps, false);
+        let coef: Vec<(Complex64, f64)> = reps
+            .iter()
+            .map(|&(i, w)| (m.residues[i] / m.poles[i], w))
+            .collect();
+        (0..grid.len())
+            .map(|k| {
+                m.dc_gain * e.c[k]
+                    + coef
+                        .iter()
+                        .zip(&e.a)
+                        .map(|(&(c, w), a)| w * (c * a[k]).re)
+                        .sum::<f64>()
+            })
+            .collect()
+    }
+
+    fn expected_values_gradient(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Jacobian {
+        let np = self.model.params().len();
+        if let Input::Tones(_) = self.input {
+            let mut cols = vec![vec![0.0; grid.len()]; np];
+            self.tones_expectation(grid, jitter, Some(&mut cols));
+            return cols;
+        }
+        let m = self.modal();
+        let reps = self.representatives();
+        let e = self.modal_expectations(grid, jitter, &reps, true);
+        (0..np)
+            .map(|j| {
+                // ∂/∂θ_j of G(0)·C + Re Σ (r/p) A, with ∂A/∂p = B.
+                let terms: Vec<(Complex64, Complex64, f64)> = reps
+                    .iter()
+                    .map(|&(i, w)| {
+                        let (p, r) = (m.poles[i], m.residues[i]);
+                        let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
+                        (dr / p - r * dp / (p * p), r / p * dp, w)
+                    })
+                    .collect();
+                (0..grid.len())
+                    .map(|k| {
+                        m.d_dc_gain[j] * e.c[k]
+                            + terms
+                                .iter()
+                                .enumerate()
+                                .map(|(i, &(d_rp, rp_dp, w))| {
+                                    w * (d_rp * e.a[i][k] + rp_dp * e.b[i][k]).re
+                                })
+                                .sum::<f64>()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,633 @@
+//! Proper, stable continuous-time transfer functions `G(s) = N(s)/A(s)` in two
+//! parameterisations, and their modal (partial-fraction) form with parameter derivatives.
+
+use crate::error::{all_finite, finite, SignalError};
+use crate::poly;
+use num_complex::Complex64;
+use std::fmt;
+
+/// Relative distance below which two poles count as repeated.
+const REPEATED_POLE_TOL: f64 = 1e-9;
+
+/// The modal form `G(s) = D + Σ_i r_i / (s − p_i)` over all poles (conjugate pairs appear as
+/// two entries), with derivatives of `D`, `p_i`, `r_i` and `G(0)` with respect to each parameter.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Modal {
+    /// Direct feed-through `D = G(∞)`.
+    pub direct: f64,
+    /// Poles `p_i` (distinct, `Re p_i < 0`).
+    pub poles: Vec<Complex64>,
+    /// Residues `r_i`.
+    pub residues: Vec<Complex64>,
+    /// Static gain `G(0)`.
+    pub dc_gain: f64,
+    /// `∂p_i/∂θ_j` as `[i][j]`.
+    pub d_poles: Vec<Vec<Complex64>>,
+    /// `∂r_i/∂θ_j` as `[i][j]`.
+    pub d_residues: Vec<Vec<Complex64>>,
+    /// `∂G(0)/∂θ_j`.
+    pub d_dc_gain: Vec<f64>,
+}
+
+/// `N(s)/A(s)` with `A` monic, the coefficient derivatives, and the modal form.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Rational {
+    num: Vec<f64>,
+    den: Vec<f64>,
+    d_num: Vec<Vec<f64>>,
+    d_den: Vec<Vec<f64>>,
+    modal: Modal,
+}
+
+impl Rational {
+    /// Builds and validates: `num` padded to `den`'s length, `den` monic, `poles` the roots of
+    /// `den`; `d_num[j]`, `d_den[j]` are the coefficient derivatives for parameter `j`.
+    fn new(
+        num: Vec<f64>,
+        den: Vec<f64>,
+        poles: Vec<Complex64>,
+        d_num: Vec<Vec<f64>>,
+        d_den: Vec<Vec<f64>>,
+    ) -> Result<Self, SignalError> {
+        for p in &poles {
+            if !(p.re < 0.0) {
+                return Err(SignalError::Unstable { re: p.re, im: p.im });
+            }
+        }
+        for (i, p) in poles.iter().enumerate() {
+            for q in &poles[i + 1..] {
+                if (p - q).norm() <= REPEATED_POLE_TOL * p.norm().max(1.0) {
+                    return Err(SignalError::RepeatedPole { re: p.re, im: p.im });
+                }
+            }
+        }
+        let n = den.len();
+        let num = poly::pad(&num, n);
+        let d_num: Vec<Vec<f64>> = d_num.iter().map(|d| poly::pad(d, n)).collect();
+        let d_den: Vec<Vec<f64>> = d_den.iter().map(|d| poly::pad(d, n)).collect();
+        let da = poly::derivative(&den);
+        let dda = poly::derivative(&da);
+        let dn = poly::derivative(&num);
+        let np = d_num.len();
+        let mut residues = Vec::with_capacity(poles.len());
+        let mut d_poles = Vec::with_capacity(poles.len());
+        let mut d_residues = Vec::with_capacity(poles.len());
+        for &p in &poles {
+            let a1 = poly::eval(&da, p);
+            let np_ = poly::eval(&num, p);
+            let r = np_ / a1;
+            let a2 = poly::eval(&dda, p);
+            let n1 = poly::eval(&dn, p);
+            let mut dp = Vec::with_capacity(np);
+            let mut dr = Vec::with_capacity(np);
+            for j in 0..np {
+                // A(p(θ); θ) = 0  ⇒  ∂p = −(∂A)(p) / A'(p).
+                let dpj = -poly::eval(&d_den[j], p) / a1;
+                let d_a1 = a2 * dpj + poly::eval(&poly::derivative(&d_den[j]), p);
+                let d_np = n1 * dpj + poly::eval(&d_num[j], p);
+                dp.push(dpj);
+                dr.push((d_np * a1 - np_ * d_a1) / (a1 * a1));
+            }
+            residues.push(r);
+            d_poles.push(dp);
+            d_residues.push(dr);
+        }
+        let a0 = den[n - 1];
+        let b0 = num[n - 1];
+        let dc_gain = b0 / a0;
+        let d_dc_gain = (0..np)
+            .map(|j| (d_num[j][n - 1] * a0 - b0 * d_den[j][n - 1]) / (a0 * a0))
+            .collect();
+        let modal = Modal {
+            direct: num[0],
+            poles,
+            residues,
+            dc_gain,
+            d_poles,
+            d_residues,
+            d_dc_gain,
+        };
+        let all_finite = modal.residues.iter().all(|r| r.is_finite()) && dc_gain.is_finite();
+        if !all_finite {
+            return Err(SignalError::Roots { name: "den" });
+        }
+        Ok(Self {
+            num,
+            den,
+            d_num,
+            d_den,
+            modal,
+        })
+    }
+
+    /// `G(s)`.
+    pub fn response(&self, s: Complex64) -> Complex64 {
+        poly::eval(&self.num, s) / poly::eval(&self.den, s)
+    }
+
+    /// `∂G(s)/∂θ_j` into `grad`.
+    pub fn response_gradient(&self, s: Complex64, grad: &mut [Complex64]) {
+        let n = poly::eval(&self.num, s);
+        let a = poly::eval(&self.den, s);
+        for (g, (dn, da)) in grad.iter_mut().zip(self.d_num.iter().zip(&self.d_den)) {
+            *g = (poly::eval(dn, s) * a - n * poly::eval(da, s)) / (a * a);
+        }
+    }
+
+    /// The modal form.
+    pub fn modal(&self) -> &Modal {
+        &self.modal
+    }
+
+    /// Numerator coefficients (padded to the denominator's length).
+    pub fn num(&self) -> &[f64] {
+        &self.num
+    }
+
+    /// Monic denominator coefficients.
+    pub fn den(&self) -> &[f64] {
+        &self.den
+    }
+}
+
+/// A proper, stable, continuous-time rational model with parameters `θ`.
+///
+/// Implementors build a [`Rational`] at construction (which validates stability, properness
+/// and distinct poles); everything else is provided.
+pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
+    /// Names of the parameters.
+    fn param_names(&self) -> Vec<String>;
+    /// The parameters.
+    fn params(&self) -> Vec<f64>;
+    /// The same parameterisation with new parameters, validated.
+    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError>;
+    /// The validated rational function with derivatives.
+    fn rational(&self) -> &Rational;
+
+    /// `G(s)` at complex `s` (rad/s).
+    fn response(&self, s: Complex64) -> Complex64 {
+        self.rational().response(s)
+    }
+
+    /// `G(i2πf)`, the frequency response at `f` Hz.
+    fn frequency_response(&self, f: f64) -> Complex64 {
+        self.response(Complex64::new(0.0, std::f64::consts::TAU * f))
+    }
+
+    /// The modal form.
+    fn modal(&self) -> &Modal {
+        self.rational().modal()
+    }
+}
+
+/// `G(s) = (b_m s^m + … + b_0) / (s^n + a_{n-1} s^{n-1} + … + a_0)`, `m ≤ n`.
+///
+/// Parameters: the numerator coefficients (highest power first), then the denominator's
+/// without its leading 1 (a denominator given with another leading coefficient is normalised).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TransferFunction {
+    rational: Rational,
+    num_len: usize,
+}
+
+impl TransferFunction {
+    /// `num` and `den` in decreasing powers. Rejects non-finite coefficients, a zero leading
+    /// denominator coefficient, an improper model, unstable or repeated poles.
+    pub fn new(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
+        all_finite("num", num)?;
+        all_finite("den", den)?;
+        if num.is_empty() {
+            return Err(SignalError::TooFew {
+                name: "num",
+                min: 1,
+                value: 0,
+            });
+        }
+        if den.len() < 2 {
+            return Err(SignalError::TooFew {
+                name: "den",
+                min: 2,
+                value: den.len(),
+            });
+        }
+        let lead = den[0];
+        if lead == 0.0 {
+            return Err(SignalError::ZeroLeading { name: "den" });
+        }
+        let first_nonzero = num.iter().position(|&c| c != 0.0).unwrap_or(num.len() - 1);
+        let degree = num.len() - 1 - first_nonzero;
+        if degree > den.len() - 1 {
+            return Err(SignalError::Improper {
+                zeros: degree,
+                poles: den.len() - 1,
+            });
+        }
+        let num: Vec<f64> = num[first_nonzero..].iter().map(|c| c / lead).collect();
+        let den: Vec<f64> = den.iter().map(|c| c / lead).collect();
+        Self::from_monic(num, den)
+    }
+
+    fn from_monic(num: Vec<f64>, den: Vec<f64>) -> Result<Self, SignalError> {
+        let poles = poly::roots(&den).ok_or(SignalError::Roots { name: "den" })?;
+        let (nb, na) = (num.len(), den.len() - 1);
+        let mut d_num = Vec::with_capacity(nb + na);
+        let mut d_den = Vec::with_capacity(nb + na);
+        for j in 0..nb {
+            let mut e = vec![0.0; nb];
+            e[j] = 1.0;
+            d_num.push(e);
+            d_den.push(vec![0.0; na + 1]);
+        }
+        for j in 0..na {
+            let mut e = vec![0.0; na + 1];
+            e[j + 1] = 1.0;
+            d_num.push(vec![0.0; nb]);
+            d_den.push(e);
+        }
+        let num_len = num.len();
+        Ok(Self {
+            rational: Rational::new(num, den, poles, d_num, d_den)?,
+            num_len,
+        })
+    }
+
+    /// Numerator coefficients, highest power first.
+    pub fn num(&self) -> &[f64] {
+        let n = self.rational.num.len();
+        &self.rational.num[n - self.num_len..]
+    }
+
+    /// Monic denominator coefficients, highest power first.
+    pub fn den(&self) -> &[f64] {
+        &self.rational.den
+    }
+}
+
+impl RationalModel for TransferFunction {
+    fn param_names(&self) -> Vec<String> {
+        let nb = self.num_len;
+        let na = self.rational.den.len() - 1;
+        (0..nb)
+            .map(|i| format!("b{}", nb - 1 - i))
+            .chain((0..na).map(|i| format!("a{}", na - 1 - i)))
+            .collect()
+    }
+
+    fn params(&self) -> Vec<f64> {
+        let mut p = self.num().to_vec();
+        p.extend_from_slice(&self.rational.den[1..]);
+        p
+    }
+
+    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
+        let na = self.rational.den.len() - 1;
+        if params.len() != self.num_len + na {
+            return Err(SignalError::WrongParamCount {
+                expected: self.num_len + na,
+                got: params.len(),
+            });
+        }
+        all_finite("tf parameter", params)?;
+        let num = params[..self.num_len].to_vec();
+        let mut den = vec![1.0];
+        den.extend_from_slice(&params[self.num_len..]);
+        Self::from_monic(num, den)
+    }
+
+    fn rational(&self) -> &Rational {
+        &self.rational
+    }
+}
+
+/// A real root of a polynomial, or a complex-conjugate pair `re ± i·im` with `im > 0`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Root {
+    /// A real root.
+    Real(f64),
+    /// The pair `re ± i·im`.
+    Pair {
+        /// Real part.
+        re: f64,
+        /// Imaginary part (> 0).
+        im: f64,
+    },
+}
+
+impl Root {
+    fn validate(&self, name: &'static str) -> Result<(), SignalError> {
+        match *self {
+            Root::Real(x) => finite(name, x).map(|_| ()),
+            Root::Pair { re, im } => {
+                finite(name, re)?;
+                finite(name, im)?;
+                if im > 0.0 {
+                    Ok(())
+                } else {
+                    Err(SignalError::BadPair { name, value: im })
+                }
+            }
+        }
+    }
+
+    fn num_params(&self) -> usize {
+        match self {
+            Root::Real(_) => 1,
+            Root::Pair { .. } => 2,
+        }
+    }
+
+    /// Monic factor `(s − x)` or `(s² − 2re·s + re² + im²)` and its derivatives with respect
+    /// to the root's parameters.
+    fn factor(&self) -> (Vec<f64>, Vec<Vec<f64>>) {
+        match *self {
+            Root::Real(x) => (vec![1.0, -x], vec![vec![0.0, -1.0]]),
+            Root::Pair { re, im } => (
+                vec![1.0, -2.0 * re, re * re + im * im],
+                vec![vec![0.0, -2.0, 2.0 * re], vec![0.0, 0.0, 2.0 * im]],
+            ),
+        }
+    }
+
+    fn values(&self) -> Vec<Complex64> {
+        match *self {
+            Root::Real(x) => vec![Complex64::new(x, 0.0)],
+            Root::Pair { re, im } => vec![Complex64::new(re, im), Complex64::new(re, -im)],
+        }
+    }
+}
+
+/// `G(s) = k · Π (s − z_i) / Π (s − p_i)` with real roots and complex pairs.
+///
+/// Parameters: the gain, then each zero, then each pole; a real root is one parameter, a pair
+/// two (real part, then imaginary part). The paper's eq. (17),
+/// `G(s) = k0 (s + z) / ((s − pr − i·pi)(s − pr + i·pi))`, is
+/// `Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }])`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Zpk {
+    gain: f64,
+    zeros: Vec<Root>,
+    poles: Vec<Root>,
+    rational: Rational,
+}
+
+fn expand(roots: &[Root]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let factors: Vec<_> = roots.iter().map(Root::factor).collect();
+    let mut prod = vec![1.0];
+    for (f, _) in &factors {
+        prod = poly::mul(&prod, f);
+    }
+    let mut d = Vec::new();
+    for (i, (_, dfs)) in factors.iter().enumerate() {
+        for df in dfs {
+            let mut p = vec![1.0];
+            for (l, (f, _)) in factors.iter().enumerate() {
+                p = poly::mul(&p, if l == i { df } else { f });
+            }
+            d.push(p);
+        }
+    }
+    (prod, d)
+}
+
+impl Zpk {
+    /// Validates finite values, pairs with `im > 0`, at most as many zeros as poles, at least
+    /// one pole, stable and distinct poles.
+    pub fn new(gain: f64, zeros: Vec<Root>, poles: Vec<Root>) -> Result<Self, SignalError> {
+        finite("gain", gain)?;
+        zeros.iter().try_for_each(|z| z.validate("zero"))?;
+        poles.iter().try_for_each(|p| p.validate("pole"))?;
+        let nz: usize = zeros.iter().map(Root::num_params).sum();
+        let np: usize = poles.iter().map(Root::num_params).sum();
+        if np == 0 {
+            return Err(SignalError::TooFew {
+                name: "poles",
+                min: 1,
+                value: 0,
+            });
+        }
+        if nz > np {
+            return Err(SignalError::Improper {
+                zeros: nz,
+                poles: np,
+            });
+        }
+        let (zn, dzn) = expand(&zeros);
+        let (den, dden_p) = expand(&poles);
+        let num: Vec<f64> = zn.iter().map(|c| gain * c).collect();
+        let mut d_num = vec![zn.clone()];
+        let mut d_den = vec![vec![0.0; den.len()]];
+        for dz in &dzn {
+            d_num.push(dz.iter().map(|c| gain * c).collect());
+            d_den.push(vec![0.0; den.len()]);
+        }
+        for dp in dden_p {
+            d_num.push(vec![0.0; num.len()]);
+            d_den.push(dp);
+        }
+        let pole_values = poles.iter().flat_map(Root::values).collect();
+        let rational = Rational::new(num, den, pole_values, d_num, d_den)?;
+        Ok(Self {
+            gain,
+            zeros,
+            poles,
+            rational,
+        })
+    }
+
+    /// The gain `k`.
+    pub fn gain(&self) -> f64 {
+        self.gain
+    }
+
+    /// The zeros.
+    pub fn zeros(&self) -> &[Root] {
+        &self.zeros
+    }
+
+    /// The poles.
+    pub fn poles(&self) -> &[Root] {
+        &self.poles
+    }
+}
+
+fn root_names(prefix: &str, roots: &[Root], out: &mut Vec<String>) {
+    for (i, r) in roots.iter().enumerate() {
+        match r {
+            Root::Real(_) => out.push(format!("{prefix}{i}")),
+            Root::Pair { .. } => {
+                out.push(format!("{prefix}{i}.re"));
+                out.push(format!("{prefix}{i}.im"));
+            }
+        }
+    }
+}
+
+fn push_root_params(roots: &[Root], out: &mut Vec<f64>) {
+    for r in roots {
+        match *r {
+            Root::Real(x) => out.push(x),
+            Root::Pair { re, im } => out.extend([re, im]),
+        }
+    }
+}
+
+fn roots_from(template: &[Root], params: &mut impl Iterator<Item = f64>) -> Vec<Root> {
+    template
+        .iter()
+        .map(|r| match r {
+            Root::Real(_) => Root::Real(params.next().unwrap_or(f64::NAN)),
+            Root::Pair { .. } => Root::Pair {
+                re: params.next().unwrap_or(f64::NAN),
+                im: params.next().unwrap_or(f64::NAN),
+            },
+        })
+        .collect()
+}
+
+impl RationalModel for Zpk {
+    fn param_names(&self) -> Vec<String> {
+        let mut names = vec!["gain".to_string()];
+        root_names("zero", &self.zeros, &mut names);
+        root_names("pole", &self.poles, &mut names);
+        names
+    }
+
+    fn params(&self) -> Vec<f64> {
+        let mut p = vec![self.gain];
+        push_root_params(&self.zeros, &mut p);
+        push_root_params(&self.poles, &mut p);
+        p
+    }
+
+    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
+        let expected = self.rational.d_num.len();
+        if params.len() != expected {
+            return Err(SignalError::WrongParamCount {
+                expected,
+                got: params.len(),
+            });
+        }
+        let mut it = params[1..].iter().copied();
+        let zeros = roots_from(&self.zeros, &mut it);
+        let poles = roots_from(&self.poles, &mut it);
+        Self::new(params[0], zeros, poles)
+    }
+
+    fn rational(&self) -> &Rational {
+        &self.rational
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> Zpk {
+        Zpk::new(
+            0.2,
+            vec![Root::Real(-0.5)],
+            vec![Root::Pair {
+                re: -0.25,
+                im: 0.3,
+            }],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn modal_form_reproduces_response() {
+        let g = paper();
+        let m = g.modal();
+        for s in [Complex64::new(0.0, 1.3), Complex64::new(-0.1, 0.2)] {
+            let modal: Complex64 = m.direct
+                + m.poles
+                    .iter()
+                    .zip(&m.residues)
+                    .map(|(p, r)| r / (s - p))
+                    .sum::<Complex64>();
+            assert!((modal - g.response(s)).norm() < 1e-14);
+        }
+        assert!((m.dc_gain - 0.2 * 0.5 / (0.0625 + 0.09)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn modal_derivatives_match_finite_differences() {
+        // Zpk and tf, each against central differences of with_params.
+        check_fd(&paper());
+        check_fd(&TransferFunction::new(&[0.3, 1.0, 0.2], &[1.0, 3.0, 2.5, 0.5]).unwrap());
+    }
+
+    fn check_fd<M: RationalModel>(g: &M) {
+        let p0 = g.params();
+        let m = g.modal().clone();
+        for j in 0..p0.len() {
+            let h = 1e-6 * p0[j].abs().max(1.0);
+            let mut pp = p0.clone();
+            pp[j] += h;
+            let mut pm = p0.clone();
+            pm[j] -= h;
+            let (mp, mm) = (
+                g.with_params(&pp).unwrap().modal().clone(),
+                g.with_params(&pm).unwrap().modal().clone(),
+            );
+            let fd_gain = (mp.dc_gain - mm.dc_gain) / (2.0 * h);
+            assert!((fd_gain - m.d_dc_gain[j]).abs() < 1e-7, "dc gain, param {j}");
+            for i in 0..m.poles.len() {
+                // Match poles by proximity: root order may differ between solves.
+                let find = |mm: &Modal| {
+                    (0..mm.poles.len())
+                        .min_by(|&a, &b| {
+                            (mm.poles[a] - m.poles[i])
+                                .norm()
+                                .total_cmp(&(mm.poles[b] - m.poles[i]).norm())
+                        })
+                        .unwrap()
+                };
+                let (ip, im) = (find(&mp), find(&mm));
+                let fd_p = (mp.poles[ip] - mm.poles[im]) / (2.0 * h);
+                let fd_r = (mp.residues[ip] - mm.residues[im]) / (2.0 * h);
+                assert!((fd_p - m.d_poles[i][j]).norm() < 1e-6, "pole {i} param {j}");
+                assert!((fd_r - m.d_residues[i][j]).norm() < 1e-6, "residue {i} param {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn validation_names_the_problem() {
+        assert!(matches!(
+            Zpk::new(1.0, vec![], vec![Root::Real(0.1)]),
+            Err(SignalError::Unstable { .. })
+        ));
+        assert!(matches!(
+            Zpk::new(1.0, vec![Root::Real(1.0), Root::Real(2.0)], vec![Root::Real(-1.0)]),
+            Err(SignalError::Improper { .. })
+        ));
+        assert!(matches!(
+            Zpk::new(1.0, vec![], vec![Root::Real(-1.0), Root::Real(-1.0)]),
+            Err(SignalError::RepeatedPole { .. })
+        ));
+        assert!(matches!(
+            Zpk::new(f64::NAN, vec![], vec![Root::Real(-1.0)]),
+            Err(SignalError::NotFinite { name: "gain", .. })
+        ));
+        assert!(matches!(
+            TransferFunction::new(&[1.0], &[0.0, 1.0]),
+            Err(SignalError::ZeroLeading { .. })
+        ));
+        assert!(matches!(
+            TransferFunction::new(&[1.0, 0.0, 0.0], &[1.0, 1.0]),
+            Err(SignalError::Improper { .. })
+        ));
+    }
+
+    #[test]
+    fn tf_and_zpk_agree() {
+        let z = paper();
+        let t = TransferFunction::new(&[0.2, 0.1], &[1.0, 0.5, 0.1525]).unwrap();
+        for f in [0.0, 0.1, 0.7] {
+            assert!((z.frequency_response(f) - t.frequency_response(f)).norm() < 1e-14);
+        }
+        assert_eq!(t.param_names(), ["b1", "b0", "a1", "a0"]);
+        assert_eq!(z.param_names(), ["gain", "zero0", "pole0.re", "pole0.im"]);
+    }
+}

@@ -1,0 +1,274 @@
+//! The LTI response against independent routes: a fine-step ODE integration for `s(t)`, the
+//! generic quadrature route for `m_k`, and finite differences for every gradient.
+
+use jitterid_jitter::{
+    ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
+};
+use jitterid_signal::{
+    Input, LtiResponse, Multisine, PiecewiseConstant, RandomBinary, RationalModel, Root,
+    SampleGrid, Signal, SignalError, SpectralLine, TransferFunction, Zpk,
+};
+use num_complex::Complex64;
+use rand::SeedableRng;
+
+/// Delegates the required methods only, so the trait's quadrature defaults are used.
+#[derive(Debug)]
+struct Plain<'a, S>(&'a S);
+
+impl<S: Signal> Signal for Plain<'_, S> {
+    fn param_names(&self) -> Vec<String> {
+        self.0.param_names()
+    }
+    fn params(&self) -> Vec<f64> {
+        self.0.params()
+    }
+    fn with_params(&self, _: &[f64]) -> Result<Self, SignalError> {
+        unreachable!("not used in these tests")
+    }
+    fn value(&self, t: f64) -> f64 {
+        self.0.value(t)
+    }
+    fn value_gradient(&self, t: f64, grad: &mut [f64]) {
+        self.0.value_gradient(t, grad)
+    }
+    fn density(&self, f: f64) -> Complex64 {
+        self.0.density(f)
+    }
+    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        self.0.density_gradient(f, grad)
+    }
+    fn lines(&self) -> Vec<SpectralLine> {
+        self.0.lines()
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        self.0.breakpoints()
+    }
+    fn rate(&self) -> f64 {
+        self.0.rate()
+    }
+}
+
+fn paper_system() -> Zpk {
+    Zpk::new(
+        0.2,
+        vec![Root::Real(-0.5)],
+        vec![Root::Pair {
+            re: -0.25,
+            im: 0.3,
+        }],
+    )
+    .unwrap()
+}
+
+fn third_order() -> TransferFunction {
+    // Poles −0.5, −1 ± 2i; a zero; direct feed-through 0.3 (biproper).
+    TransferFunction::new(&[0.3, 1.0, 0.8, 2.0], &[1.0, 2.5, 6.0, 2.5]).unwrap()
+}
+
+fn binary_input(seed: u64, end: f64) -> PiecewiseConstant {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    RandomBinary::new(3.0, -0.5, 1.0)
+        .unwrap()
+        .generate(-5.0, end, &mut rng)
+        .unwrap()
+}
+
+fn jitters() -> Vec<Box<dyn JitterModel>> {
+    vec![
+        Box::new(NoJitter),
+        Box::new(UniformSum::new(0, 0.5).unwrap()),
+        Box::new(UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap()),
+        Box::new(UniformSum::new(9, 1.3).unwrap()),
+        Box::new(Gaussian::new(0.15).unwrap()),
+        Box::new(Laplace::new(0.05).unwrap()),
+        Box::new(TwoPoint::new(0.3).unwrap()),
+        Box::new(ExponentialDelay::new(0.1).unwrap()),
+        Box::new(Shifted::new(UniformSum::new(1, 0.4).unwrap(), -0.2).unwrap()),
+    ]
+}
+
+/// RK4 on the controllable canonical form of `N(s)/A(s)` with `A` monic:
+/// `ẋ = A_c x + B u`, `y = C x + D u` with `C_i = b_i − D a_i`.
+fn ode_response(num: &[f64], den: &[f64], u: &PiecewiseConstant, t_end: f64, h: f64) -> Vec<(f64, f64)> {
+    let n = den.len() - 1;
+    let d = num[0];
+    let c: Vec<f64> = (0..n).map(|i| num[i + 1] - d * den[i + 1]).collect();
+    let deriv = |x: &[f64], uval: f64| -> Vec<f64> {
+        // x[0] is the highest-order state: ẋ_0 = −Σ a_{i+1} x_i + u, ẋ_i = x_{i−1}.
+        let mut dx = vec![0.0; n];
+        dx[0] = uval - (0..n).map(|i| den[i + 1] * x[i]).sum::<f64>();
+        for i in 1..n {
+            dx[i] = x[i - 1];
+        }
+        dx
+    };
+    let mut x = vec![0.0; n];
+    let mut out = Vec::new();
+    // Step exactly onto every edge so the input is constant within each RK4 step.
+    let mut marks: Vec<f64> = u.edges().to_vec();
+    marks.push(t_end);
+    marks.sort_by(f64::total_cmp);
+    for w in marks.windows(2) {
+        let (a, b) = (w[0], w[1].min(t_end));
+        if b <= a {
+            continue;
+        }
+        let uval = u.value(0.5 * (a + b));
+        let steps = ((b - a) / h).ceil() as usize;
+        let hh = (b - a) / steps as f64;
+        for _ in 0..steps {
+            let k1 = deriv(&x, uval);
+            let x2: Vec<f64> = x.iter().zip(&k1).map(|(x, k)| x + 0.5 * hh * k).collect();
+            let k2 = deriv(&x2, uval);
+            let x3: Vec<f64> = x.iter().zip(&k2).map(|(x, k)| x + 0.5 * hh * k).collect();
+            let k3 = deriv(&x3, uval);
+            let x4: Vec<f64> = x.iter().zip(&k3).map(|(x, k)| x + hh * k).collect();
+            let k4 = deriv(&x4, uval);
+            for i in 0..n {
+                x[i] += hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        let y = c.iter().zip(&x).map(|(c, x)| c * x).sum::<f64>() + d * u.value(b - 1e-12);
+        out.push((b, y));
+    }
+    out
+}
+
+#[test]
+fn response_matches_fine_step_ode_integration() {
+    let u = binary_input(7, 60.0);
+    for (num, den) in [
+        (vec![0.2, 0.1], vec![1.0, 0.5, 0.1525]),
+        (vec![0.3, 1.0, 0.8, 2.0], vec![1.0, 2.5, 6.0, 2.5]),
+    ] {
+        let g = TransferFunction::new(&num, &den).unwrap();
+        let s = LtiResponse::new(g.clone(), u.clone());
+        let ode = ode_response(g.rational().num(), g.den(), &u, 60.0, 1e-3);
+        for (t, y) in ode {
+            // Just before the edge, where the ODE state is; RK4 at h = 1e-3 is accurate to ~1e-11.
+            let exact = s.value(t - 1e-12);
+            assert!((exact - y).abs() < 1e-8, "t = {t}: exact {exact}, ode {y}");
+        }
+    }
+}
+
+#[test]
+fn fast_first_moment_equals_quadrature_route() {
+    let grid = SampleGrid::new(0.3, 1.0, 60).unwrap();
+    let u = binary_input(11, 70.0);
+    let paper = LtiResponse::new(paper_system(), u.clone());
+    let third = LtiResponse::new(third_order(), u);
+    let mut worst = 0.0f64;
+    for jitter in jitters() {
+        for (fast, slow) in [
+            (
+                paper.expected_values(&grid, jitter.as_ref()),
+                Plain(&paper).expected_values(&grid, jitter.as_ref()),
+            ),
+            (
+                third.expected_values(&grid, jitter.as_ref()),
+                Plain(&third).expected_values(&grid, jitter.as_ref()),
+            ),
+        ] {
+            for (a, b) in fast.iter().zip(&slow) {
+                worst = worst.max((a - b).abs());
+                // Both routes are exact up to quadrature rounding (~1e-15 per node).
+                assert!((a - b).abs() < 1e-12, "{}: {a} vs {b}", jitter.name());
+            }
+        }
+    }
+    eprintln!("largest fast/quadrature difference: {worst:e}");
+}
+
+fn check_gradient<S: Signal>(s: &S, grid: &SampleGrid, jitter: &dyn JitterModel) {
+    let jac = s.expected_values_gradient(grid, jitter);
+    let plain = Plain(s).expected_values_gradient(grid, jitter);
+    let p0 = s.params();
+    for j in 0..p0.len() {
+        let h = 1e-6 * p0[j].abs().max(0.1);
+        let mut pp = p0.clone();
+        pp[j] += h;
+        let mut pm = p0.clone();
+        pm[j] -= h;
+        let mp = s.with_params(&pp).unwrap().expected_values(grid, jitter);
+        let mm = s.with_params(&pm).unwrap().expected_values(grid, jitter);
+        for k in 0..grid.len() {
+            let fd = (mp[k] - mm[k]) / (2.0 * h);
+            // Central differences: error O(h²·m''') plus rounding ~1e-16/h ≈ 1e-9.
+            assert!(
+                (fd - jac[j][k]).abs() < 1e-7,
+                "{} param {j} sample {k}: fd {fd} analytic {}",
+                jitter.name(),
+                jac[j][k]
+            );
+            assert!((plain[j][k] - jac[j][k]).abs() < 1e-11);
+        }
+    }
+}
+
+#[test]
+fn first_moment_gradient_matches_finite_differences() {
+    let grid = SampleGrid::new(0.0, 1.0, 40).unwrap();
+    let u = binary_input(3, 50.0);
+    for jitter in jitters() {
+        check_gradient(&LtiResponse::new(paper_system(), u.clone()), &grid, jitter.as_ref());
+        check_gradient(&LtiResponse::new(third_order(), u.clone()), &grid, jitter.as_ref());
+    }
+}
+
+#[test]
+fn value_gradient_matches_finite_differences() {
+    let s = LtiResponse::new(third_order(), binary_input(5, 30.0));
+    let p0 = s.params();
+    let mut g = vec![0.0; p0.len()];
+    for t in [0.5, 3.3, 12.0, 29.0] {
+        s.value_gradient(t, &mut g);
+        for j in 0..p0.len() {
+            let h = 1e-6;
+            let mut pp = p0.clone();
+            pp[j] += h;
+            let mut pm = p0.clone();
+            pm[j] -= h;
+            let fd = (s.with_params(&pp).unwrap().value(t) - s.with_params(&pm).unwrap().value(t))
+                / (2.0 * h);
+            assert!((fd - g[j]).abs() < 1e-7, "t {t} param {j}: {fd} vs {}", g[j]);
+        }
+    }
+}
+
+#[test]
+fn tone_input_moments_match_quadrature() {
+    let tones = Multisine::new(vec![
+        jitterid_signal::Tone {
+            frequency: 0.13,
+            amplitude: 1.0,
+            phase: 0.2,
+        },
+        jitterid_signal::Tone {
+            frequency: 0.41,
+            amplitude: 0.5,
+            phase: -1.0,
+        },
+    ])
+    .unwrap();
+    let s = LtiResponse::new(paper_system(), Input::Tones(tones));
+    let grid = SampleGrid::new(0.0, 1.0, 30).unwrap();
+    for jitter in jitters() {
+        let a = s.expected_values(&grid, jitter.as_ref());
+        let b = Plain(&s).expected_values(&grid, jitter.as_ref());
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() < 1e-12, "{}: {x} vs {y}", jitter.name());
+        }
+        check_gradient(&s, &grid, jitter.as_ref());
+    }
+}
+
+#[test]
+fn no_jitter_first_moment_is_the_sampled_signal() {
+    let s = LtiResponse::new(paper_system(), binary_input(9, 40.0));
+    let grid = SampleGrid::new(0.0, 0.5, 70).unwrap();
+    let m = s.expected_values(&grid, &NoJitter);
+    for (k, t) in grid.times().enumerate() {
+        assert!((m[k] - s.value(t)).abs() < 1e-14);
+    }
+}
