@@ -189,6 +189,9 @@ mod tests {
         let j = ExponentialDelay::new(0.5).unwrap();
         assert!(j.mgf(Complex64::new(1.99, 5.0)).is_some());
         assert!(j.mgf(Complex64::new(2.0, 0.0)).is_none());
-        assert_eq!(j.mgf(Complex64::new(-2.0, 0.0)), Some(Complex64::new(0.5, 0.0)));
+        assert_eq!(
+            j.mgf(Complex64::new(-2.0, 0.0)),
+            Some(Complex64::new(0.5, 0.0))
+        );
     }
 }

@@ -90,7 +90,11 @@ impl JitterModel for Gaussian {
         // ∂γ/∂σ = -(u²/σ) γ with u = 2πσf; when γ underflows, u² may be infinite.
         let u = 2.0 * PI * self.sigma * f;
         let g = (-0.5 * u * u).exp();
-        let d = if g == 0.0 { 0.0 } else { -u * u * g / self.sigma };
+        let d = if g == 0.0 {
+            0.0
+        } else {
+            -u * u * g / self.sigma
+        };
         grad[0] = Complex64::new(d, 0.0);
     }
 
@@ -166,9 +170,17 @@ mod tests {
         let j = Gaussian::new(0.3).unwrap();
         let r = j.rule(&[], 0.0);
         let s2 = 0.09;
-        assert!((r.mass() - 1.0).abs() < 1e-15);
-        assert!((r.expect(|t| t * t) - s2).abs() < 1e-15 * s2);
-        assert!((r.expect(|t| t.powi(4)) - 3.0 * s2 * s2).abs() < 1e-14 * s2 * s2);
+        // Plain summation of N positive terms: rounding ≈ √N ε, allowed 4√N ε.
+        let tol = 4.0 * (r.len() as f64).sqrt() * f64::EPSILON;
+        assert!((r.mass() - 1.0).abs() < tol);
+        // Moments of the truncated law: the tails beyond c = 8.6 carry
+        // 2φ(c)c of E[Z²] and 2φ(c)(c³ + 3c) of E[Z⁴] (up to the mass 2Q(c) < 1e-17).
+        let c = REACH_SIGMAS;
+        let phi = (-0.5 * c * c).exp() / (2.0 * PI).sqrt();
+        let m2 = (1.0 - 2.0 * phi * c) * s2;
+        let m4 = (3.0 - 2.0 * phi * (c.powi(3) + 3.0 * c)) * s2 * s2;
+        assert!((r.expect(|t| t * t) / m2 - 1.0).abs() < tol);
+        assert!((r.expect(|t| t.powi(4)) / m4 - 1.0).abs() < tol);
     }
 
     #[test]

@@ -99,7 +99,7 @@ impl QuadratureRule {
     /// Appends Gauss–Legendre nodes for `∫_lo^hi density(τ) h(τ) dτ`, split so that
     /// `rate × width ≤ 6` on each sub-interval.
     pub fn push_interval(&mut self, lo: f64, hi: f64, rate: f64, density: impl Fn(f64) -> f64) {
-        if !(hi > lo) {
+        if lo.is_nan() || hi.is_nan() || hi <= lo {
             return;
         }
         let (x, w) = gl16();

@@ -103,12 +103,11 @@ impl<J: JitterModel> JitterModel for Shifted<J> {
     fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
         let e = phasor(f * self.offset);
         let g = e * self.inner.cf(f);
-        // ∂γ/∂c = -i2πf γ; write it as a product so that γ = 0 never meets 2πf = ∞.
-        grad[0] = if g == Complex64::new(0.0, 0.0) {
-            g
-        } else {
-            Complex64::new(0.0, -2.0 * PI * f) * g
-        };
+        // ∂γ/∂c = -i2πf γ = 2πf (Im γ - i Re γ), by components so that a zero component
+        // never meets 2πf = ∞ (which would give NaN; the true derivative is then ±∞ or 0).
+        let w = 2.0 * PI * f;
+        let mul = |x: f64| if x == 0.0 { 0.0 } else { w * x };
+        grad[0] = Complex64::new(mul(g.im), -mul(g.re));
         self.inner.cf_gradient(f, &mut grad[1..]);
         for d in &mut grad[1..] {
             *d *= e;

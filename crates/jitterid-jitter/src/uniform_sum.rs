@@ -8,9 +8,8 @@ use rand::{Rng, RngCore};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// Largest `n` accepted. The density costs `O(n²)` per evaluation and its rule has `16(n+1)`
-/// nodes; far below this bound the family is already indistinguishable from a Gaussian.
-pub const MAX_N: u32 = 200;
+/// See [`UniformSum::MAX_N`].
+const MAX_N: u32 = 200;
 
 /// Sum of `n + 1` independent uniforms: `τ = U_1 + … + U_{n+1}`, `U_j ~ U[-a/(n+1), a/(n+1)]`.
 ///
@@ -23,8 +22,9 @@ pub const MAX_N: u32 = 200;
 /// `n` is structural, changed with [`with_n`](Self::with_n), and estimated by profiling.
 ///
 /// The density is the scaled Irwin–Hall density, evaluated with a recursion of non-negative
-/// terms so that it stays accurate for every `n ≤` [`MAX_N`] (the textbook alternating sum
-/// loses all digits near `n ≈ 20`).
+/// terms so that it stays accurate for every `n ≤` [`MAX_N`](Self::MAX_N). (The textbook
+/// alternating sum loses about 8 digits at the centre for `n = 20` and all of them by
+/// `n ≈ 40`.)
 ///
 /// ```
 /// use jitterid_jitter::{JitterModel, UniformSum};
@@ -55,8 +55,13 @@ impl TryFrom<UniformSumRaw> for UniformSum {
 }
 
 impl UniformSum {
+    /// Largest `n` accepted. The density costs `O(n²)` per evaluation and its rule has
+    /// `16(n+1)` nodes; far below this bound the family is already indistinguishable from a
+    /// Gaussian.
+    pub const MAX_N: u32 = MAX_N;
+
     /// Sum of `n + 1` uniforms with total half-width `a` (seconds). `a` must be finite and
-    /// `> 0`, and `n ≤` [`MAX_N`].
+    /// `> 0`, and `n ≤` [`MAX_N`](Self::MAX_N).
     pub fn new(n: u32, a: f64) -> Result<Self, JitterError> {
         if n > MAX_N {
             return Err(JitterError::OutOfRange {
@@ -114,7 +119,7 @@ impl UniformSum {
             (s, d)
         } else {
             let e = phasor(q); // cos x - i sin x
-            // x is infinite only if q is; the phase of a huge double is then taken as 0.
+                               // x is infinite only if q is; the phase of a huge double is then taken as 0.
             let s = if x.is_finite() { -e.im / x } else { 0.0 };
             (s, e.re - s)
         }
@@ -222,7 +227,7 @@ impl JitterModel for UniformSum {
     }
 
     fn pdf(&self, tau: f64) -> f64 {
-        if !(tau.abs() <= self.a) {
+        if tau.is_nan() || tau.abs() > self.a {
             return 0.0;
         }
         let w = 2.0 * self.half_width();
@@ -291,7 +296,11 @@ mod tests {
             -2.0 * m * h.powi(4) / 15.0,
             16.0 * m * h.powi(6) / 63.0,
         );
-        [k2, k4 + 3.0 * k2 * k2, k6 + 15.0 * k4 * k2 + 15.0 * k2.powi(3)]
+        [
+            k2,
+            k4 + 3.0 * k2 * k2,
+            k6 + 15.0 * k4 * k2 + 15.0 * k2.powi(3),
+        ]
     }
 
     #[test]
@@ -338,8 +347,9 @@ mod tests {
         }
         assert_eq!(t.pieces(), vec![(-1.0, 0.0), (0.0, 1.0)]);
         // The paper's Table 2 jitter.
-        let j = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
-        assert!((j.std_dev() - 0.5 / 3.0).abs() < 1e-16);
+        let a = 0.5 / 3f64.sqrt();
+        let j = UniformSum::new(2, a).unwrap();
+        assert!((j.std_dev() - a / 3.0).abs() < 1e-17);
     }
 
     #[test]
@@ -376,7 +386,11 @@ mod tests {
             let p = j.pdf(tau);
             assert!(p >= 0.0 && p.is_finite(), "{tau}: {p}");
             if tau.abs() <= sigma {
-                assert!((p / gauss(tau) - 1.0).abs() < 0.02, "{tau}: {p} vs {}", gauss(tau));
+                assert!(
+                    (p / gauss(tau) - 1.0).abs() < 0.02,
+                    "{tau}: {p} vs {}",
+                    gauss(tau)
+                );
             }
         }
         // The far tail is the monomial x^50/50! exactly.
@@ -403,13 +417,27 @@ mod tests {
                 let j = UniformSum::new(n, a).unwrap();
                 let r = j.rule(&[], 0.0);
                 let [m2, m4, m6] = exact_moments(n, a);
-                assert!((r.mass() - 1.0).abs() < 2e-15, "n = {n}: {}", r.mass() - 1.0);
+                // Plain summation of N positive terms: rounding ≈ √N ε, allowed 4√N ε.
+                let tol = 4.0 * (r.len() as f64).sqrt() * f64::EPSILON;
+                assert!((r.mass() - 1.0).abs() < tol, "n = {n}: {}", r.mass() - 1.0);
                 let e2 = r.expect(|t| t * t);
                 let e4 = r.expect(|t| t.powi(4));
                 let e6 = r.expect(|t| t.powi(6));
-                assert!((e2 / m2 - 1.0).abs() < 1e-14, "n = {n}, a = {a}: {}", e2 / m2 - 1.0);
-                assert!((e4 / m4 - 1.0).abs() < 1e-14, "n = {n}, a = {a}: {}", e4 / m4 - 1.0);
-                assert!((e6 / m6 - 1.0).abs() < 1e-14, "n = {n}, a = {a}: {}", e6 / m6 - 1.0);
+                assert!(
+                    (e2 / m2 - 1.0).abs() < tol,
+                    "n = {n}, a = {a}: {}",
+                    e2 / m2 - 1.0
+                );
+                assert!(
+                    (e4 / m4 - 1.0).abs() < tol,
+                    "n = {n}, a = {a}: {}",
+                    e4 / m4 - 1.0
+                );
+                assert!(
+                    (e6 / m6 - 1.0).abs() < tol,
+                    "n = {n}, a = {a}: {}",
+                    e6 / m6 - 1.0
+                );
                 assert!((j.variance() / m2 - 1.0).abs() < 1e-15);
             }
         }

@@ -69,13 +69,19 @@ fn shifted() {
         &Shifted::new(UniformSum::new(20, 1e-3).unwrap(), 0.0).unwrap(),
         603,
     );
-    assert_contract(&Shifted::new(Gaussian::new(0.01).unwrap(), 0.05).unwrap(), 604);
+    assert_contract(
+        &Shifted::new(Gaussian::new(0.01).unwrap(), 0.05).unwrap(),
+        604,
+    );
     assert_contract(
         &Shifted::new(ExponentialDelay::new(0.2).unwrap(), -0.2).unwrap(),
         605,
     );
     assert_contract(&Shifted::new(Laplace::new(2.0).unwrap(), 3.0).unwrap(), 606);
-    assert_contract(&Shifted::new(TwoPoint::new(0.3).unwrap(), 0.1).unwrap(), 607);
+    assert_contract(
+        &Shifted::new(TwoPoint::new(0.3).unwrap(), 0.1).unwrap(),
+        607,
+    );
     // Nested: two offsets and an inner family.
     let nested = Shifted::new(
         Shifted::new(Gaussian::new(0.5).unwrap(), 1.0).unwrap(),

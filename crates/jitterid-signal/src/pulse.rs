@@ -155,7 +155,9 @@ impl Tail {
 
 impl Signal for PulseResponse {
     fn param_names(&self) -> Vec<String> {
-        (0..self.coefficients.len()).map(|l| format!("h{l}")).collect()
+        (0..self.coefficients.len())
+            .map(|l| format!("h{l}"))
+            .collect()
     }
 
     fn params(&self) -> Vec<f64> {
@@ -281,7 +283,10 @@ mod tests {
                 got: 1
             })
         );
-        assert_eq!(p.with_params(&[1.0, 2.0, 3.0]).unwrap().params(), [1.0, 2.0, 3.0]);
+        assert_eq!(
+            p.with_params(&[1.0, 2.0, 3.0]).unwrap().params(),
+            [1.0, 2.0, 3.0]
+        );
     }
 
     #[test]

@@ -162,7 +162,7 @@ impl Signal for Sinusoid {
             .zip(&rule.weights)
             .map(|(&tau, &w)| w * tau * Complex64::cis(TAU * self.frequency * tau))
             .sum();
-        let mut cols = vec![Vec::with_capacity(grid.len()); 3];
+        let mut cols: Jacobian = (0..3).map(|_| Vec::with_capacity(grid.len())).collect();
         for t in grid.times() {
             let e = Complex64::cis(self.angle(t));
             let z = e * g;

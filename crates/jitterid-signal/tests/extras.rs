@@ -222,7 +222,14 @@ fn simulation_is_reproducible_and_exact() {
 fn simulation_without_jitter_or_noise_samples_the_signal() {
     let p = PulseResponse::new(vec![0.5, 0.25, -0.3], 0.73, random_input(11)).unwrap();
     let grid = SampleGrid::new(-1.0, 0.5, 40).unwrap();
-    let sim = simulate(&p, &NoJitter::new(), &grid, 0.0, &mut StdRng::seed_from_u64(1)).unwrap();
+    let sim = simulate(
+        &p,
+        &NoJitter::new(),
+        &grid,
+        0.0,
+        &mut StdRng::seed_from_u64(1),
+    )
+    .unwrap();
     let direct: Vec<f64> = grid.times().map(|t| p.value(t)).collect();
     assert_eq!(sim.y, direct);
     assert!(sim.tau.iter().all(|&t| t == 0.0));
@@ -284,22 +291,23 @@ fn monte_carlo(
     (mean, var)
 }
 
+/// A signal, its jitter and the instants to sample.
+type Case = (Box<dyn Signal>, Box<dyn JitterModel>, SampleGrid);
+
 #[test]
 fn monte_carlo_mean_matches_expected_values() {
     // Per sample, |ȳ_k − m_k| ≤ 5·√(λ_k / R) with λ_k = σ_v² + E[s²] − m_k²: a 5-standard-error
     // CLT bound (two-sided tail ≈ 6e-7 per sample).
     let runs = 4000;
     let noise_std = 0.05;
-    let cases: Vec<(Box<dyn Signal>, Box<dyn JitterModel>, SampleGrid)> = vec![
+    let cases: Vec<Case> = vec![
         (
             Box::new(Sinusoid::new(1.0, 0.3, 0.2).unwrap()),
             Box::new(UniformSum::new(2, 0.45).unwrap()),
             SampleGrid::new(0.0, 1.0, 30).unwrap(),
         ),
         (
-            Box::new(
-                PulseResponse::new(vec![0.8, 0.4, -0.2], 0.6, random_input(5)).unwrap(),
-            ),
+            Box::new(PulseResponse::new(vec![0.8, 0.4, -0.2], 0.6, random_input(5)).unwrap()),
             Box::new(Gaussian::new(0.3).unwrap()),
             SampleGrid::new(0.0, 0.7, 30).unwrap(),
         ),

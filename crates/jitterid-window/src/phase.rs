@@ -41,15 +41,6 @@ impl Cycles {
         }
     }
 
-    /// A value already in cycles per sample, `x = hi + lo`.
-    #[inline]
-    pub(crate) fn from_parts(hi: f64, lo: f64) -> Self {
-        let s = hi + lo;
-        let err = lo - (s - hi);
-        let h = centred_frac(s);
-        Self { hi: h, lo: err }
-    }
-
     /// The same frequency shifted by `d` cycles per sample (`d` small, such as `±1/N`),
     /// reduced again, without rounding the sum.
     #[inline]

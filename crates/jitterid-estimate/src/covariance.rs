@@ -1,0 +1,128 @@
+//! The asymptotic covariance of a frequency-domain least-squares estimate, in sandwich form.
+//!
+//! With `r = √W A d`, where `d_k = y_k − m_k` are the independent sample deviations and `A` maps
+//! them to `[Re D(f), Im D(f)]`, the estimate's covariance is
+//! `H⁻¹ (Jᵀ Σ_r J) H⁻¹` with `H = JᵀJ` and `Σ_r = √W A Λ Aᵀ √W`. Jittered samples are
+//! heteroscedastic: `Λ = diag(λ_k)`, `λ_k = σ_v² + E[s(t_k+τ)²] − m_k²` (`conventions.md`),
+//! so the simple `σ² H⁻¹` would be wrong. For coloured (Box–Jenkins) noise, its part of `Σ_r`
+//! is the asymptotic diagonal `N Φ_v(f)/2` per real and imaginary part.
+
+use crate::criterion::{Criterion, FrequencyData};
+use crate::noise::NoiseModel;
+use crate::structure::ModelStructure;
+use faer::linalg::solvers::DenseSolveCore;
+use faer::{Mat, Side};
+use jitterid_jitter::JitterModel;
+use jitterid_signal::Signal;
+use jitterid_window::Window;
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+
+/// The sandwich covariance and the noise standard deviation it used (known, or estimated by
+/// moments from the residuals). `None` when `JᵀJ` is singular or not finite.
+pub(crate) fn sandwich<S, J, N, C, W>(
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+    criterion: &C,
+    jac: &Mat<f64>,
+) -> (Option<Vec<Vec<f64>>>, f64)
+where
+    S: Signal,
+    J: JitterModel,
+    N: NoiseModel,
+    C: Criterion,
+    W: Window,
+{
+    let record = data.record();
+    let grid = record.grid();
+    let n = grid.len();
+    let p = jac.ncols();
+    // The data's true variance always involves the jitter, whatever the criterion models.
+    let m = model.signal.expected_values(grid, &model.jitter);
+    let sq = model.signal.expected_squares(grid, &model.jitter);
+    let jitter_var: Vec<f64> = sq.iter().zip(&m).map(|(s, m)| (s - m * m).max(0.0)).collect();
+    let mean_jitter_var = jitter_var.iter().sum::<f64>() / n as f64;
+    let freqs = data.frequencies();
+    let t = grid.interval();
+    let white = model.noise.is_white();
+    let noise_var = match model.noise_std {
+        Some(s) => s * s,
+        None if white => {
+            let mse = record
+                .y()
+                .iter()
+                .zip(&m)
+                .map(|(y, m)| (y - m).powi(2))
+                .sum::<f64>()
+                / n as f64;
+            (mse - mean_jitter_var).max(0.0)
+        }
+        None => {
+            // σ_e² from |D|² ≈ N (σ_e²|H|² + mean λ^J), averaged over the set.
+            let mu = data.transform_moment(&m);
+            let mut acc = 0.0;
+            for ((y, mu), &f) in data.dtft().iter().zip(&mu).zip(freqs.frequencies()) {
+                let d2 = (y - mu).norm_sqr() / n as f64;
+                acc += (d2 - mean_jitter_var).max(0.0) / model.noise.shape(f, t);
+            }
+            acc / freqs.len() as f64
+        }
+    };
+    let w = criterion.weights(freqs, &model.noise);
+    let taper = data.window().weights(n);
+
+    // G = Aᵀ√W·J without the taper c_k (applied in the sum below):
+    // G[k][j] = Σ_f √w_f (cos φ J[2f,j] − sin φ J[2f+1,j]), φ = 2π f kT.
+    let mut g = vec![vec![0.0; p]; n];
+    for (fi, &f) in freqs.frequencies().iter().enumerate() {
+        let sw = w[fi].sqrt();
+        let step = Complex64::from_polar(1.0, TAU * f * t);
+        let mut rot = Complex64::new(1.0, 0.0);
+        for (k, gk) in g.iter_mut().enumerate() {
+            if k % 128 == 0 {
+                // Re-anchor the rotation so rounding does not accumulate over long records.
+                rot = Complex64::from_polar(1.0, TAU * ((f * t * k as f64).fract()));
+            }
+            for (j, gkj) in gk.iter_mut().enumerate() {
+                *gkj += sw * (rot.re * jac[(2 * fi, j)] - rot.im * jac[(2 * fi + 1, j)]);
+            }
+            rot *= step;
+        }
+    }
+    let mut meat = Mat::<f64>::zeros(p, p);
+    for (k, gk) in g.iter().enumerate() {
+        let ck = taper[k];
+        let lambda = jitter_var[k] + if white { noise_var } else { 0.0 };
+        for a in 0..p {
+            for b in 0..p {
+                meat[(a, b)] += lambda * ck * ck * gk[a] * gk[b];
+            }
+        }
+    }
+    if !white {
+        let nyquist = 0.5 / t;
+        let energy: f64 = taper.iter().map(|c| c * c).sum();
+        for (fi, &f) in freqs.frequencies().iter().enumerate() {
+            let phi = noise_var * model.noise.shape(f, t) * energy;
+            let edge = f == 0.0 || (f - nyquist).abs() < 1e-12 * nyquist;
+            let (vre, vim) = if edge { (phi, 0.0) } else { (phi / 2.0, phi / 2.0) };
+            // Var r = w_f · Var(Re V), w_f · Var(Im V): the rows of J already carry √w_f.
+            for a in 0..p {
+                for b in 0..p {
+                    meat[(a, b)] += w[fi]
+                        * (vre * jac[(2 * fi, a)] * jac[(2 * fi, b)]
+                            + vim * jac[(2 * fi + 1, a)] * jac[(2 * fi + 1, b)]);
+                }
+            }
+        }
+    }
+    let h = jac.transpose() * jac;
+    let Ok(llt) = h.llt(Side::Lower) else {
+        return (None, noise_var.sqrt());
+    };
+    let hinv = llt.inverse();
+    let cov = &hinv * &meat * &hinv;
+    let out: Vec<Vec<f64>> = (0..p).map(|a| (0..p).map(|b| cov[(a, b)]).collect()).collect();
+    let finite = out.iter().flatten().all(|v| v.is_finite());
+    (finite.then_some(out), noise_var.sqrt())
+}

@@ -1,0 +1,225 @@
+//! The one entry point: [`estimate`] a model structure from a record with a criterion and a
+//! solver, with the asymptotic covariance of the estimate.
+
+use crate::covariance::sandwich;
+use crate::criterion::{Criterion, FrequencyData};
+use crate::data::Record;
+use crate::noise::NoiseModel;
+use crate::solver::{LeastSquares, LevenbergMarquardt, Solver, SolverError, Termination};
+use crate::structure::ModelStructure;
+use crate::EstimateError;
+use faer::Mat;
+use jitterid_jitter::JitterModel;
+use jitterid_signal::Signal;
+use jitterid_window::{DirichletWindow, FrequencySet, Window};
+
+/// Which frequencies a criterion uses.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Frequencies {
+    /// The DFT grid `j/(NT)`, `0 ≤ j ≤ N/2` (the default).
+    Dft,
+    /// The DFT-grid points in `[min, max]` Hz.
+    Band {
+        /// Lowest frequency (Hz).
+        min: f64,
+        /// Highest frequency (Hz).
+        max: f64,
+    },
+    /// Any list of frequencies in `[0, 1/T)`.
+    List(Vec<f64>),
+}
+
+impl Frequencies {
+    /// The validated set for a record.
+    pub fn resolve(&self, record: &Record) -> Result<FrequencySet, EstimateError> {
+        let grid = record.grid();
+        Ok(match self {
+            Frequencies::Dft => FrequencySet::dft(grid),
+            Frequencies::Band { min, max } => FrequencySet::band(grid, *min, *max)?,
+            Frequencies::List(f) => FrequencySet::list(grid, f.clone())?,
+        })
+    }
+}
+
+/// How to estimate.
+#[derive(Debug, Clone)]
+pub struct EstimateOptions<V = LevenbergMarquardt, W = DirichletWindow> {
+    /// The frequency set.
+    pub frequencies: Frequencies,
+    /// The window (taper) of the DTFT.
+    pub window: W,
+    /// The solver.
+    pub solver: V,
+    /// Whether to compute the asymptotic covariance.
+    pub covariance: bool,
+}
+
+impl Default for EstimateOptions {
+    fn default() -> Self {
+        Self {
+            frequencies: Frequencies::Dft,
+            window: DirichletWindow,
+            solver: LevenbergMarquardt::default(),
+            covariance: true,
+        }
+    }
+}
+
+/// The result of [`estimate`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Estimate {
+    /// The criterion's name.
+    pub criterion: String,
+    /// Names of the free parameters.
+    pub names: Vec<String>,
+    /// `θ̂`.
+    pub params: Vec<f64>,
+    /// Asymptotic covariance of `θ̂` (sandwich form), if computed and defined.
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// Standard errors, the square roots of the covariance's diagonal.
+    pub std_errors: Option<Vec<f64>>,
+    /// Final cost `½ Σ r²`.
+    pub cost: f64,
+    /// Solver iterations.
+    pub iterations: u64,
+    /// Why the solver stopped.
+    pub termination: Termination,
+    /// Whether the solver met a convergence test.
+    pub converged: bool,
+    /// Final residuals.
+    pub residuals: Vec<f64>,
+    /// The measurement-noise standard deviation used for the covariance (known or estimated).
+    pub noise_std: f64,
+}
+
+/// A criterion and its data as a [`LeastSquares`] problem in the structure's free parameters.
+///
+/// A parameter vector outside the model's domain (an unstable pole, `a ≤ 0`, …) gives NaN
+/// residuals, which the solvers treat as a rejected trial point.
+#[derive(Debug)]
+pub struct FitProblem<'a, S, J, N, C, W> {
+    /// The structure at the start (fixed parts and the template for `with_params`).
+    pub structure: &'a ModelStructure<S, J, N>,
+    /// The criterion.
+    pub criterion: &'a C,
+    /// The data.
+    pub data: &'a FrequencyData<W>,
+}
+
+impl<S, J, N, C, W> LeastSquares for FitProblem<'_, S, J, N, C, W>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion,
+    W: Window,
+{
+    fn num_params(&self) -> usize {
+        self.structure.num_params()
+    }
+
+    fn num_residuals(&self) -> usize {
+        self.data.num_residuals()
+    }
+
+    fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
+        Ok(match self.structure.with_params(theta) {
+            Ok(m) => self.criterion.residuals(self.data, &m),
+            Err(_) => vec![f64::NAN; self.num_residuals()],
+        })
+    }
+
+    fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
+        Ok(match self.structure.with_params(theta) {
+            Ok(m) => self.criterion.jacobian(self.data, &m),
+            Err(_) => Mat::from_fn(self.num_residuals(), self.num_params(), |_, _| f64::NAN),
+        })
+    }
+}
+
+/// Estimates the free parameters of `structure` from `record` by minimising `criterion` with
+/// `options.solver`, starting from the structure's current parameters.
+///
+/// # Errors
+///
+/// No free parameter; a criterion that ignores jitter asked to estimate it; fewer samples or
+/// residuals than parameters; an invalid frequency set or weights; a criterion not finite at
+/// the start; invalid solver options. A search that stops without converging is not an error:
+/// see [`Estimate::converged`] and [`Estimate::termination`].
+pub fn estimate<S, J, N, C, V, W>(
+    structure: &ModelStructure<S, J, N>,
+    record: &Record,
+    criterion: &C,
+    options: &EstimateOptions<V, W>,
+) -> Result<Estimate, EstimateError>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion,
+    V: Solver,
+    W: Window + Clone,
+{
+    let p = structure.num_params();
+    if p == 0 {
+        return Err(EstimateError::NothingToEstimate);
+    }
+    if structure.estimate_jitter && !criterion.models_jitter() {
+        return Err(EstimateError::JitterNotModelled {
+            criterion: criterion.name(),
+        });
+    }
+    if record.y().len() < p {
+        return Err(EstimateError::TooFewData {
+            what: "samples",
+            available: record.y().len(),
+            params: p,
+        });
+    }
+    let freqs = options.frequencies.resolve(record)?;
+    criterion.validate(&freqs)?;
+    let data = FrequencyData::new(record.clone(), options.window.clone(), freqs)?;
+    if data.num_residuals() < p {
+        return Err(EstimateError::TooFewData {
+            what: "residuals",
+            available: data.num_residuals(),
+            params: p,
+        });
+    }
+    let problem = FitProblem {
+        structure,
+        criterion,
+        data: &data,
+    };
+    let start = structure.params();
+    let r0 = criterion.residuals(&data, structure);
+    if let Some((index, &value)) = r0.iter().enumerate().find(|(_, r)| !r.is_finite()) {
+        return Err(EstimateError::NonFiniteAtStart { index, value });
+    }
+    let report = options.solver.minimize(&problem, &start)?;
+    let fitted = structure.with_params(&report.params)?;
+    let residuals = criterion.residuals(&data, &fitted);
+    let (covariance, noise_std) = if options.covariance {
+        let jac = criterion.jacobian(&data, &fitted);
+        let (cov, std) = sandwich(&data, &fitted, criterion, &jac);
+        (cov, std)
+    } else {
+        (None, fitted.noise_std.unwrap_or(f64::NAN))
+    };
+    let std_errors = covariance
+        .as_ref()
+        .map(|c: &Vec<Vec<f64>>| (0..p).map(|i| c[i][i].max(0.0).sqrt()).collect());
+    Ok(Estimate {
+        criterion: criterion.name().to_string(),
+        names: structure.param_names(),
+        params: report.params,
+        covariance,
+        std_errors,
+        cost: report.cost,
+        iterations: report.iterations,
+        termination: report.termination,
+        converged: report.converged,
+        residuals,
+        noise_std,
+    })
+}

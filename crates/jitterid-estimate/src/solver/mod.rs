@@ -1,0 +1,173 @@
+//! Optimisation layer: nonlinear least squares over [argmin].
+//!
+//! Every estimation criterion of this crate ends up as a [`LeastSquares`] problem: a residual
+//! vector `r(θ)` and its Jacobian, with cost `V(θ) = ½ Σ rᵢ²`. A [`Solver`] minimises `V` from a
+//! start and returns a [`SolverReport`] that says where it stopped and why.
+//!
+//! # Solvers
+//!
+//! * [`LevenbergMarquardt`]: the workhorse. Written here as an argmin [`argmin::core::Solver`]
+//!   (argmin has none), so it can also run under argmin's `Executor` with observers and
+//!   checkpointing; see [`lm`].
+//! * [`GaussNewtonLineSearch`]: argmin's `GaussNewtonLS` with a backtracking (Armijo) line search.
+//! * [`NelderMead`]: argmin's derivative-free simplex method on the cost.
+//! * [`MultiStart`]: runs another solver from the start plus seeded perturbed starts and keeps
+//!   the best result, to escape local minima.
+//!
+//! # Constraints
+//!
+//! Solvers are unconstrained. Sign and box constraints are handled by reparametrisation: wrap the
+//! problem in [`Transformed`] with one [`Transform`] per parameter. A start that violates its
+//! constraint is rejected with [`SolverError::OutsideConstraint`].
+//!
+//! # Infeasible points
+//!
+//! A problem marks a parameter vector as infeasible (say, an unstable model) by returning
+//! non-finite residuals there. The gradient-based solvers then shorten or reject the step;
+//! [`NelderMead`] treats it as an infinite cost. Returning an `Err` from
+//! [`LeastSquares::residuals`] instead aborts the solve with that error.
+//!
+//! # Example
+//!
+//! ```
+//! use jitterid_estimate::solver::{LeastSquares, LevenbergMarquardt, Solver, SolverError};
+//!
+//! /// Rosenbrock's function as residuals `[10(y − x²), 1 − x]`.
+//! struct Rosenbrock;
+//!
+//! impl LeastSquares for Rosenbrock {
+//!     fn num_params(&self) -> usize { 2 }
+//!     fn num_residuals(&self) -> usize { 2 }
+//!     fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, SolverError> {
+//!         Ok(vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]])
+//!     }
+//!     // `jacobian` defaults to central finite differences.
+//! }
+//!
+//! let report = LevenbergMarquardt::default().minimize(&Rosenbrock, &[-1.2, 1.0])?;
+//! assert!(report.converged);
+//! assert!((report.params[0] - 1.0).abs() < 1e-8 && (report.params[1] - 1.0).abs() < 1e-8);
+//! # Ok::<(), SolverError>(())
+//! ```
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+mod error;
+mod gauss_newton;
+pub mod lm;
+mod multistart;
+mod nelder_mead;
+mod problem;
+mod transform;
+
+pub use error::SolverError;
+pub use gauss_newton::GaussNewtonLineSearch;
+pub use lm::{LevenbergMarquardt, LmOptions, Scaling};
+pub use multistart::MultiStart;
+pub use nelder_mead::NelderMead;
+pub use problem::{
+    fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, DEFAULT_FD_STEP,
+};
+pub use transform::{Transform, Transformed};
+
+/// A minimiser of `V(θ) = ½ Σ rᵢ(θ)²`.
+pub trait Solver {
+    /// Minimises the cost of `problem` from `start`.
+    ///
+    /// # Errors
+    ///
+    /// Invalid starts ([`SolverError::WrongStartLength`], [`SolverError::NonFiniteStart`]),
+    /// problems with fewer residuals than parameters ([`SolverError::TooFewResiduals`]), a start
+    /// where the residuals are not finite ([`SolverError::NonFiniteResidual`]), invalid solver
+    /// options ([`SolverError::InvalidOption`]), and errors returned by the problem itself.
+    /// Running out of iterations or getting stuck is *not* an error: it is reported through
+    /// [`SolverReport::termination`] with [`SolverReport::converged`] `false`.
+    fn minimize<P: LeastSquares + ?Sized>(
+        &self,
+        problem: &P,
+        start: &[f64],
+    ) -> Result<SolverReport, SolverError>;
+}
+
+/// Outcome of [`Solver::minimize`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SolverReport {
+    /// Final parameters (the best point found).
+    pub params: Vec<f64>,
+    /// Cost `½ Σ rᵢ²` at [`params`](Self::params); always finite.
+    pub cost: f64,
+    /// Iterations performed (for [`MultiStart`]: summed over all starts).
+    pub iterations: u64,
+    /// Why the solver stopped.
+    pub termination: Termination,
+    /// `true` iff the solver stopped on one of its convergence tests
+    /// ([`Termination::is_convergence`]) at a finite cost.
+    pub converged: bool,
+}
+
+/// Why a solver stopped.
+#[non_exhaustive]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Termination {
+    /// The step became small relative to the parameters.
+    SmallStep,
+    /// The cost stopped decreasing (relative to the solver's tolerance).
+    SmallCostChange,
+    /// The gradient vanished (relative to the solver's tolerance).
+    SmallGradient,
+    /// The iteration limit was reached before any convergence test held.
+    MaxIterations,
+    /// The solver could not leave the current point because the residuals (or the Jacobian)
+    /// are not finite at every nearby trial point.
+    NonFinite,
+    /// The line search found no acceptable step along a non-negligible descent direction.
+    LineSearchFailed,
+    /// Any other reason, described in words.
+    Other(String),
+}
+
+impl Termination {
+    /// Whether this reason is a convergence test (small step, cost change or gradient).
+    pub fn is_convergence(&self) -> bool {
+        matches!(
+            self,
+            Termination::SmallStep | Termination::SmallCostChange | Termination::SmallGradient
+        )
+    }
+}
+
+impl fmt::Display for Termination {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Termination::SmallStep => f.write_str("small relative step"),
+            Termination::SmallCostChange => f.write_str("small relative cost change"),
+            Termination::SmallGradient => f.write_str("small gradient"),
+            Termination::MaxIterations => f.write_str("maximum number of iterations reached"),
+            Termination::NonFinite => {
+                f.write_str("residuals or Jacobian not finite at every nearby trial point")
+            }
+            Termination::LineSearchFailed => f.write_str("line search failed"),
+            Termination::Other(why) => f.write_str(why),
+        }
+    }
+}
+
+/// Maps a termination reason of argmin's own solvers, for solvers without finer reasons.
+fn from_argmin_reason(
+    status: &argmin::core::TerminationStatus,
+    converged_as: Termination,
+) -> Termination {
+    use argmin::core::{TerminationReason, TerminationStatus};
+    match status {
+        TerminationStatus::Terminated(TerminationReason::SolverConverged) => converged_as,
+        TerminationStatus::Terminated(TerminationReason::MaxItersReached) => {
+            Termination::MaxIterations
+        }
+        TerminationStatus::Terminated(reason) => Termination::Other(reason.text().to_string()),
+        TerminationStatus::NotTerminated => Termination::Other("not terminated".to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,317 @@
+//! Discrete-time Fourier transforms of a record: direct (any frequency), FFT (the DFT grid),
+//! and [`transform`], which picks between them.
+//!
+//! Convention: `X(f) = Σ_{k=0}^{N-1} w_k x_k e^{-i2πf kT}`, the phase referred to `k·T`, i.e.
+//! to the record's first instant `t0` (the samples are at `t0 + kT`).
+//!
+//! # Accuracy of the direct DTFT
+//!
+//! The naive recurrence `z ← z·e^{-i2πfT}` loses about one ulp of phase per step, and
+//! computing `f·k·T` directly loses the digits of the product above the unit. Here the phase
+//! `f·T` is split exactly into a double-double with a fused multiply-add and reduced modulo 1;
+//! every 64 samples the rotation is re-anchored from `k·(fT) mod 1`, itself computed with an
+//! exact product, and the 64-term block sums are added with Neumaier's compensated summation.
+//! The error is then a few `1e-16 · Σ|w_k x_k|`, independent of `N` and `f`
+//! (measured: about `1e-15` relative at `N = 10^5` against a compensated direct sum; see
+//! `tests/dtft.rs`).
+
+use crate::frequencies::FrequencySet;
+use crate::phase::{cis_neg_cycles, Cycles};
+use crate::window::Window;
+use crate::WindowError;
+use jitterid_signal::SampleGrid;
+use num_complex::Complex64;
+use rustfft::{Fft, FftPlanner};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Re-anchoring period of the rotation recurrence.
+const BLOCK: usize = 64;
+
+/// Neumaier-compensated complex sum.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct CompensatedSum {
+    re: f64,
+    im: f64,
+    c_re: f64,
+    c_im: f64,
+}
+
+#[inline]
+fn neumaier(sum: &mut f64, comp: &mut f64, x: f64) {
+    let t = *sum + x;
+    if sum.abs() >= x.abs() {
+        *comp += (*sum - t) + x;
+    } else {
+        *comp += (x - t) + *sum;
+    }
+    *sum = t;
+}
+
+impl CompensatedSum {
+    #[inline]
+    pub(crate) fn add(&mut self, z: Complex64) {
+        neumaier(&mut self.re, &mut self.c_re, z.re);
+        neumaier(&mut self.im, &mut self.c_im, z.im);
+    }
+
+    #[inline]
+    pub(crate) fn value(&self) -> Complex64 {
+        Complex64::new(self.re + self.c_re, self.im + self.c_im)
+    }
+}
+
+/// `Σ_k v_k e^{-i2πkx}` for `x` in cycles per sample: `O(N)`, stable for any `N` and `x`.
+pub(crate) fn dtft_at(values: &[f64], x: Cycles) -> Complex64 {
+    let step = cis_neg_cycles(x.value());
+    let mut sum = CompensatedSum::default();
+    for (b, chunk) in values.chunks(BLOCK).enumerate() {
+        let mut z = cis_neg_cycles(x.times((b * BLOCK) as f64));
+        let mut acc = Complex64::new(0.0, 0.0);
+        for &v in chunk {
+            acc += z * v;
+            z *= step;
+        }
+        sum.add(acc);
+    }
+    sum.value()
+}
+
+fn check_finite(name: &'static str, values: &[f64]) -> Result<(), WindowError> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(WindowError::NonFinite {
+            name,
+            index,
+            value: values[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+fn check_len(name: &'static str, expected: usize, values: &[f64]) -> Result<(), WindowError> {
+    if values.len() == expected {
+        Ok(())
+    } else {
+        Err(WindowError::WrongLength {
+            name,
+            expected,
+            got: values.len(),
+        })
+    }
+}
+
+/// `w_k x_k`, or a copy of `x` without weights.
+fn weighted(data: &[f64], weights: Option<&[f64]>) -> Vec<f64> {
+    match weights {
+        Some(w) => data.iter().zip(w).map(|(x, w)| x * w).collect(),
+        None => data.to_vec(),
+    }
+}
+
+/// The direct DTFT `X(f) = Σ_k w_k x_k e^{-i2πf kT}` of a record at arbitrary frequencies.
+///
+/// `data` (and `weights`, if given) must have length `N = grid.len()` and be finite; the
+/// frequencies (Hz) must be finite but may lie anywhere (the transform has period `1/T`).
+/// Cost `O(N)` per frequency; accurate to a few `1e-16 · Σ_k |w_k x_k|` for any `N` and `f`
+/// (see the module docs).
+pub fn dtft(
+    grid: &SampleGrid,
+    data: &[f64],
+    weights: Option<&[f64]>,
+    freqs: &[f64],
+) -> Result<Vec<Complex64>, WindowError> {
+    let n = grid.len();
+    check_len("data", n, data)?;
+    check_finite("data", data)?;
+    if let Some(w) = weights {
+        check_len("weights", n, w)?;
+        check_finite("weights", w)?;
+    }
+    if let Some(index) = freqs.iter().position(|f| !f.is_finite()) {
+        return Err(WindowError::FrequencyNotFinite {
+            index,
+            value: freqs[index],
+        });
+    }
+    let v = weighted(data, weights);
+    let t = grid.interval();
+    Ok(freqs
+        .iter()
+        .map(|&f| dtft_at(&v, Cycles::new(f, t)))
+        .collect())
+}
+
+fn planner() -> &'static Mutex<FftPlanner<f64>> {
+    static PLANNER: OnceLock<Mutex<FftPlanner<f64>>> = OnceLock::new();
+    PLANNER.get_or_init(|| Mutex::new(FftPlanner::new()))
+}
+
+/// A forward FFT plan of length `n`, planned once per length and shared.
+fn plan(n: usize) -> Arc<dyn Fft<f64>> {
+    let mut guard = match planner().lock() {
+        Ok(g) => g,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    guard.plan_fft_forward(n)
+}
+
+/// FFT of `values` (any length ≥ 1), unchecked.
+fn fft_values(values: Vec<f64>) -> Vec<Complex64> {
+    let mut buffer: Vec<Complex64> = values.into_iter().map(|v| Complex64::new(v, 0.0)).collect();
+    if !buffer.is_empty() {
+        plan(buffer.len()).process(&mut buffer);
+    }
+    buffer
+}
+
+/// All `N` DFT-grid values `X(j/(NT)) = Σ_k w_k x_k e^{-i2πjk/N}`, `j = 0..N-1`, by FFT
+/// (rustfft; plans are made once per length and shared between calls and threads).
+///
+/// `data` must be non-empty and finite; `weights`, if given, finite and of the same length.
+pub fn fft_grid(data: &[f64], weights: Option<&[f64]>) -> Result<Vec<Complex64>, WindowError> {
+    if data.is_empty() {
+        return Err(WindowError::Empty { name: "data" });
+    }
+    check_finite("data", data)?;
+    if let Some(w) = weights {
+        check_len("weights", data.len(), w)?;
+        check_finite("weights", w)?;
+    }
+    Ok(fft_values(weighted(data, weights)))
+}
+
+/// Whether the FFT beats `m` direct DTFTs of length `n`.
+fn fft_pays(m: usize, n: usize) -> bool {
+    m as f64 > 2.0 * (n as f64).log2().max(1.0)
+}
+
+/// The windowed transform `Y_w(f) = Σ_k w_k y_k e^{-i2πf kT}` of a record at the frequencies of
+/// a set, one output per frequency, in the set's order.
+///
+/// When the set lies on the DFT grid of this record and has more than about `2 log2 N`
+/// frequencies, one FFT is used and only the requested bins are kept; otherwise each frequency
+/// is a direct [`dtft`]. `data` must have length `N` and be finite.
+pub fn transform<W: Window + ?Sized>(
+    grid: &SampleGrid,
+    window: &W,
+    data: &[f64],
+    freqs: &FrequencySet,
+) -> Result<Vec<Complex64>, WindowError> {
+    let n = grid.len();
+    check_len("data", n, data)?;
+    check_finite("data", data)?;
+    if window.is_rectangular() {
+        return Ok(transform_weighted(grid, data.to_vec(), freqs));
+    }
+    let w = window.weights(n);
+    check_len("weights", n, &w)?;
+    check_finite("weights", &w)?;
+    Ok(transform_weighted(grid, weighted(data, Some(&w)), freqs))
+}
+
+/// [`transform`] without validation: wrong lengths or non-finite values give NaN outputs.
+pub(crate) fn transform_unchecked<W: Window + ?Sized>(
+    grid: &SampleGrid,
+    window: &W,
+    data: &[f64],
+    freqs: &FrequencySet,
+) -> Vec<Complex64> {
+    let n = grid.len();
+    if data.len() != n {
+        return vec![Complex64::new(f64::NAN, f64::NAN); freqs.len()];
+    }
+    if window.is_rectangular() {
+        return transform_weighted(grid, data.to_vec(), freqs);
+    }
+    let w = window.weights(n);
+    if w.len() != n {
+        return vec![Complex64::new(f64::NAN, f64::NAN); freqs.len()];
+    }
+    transform_weighted(grid, weighted(data, Some(&w)), freqs)
+}
+
+/// The transform of already weighted values of length `N`.
+fn transform_weighted(grid: &SampleGrid, values: Vec<f64>, freqs: &FrequencySet) -> Vec<Complex64> {
+    let n = values.len();
+    if let Some(indices) = freqs.dft_indices() {
+        if freqs.fits(grid) && fft_pays(freqs.len(), n) {
+            let spectrum = fft_values(values);
+            return indices
+                .iter()
+                .map(|&j| {
+                    spectrum
+                        .get(j)
+                        .copied()
+                        .unwrap_or(Complex64::new(f64::NAN, f64::NAN))
+                })
+                .collect();
+        }
+    }
+    let t = grid.interval();
+    freqs
+        .frequencies()
+        .iter()
+        .map(|&f| dtft_at(&values, Cycles::new(f, t)))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DirichletWindow, HannWindow};
+
+    #[test]
+    fn errors_name_the_offender() {
+        let g = SampleGrid::new(0.0, 1.0, 3).unwrap();
+        assert_eq!(
+            dtft(&g, &[1.0, 2.0], None, &[0.1]),
+            Err(WindowError::WrongLength {
+                name: "data",
+                expected: 3,
+                got: 2
+            })
+        );
+        assert!(matches!(
+            dtft(&g, &[1.0, f64::NAN, 0.0], None, &[0.1]),
+            Err(WindowError::NonFinite {
+                name: "data",
+                index: 1,
+                ..
+            })
+        ));
+        assert!(matches!(
+            dtft(&g, &[1.0, 2.0, 3.0], Some(&[1.0]), &[0.1]),
+            Err(WindowError::WrongLength {
+                name: "weights",
+                ..
+            })
+        ));
+        assert!(matches!(
+            dtft(&g, &[1.0, 2.0, 3.0], None, &[f64::NAN]),
+            Err(WindowError::FrequencyNotFinite { index: 0, .. })
+        ));
+        assert!(matches!(
+            fft_grid(&[], None),
+            Err(WindowError::Empty { name: "data" })
+        ));
+        let s = FrequencySet::dft(&g);
+        assert!(matches!(
+            transform(&g, &HannWindow, &[1.0, f64::INFINITY, 0.0], &s),
+            Err(WindowError::NonFinite {
+                name: "data",
+                index: 1,
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn small_dtft_by_hand() {
+        let g = SampleGrid::new(5.0, 0.5, 2).unwrap();
+        // X(f) = 1 + 2 e^{-i2π f 0.5}; at f = 0.5 Hz: 1 + 2 e^{-iπ/2} = 1 - 2i.
+        let x = dtft(&g, &[1.0, 2.0], None, &[0.5]).unwrap();
+        assert!((x[0] - Complex64::new(1.0, -2.0)).norm() < 1e-15);
+        let s = FrequencySet::full_dft(&g);
+        let y = transform(&g, &DirichletWindow, &[1.0, 2.0], &s).unwrap();
+        assert!((y[1] - Complex64::new(-1.0, 0.0)).norm() < 1e-15);
+    }
+}
