@@ -1,1 +1,90 @@
-fn main() {}
+//! Project tasks: `cargo xtask demo`, `cargo xtask reproduce <case>`.
+
+mod demo;
+mod paper;
+mod reproduce;
+
+use std::process::ExitCode;
+
+const USAGE: &str = "usage:
+  cargo xtask demo
+      simulate the paper's Table 2 setup and print μ_Y by both routes
+  cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
+      cases: table1, table2, ls-bias, alias, all";
+
+/// Options of `reproduce`.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub runs: Option<u64>,
+    pub seed: u64,
+    pub shard: (u64, u64),
+    pub json: Option<String>,
+    pub out: String,
+}
+
+fn parse(args: &[String]) -> Result<(String, Options), String> {
+    let mut case = None;
+    let mut o = Options {
+        runs: None,
+        seed: 20_051_205,
+        shard: (0, 1),
+        json: None,
+        out: "results".into(),
+    };
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = |name: &str| {
+            it.next()
+                .cloned()
+                .ok_or_else(|| format!("{name} needs a value"))
+        };
+        match a.as_str() {
+            "--runs" => {
+                o.runs = Some(
+                    value("--runs")?
+                        .parse()
+                        .map_err(|_| "--runs takes a whole number".to_string())?,
+                )
+            }
+            "--seed" => {
+                o.seed = value("--seed")?
+                    .parse()
+                    .map_err(|_| "--seed takes a whole number".to_string())?
+            }
+            "--shard" => {
+                let v = value("--shard")?;
+                let (i, n) = v
+                    .split_once('/')
+                    .and_then(|(i, n)| Some((i.parse().ok()?, n.parse().ok()?)))
+                    .filter(|&(i, n): &(u64, u64)| n > 0 && i < n)
+                    .ok_or_else(|| format!("--shard takes i/n with 0 <= i < n, got {v}"))?;
+                o.shard = (i, n);
+            }
+            "--json" => o.json = Some(value("--json")?),
+            "--out" => o.out = value("--out")?,
+            s if s.starts_with("--") => return Err(format!("unknown option {s}")),
+            s => {
+                if case.replace(s.to_string()).is_some() {
+                    return Err(format!("unexpected argument {s}"));
+                }
+            }
+        }
+    }
+    Ok((case.ok_or("which case?")?, o))
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("demo") => demo::run(),
+        Some("reproduce") => parse(&args[1..]).and_then(|(case, o)| reproduce::run(&case, &o)),
+        _ => Err(USAGE.to_string()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

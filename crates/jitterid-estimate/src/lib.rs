@@ -38,6 +38,7 @@ mod criterion;
 mod data;
 mod error;
 mod fit;
+pub mod montecarlo;
 mod noise;
 mod profile;
 pub mod solver;

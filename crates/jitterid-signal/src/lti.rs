@@ -104,7 +104,6 @@ impl<M: RationalModel> LtiResponse<M> {
             }
         }
         let mass: f64 = full.mass();
-        let decay: Vec<Complex64> = poles.iter().map(|p| (p * grid.interval()).exp()).collect();
 
         let mut out = ModalExpectations {
             c: vec![0.0; n],
@@ -115,32 +114,7 @@ impl<M: RationalModel> LtiResponse<M> {
                 Vec::new()
             },
         };
-        // State over the steps already fully past: u_past = Σ Δu_j,
-        // x_i = Σ Δu_j e^{p_i a_j}, y_i = Σ Δu_j a_j e^{p_i a_j}, a_j = t_k + lo − t_j ≥ 0.
-        let mut u_past = 0.0;
-        let mut x = vec![Complex64::new(0.0, 0.0); np];
-        let mut y = vec![Complex64::new(0.0, 0.0); np];
-        let mut next_past = 0usize;
-        let steps = &self.steps;
-        for k in 0..n {
-            let t = grid.time(k);
-            if k > 0 {
-                for i in 0..np {
-                    y[i] = decay[i] * (y[i] + grid.interval() * x[i]);
-                    x[i] *= decay[i];
-                }
-            }
-            while next_past < steps.len() && steps[next_past].0 <= t + lo {
-                let (tj, du) = steps[next_past];
-                let a = t + lo - tj;
-                u_past += du;
-                for i in 0..np {
-                    let e = (poles[i] * a).exp() * du;
-                    x[i] += e;
-                    y[i] += e * a;
-                }
-                next_past += 1;
-            }
+        self.walk(grid, lo, hi, &poles, with_b, |k, t, u_past, x, y, in_reach| {
             out.c[k] = u_past * mass;
             for i in 0..np {
                 out.a[i][k] = x[i] * m0[i];
@@ -149,10 +123,7 @@ impl<M: RationalModel> LtiResponse<M> {
                 }
             }
             // Steps inside the reach: quadrature over τ ≥ c = t_j − t_k.
-            for &(tj, du) in steps[next_past..]
-                .iter()
-                .take_while(|(tj, _)| *tj < t + hi)
-            {
+            for &(tj, du) in in_reach {
                 let c = tj - t;
                 let rule = jitter.rule(&[c], rate);
                 for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
@@ -170,8 +141,139 @@ impl<M: RationalModel> LtiResponse<M> {
                     }
                 }
             }
-        }
+        });
         out
+    }
+
+    /// Visits every sample `k` with the state of the steps already fully past its reach,
+    /// `u_past = Σ Δu_j`, `x_i = Σ Δu_j e^{p_i a_j}` and (when `with_y`)
+    /// `y_i = Σ Δu_j a_j e^{p_i a_j}` with `a_j = t_k + lo − t_j ≥ 0`, and the steps inside the
+    /// reach `(t_k + lo, t_k + hi)`. The state is carried by `x ← e^{p_i T} x`: `O(N + J)` in all.
+    fn walk(
+        &self,
+        grid: &SampleGrid,
+        lo: f64,
+        hi: f64,
+        poles: &[Complex64],
+        with_y: bool,
+        mut visit: impl FnMut(usize, f64, f64, &[Complex64], &[Complex64], &[(f64, f64)]),
+    ) {
+        let np = poles.len();
+        let decay: Vec<Complex64> = poles.iter().map(|p| (p * grid.interval()).exp()).collect();
+        let mut u_past = 0.0;
+        let mut x = vec![Complex64::new(0.0, 0.0); np];
+        let mut y = vec![Complex64::new(0.0, 0.0); np];
+        let mut next_past = 0usize;
+        let steps = &self.steps;
+        for k in 0..grid.len() {
+            let t = grid.time(k);
+            if k > 0 {
+                for i in 0..np {
+                    if with_y {
+                        y[i] = decay[i] * (y[i] + grid.interval() * x[i]);
+                    }
+                    x[i] *= decay[i];
+                }
+            }
+            while next_past < steps.len() && steps[next_past].0 <= t + lo {
+                let (tj, du) = steps[next_past];
+                let a = t + lo - tj;
+                u_past += du;
+                for i in 0..np {
+                    let e = (poles[i] * a).exp() * du;
+                    x[i] += e;
+                    if with_y {
+                        y[i] += e * a;
+                    }
+                }
+                next_past += 1;
+            }
+            let reach_end = next_past + steps[next_past..].partition_point(|s| s.0 < t + hi);
+            visit(k, t, u_past, &x, &y, &steps[next_past..reach_end]);
+        }
+    }
+
+    /// `E[s(t_k + τ)²]` for a piecewise-constant input: `s` on each sample's reach is the past
+    /// steps' modal state plus the steps inside the reach, evaluated at the jitter's quadrature
+    /// nodes in `O(poles + steps in reach)` per node.
+    fn piecewise_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        let m = self.modal();
+        let reps = self.representatives();
+        let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| m.poles[i]).collect();
+        let coef: Vec<Complex64> = reps
+            .iter()
+            .map(|&(i, w)| m.residues[i] / m.poles[i] * w)
+            .collect();
+        let (lo, hi) = jitter.reach();
+        let rate = 2.0 * self.rate();
+        let full = jitter.rule(&[], rate);
+        let mut out = vec![0.0; grid.len()];
+        self.walk(grid, lo, hi, &poles, false, |k, t, u_past, x, _, in_reach| {
+            let local;
+            let rule = if in_reach.is_empty() {
+                &full
+            } else {
+                let cuts: Vec<f64> = in_reach.iter().map(|s| s.0 - t).collect();
+                local = jitter.rule(&cuts, rate);
+                &local
+            };
+            let mut acc = 0.0;
+            for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                let mut s = m.dc_gain * u_past;
+                for i in 0..poles.len() {
+                    s += (coef[i] * x[i] * (poles[i] * (tau - lo)).exp()).re;
+                }
+                for &(tj, du) in in_reach {
+                    let xj = tau - (tj - t);
+                    if xj >= 0.0 {
+                        let mut step = m.dc_gain;
+                        for i in 0..poles.len() {
+                            step += (coef[i] * (poles[i] * xj).exp()).re;
+                        }
+                        s += du * step;
+                    }
+                }
+                acc += w * s * s;
+            }
+            out[k] = acc;
+        });
+        out
+    }
+
+    /// `E[s(t_k + τ)²]` for tones: with `a_l = A_l G(i2πf_l) e^{iφ_l}`,
+    /// `s² = Σ_l Σ_m ½ Re(a_l ā_m e^{i(ω_l−ω_m)t} − a_l a_m e^{i(ω_l+ω_m)t})`, so the expectation
+    /// needs `γ` at the sums and differences of the tones' frequencies.
+    fn tones_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        let Input::Tones(ms) = &self.input else {
+            return vec![0.0; grid.len()];
+        };
+        let tones: Vec<(f64, Complex64)> = ms
+            .tones()
+            .iter()
+            .map(|c| {
+                let g = self.model.frequency_response(c.frequency);
+                (c.frequency, g * Complex64::from_polar(c.amplitude, c.phase))
+            })
+            .collect();
+        grid.times()
+            .map(|t| {
+                let mut acc = 0.0;
+                for &(fl, al) in &tones {
+                    for &(fm, am) in &tones {
+                        let diff = al
+                            * am.conj()
+                            * Complex64::from_polar(1.0, TAU * (fl - fm) * t)
+                            * jitter.cf(-(fl - fm));
+                        let sum = al
+                            * am
+                            * Complex64::from_polar(1.0, TAU * (fl + fm) * t)
+                            * jitter.cf(-(fl + fm));
+                        acc += 0.5 * (diff - sum).re;
+                    }
+                }
+                acc
+            })
+            .collect()
     }
 
     fn tones_expectation(
@@ -362,6 +464,13 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
             Input::Piecewise(_) => Vec::new(),
         };
         poles.chain(tones).fold(0.0, f64::max)
+    }
+
+    fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        match self.input {
+            Input::Tones(_) => self.tones_squares(grid, jitter),
+            Input::Piecewise(_) => self.piecewise_squares(grid, jitter),
+        }
     }
 
     fn expected_values(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {

@@ -272,3 +272,47 @@ fn no_jitter_first_moment_is_the_sampled_signal() {
         assert!((m[k] - s.value(t)).abs() < 1e-14);
     }
 }
+
+#[test]
+fn fast_second_moment_equals_quadrature_route() {
+    let grid = SampleGrid::new(0.3, 1.0, 50).unwrap();
+    let u = binary_input(13, 60.0);
+    let tones = Multisine::new(vec![
+        jitterid_signal::Tone {
+            frequency: 0.13,
+            amplitude: 1.0,
+            phase: 0.2,
+        },
+        jitterid_signal::Tone {
+            frequency: 0.41,
+            amplitude: 0.5,
+            phase: -1.0,
+        },
+    ])
+    .unwrap();
+    let signals = [
+        LtiResponse::new(paper_system(), Input::from(u.clone())),
+        LtiResponse::new(paper_system(), Input::Tones(tones)),
+    ];
+    let third = LtiResponse::new(third_order(), u);
+    for jitter in jitters() {
+        for (fast, slow) in [
+            (
+                signals[0].expected_squares(&grid, jitter.as_ref()),
+                Plain(&signals[0]).expected_squares(&grid, jitter.as_ref()),
+            ),
+            (
+                signals[1].expected_squares(&grid, jitter.as_ref()),
+                Plain(&signals[1]).expected_squares(&grid, jitter.as_ref()),
+            ),
+            (
+                third.expected_squares(&grid, jitter.as_ref()),
+                Plain(&third).expected_squares(&grid, jitter.as_ref()),
+            ),
+        ] {
+            for (a, b) in fast.iter().zip(&slow) {
+                assert!((a - b).abs() < 1e-12 * b.abs().max(1.0), "{}: {a} vs {b}", jitter.name());
+            }
+        }
+    }
+}

@@ -1,1 +1,162 @@
-//! Unit tests of the optimisation layer.
+//! Unit tests of the optimisation layer's internals and argmin adapters.
+
+use super::lm::{LevenbergMarquardt, LmState};
+use super::problem::{half_sum_sq, Scaled};
+use super::*;
+use argmin::core::{
+    CostFunction, Executor, Gradient, Jacobian, Operator, State, TerminationReason,
+    TerminationStatus,
+};
+use faer::Mat;
+
+/// Rosenbrock's function as residuals `[10(y − x²), 1 − x]`.
+struct Rosenbrock;
+
+impl LeastSquares for Rosenbrock {
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn num_residuals(&self) -> usize {
+        2
+    }
+    fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, SolverError> {
+        Ok(vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]])
+    }
+    fn jacobian(&self, p: &[f64]) -> Result<Mat<f64>, SolverError> {
+        let j = [[-20.0 * p[0], 10.0], [-1.0, 0.0]];
+        Ok(Mat::from_fn(2, 2, |r, c| j[r][c]))
+    }
+}
+
+#[test]
+fn transforms_round_trip_and_differentiate() {
+    let cases = [
+        (Transform::Free, -3.25),
+        (Transform::Positive, 0.02),
+        (Transform::Negative, -7.5),
+        (Transform::Bounded { lo: -1.0, hi: 4.0 }, 3.999),
+        (Transform::Bounded { lo: -1.0, hi: 4.0 }, -0.999),
+    ];
+    for (t, theta) in cases {
+        let phi = t.to_internal(theta).unwrap();
+        assert!((t.to_external(phi) - theta).abs() <= 1e-13 * theta.abs().max(1.0), "{t:?}");
+        let h = 1e-6;
+        let fd = (t.to_external(phi + h) - t.to_external(phi - h)) / (2.0 * h);
+        assert!((fd - t.derivative(phi)).abs() < 1e-8, "{t:?}: {fd} vs {}", t.derivative(phi));
+    }
+}
+
+#[test]
+fn bounded_transform_saturates_without_overflow() {
+    let t = Transform::Bounded { lo: 1.0, hi: 2.0 };
+    for phi in [-1e4, -800.0, 800.0, 1e4] {
+        let theta = t.to_external(phi);
+        assert!((1.0..=2.0).contains(&theta), "{phi}: {theta}");
+        let d = t.derivative(phi);
+        assert!(d.is_finite() && d >= 0.0, "{phi}: {d}");
+    }
+    assert_eq!(t.to_internal(1.0), None);
+    assert_eq!(t.to_internal(f64::NAN), None);
+    assert_eq!(Transform::Positive.to_internal(f64::INFINITY), None);
+    assert!(!Transform::Bounded { lo: 0.0, hi: f64::INFINITY }.is_valid());
+}
+
+#[test]
+fn argmin_adapter_matches_the_problem() {
+    let a = ArgminProblem::new(&Rosenbrock);
+    let x = vec![-1.2, 1.0];
+    let r = a.apply(&x).unwrap();
+    assert_eq!(r, Rosenbrock.residuals(&x).unwrap());
+    assert_eq!(a.cost(&x).unwrap(), half_sum_sq(&r));
+    let j = Jacobian::jacobian(&a, &x).unwrap();
+    let g = a.gradient(&x).unwrap();
+    for (k, gk) in g.iter().enumerate() {
+        let expect = j[(0, k)] * r[0] + j[(1, k)] * r[1];
+        assert_eq!(*gk, expect);
+    }
+    // A wrong parameter length is an error that comes back out as a `SolverError`.
+    let err = a.apply(&vec![1.0]).unwrap_err();
+    assert_eq!(
+        SolverError::from_argmin(err),
+        SolverError::WrongStartLength { expected: 2, got: 1 }
+    );
+    let f = ArgminFaerProblem::new(&Rosenbrock);
+    let xc = Mat::from_fn(2, 1, |i, _| x[i]);
+    let gc = f.gradient(&xc).unwrap();
+    assert_eq!((gc.nrows(), gc.ncols()), (2, 1));
+    assert_eq!((gc[(0, 0)], gc[(1, 0)]), (g[0], g[1]));
+    assert_eq!(f.cost(&xc).unwrap(), half_sum_sq(&r));
+    assert!(f.apply(&Mat::zeros(2, 2)).is_err());
+}
+
+#[test]
+fn argmin_solvers_run_on_the_adapter() {
+    use argmin::solver::linesearch::MoreThuenteLineSearch;
+    use argmin::solver::quasinewton::LBFGS;
+    let solver = LBFGS::new(MoreThuenteLineSearch::new(), 5);
+    let result = Executor::new(ArgminProblem::new(&Rosenbrock), solver)
+        .configure(|s| s.param(vec![-1.2, 1.0]).max_iters(200))
+        .run()
+        .unwrap();
+    let best = result.state.get_best_param().unwrap();
+    assert!((best[0] - 1.0).abs() < 1e-5 && (best[1] - 1.0).abs() < 1e-5, "{best:?}");
+}
+
+#[test]
+fn lm_as_argmin_solver_reports_through_termination_status() {
+    let result = Executor::new(ArgminProblem::new(&Rosenbrock), LevenbergMarquardt::default())
+        .configure(|s: LmState| s.param(vec![-1.2, 1.0]))
+        .run()
+        .unwrap();
+    assert_eq!(
+        result.state.termination_status,
+        TerminationStatus::Terminated(TerminationReason::SolverConverged)
+    );
+    assert_eq!(result.solver.termination(), Some(&Termination::SmallStep));
+    assert!(result.solver.lambda() > 0.0);
+    let state = &result.state;
+    assert_eq!(state.get_residuals().map(Vec::len), Some(2));
+    assert!(state.get_jacobian().is_some() && state.get_gradient().is_some());
+
+    // Without a start, `init` fails with a typed error rather than panicking.
+    let run = Executor::new(ArgminProblem::new(&Rosenbrock), LevenbergMarquardt::default()).run();
+    let Err(err) = run else {
+        panic!("ran without a start")
+    };
+    assert_eq!(SolverError::from_argmin(err), SolverError::MissingStart);
+
+    // The executor's own iteration limit is honoured as well as the solver's option.
+    let result = Executor::new(ArgminProblem::new(&Rosenbrock), LevenbergMarquardt::default())
+        .configure(|s: LmState| s.param(vec![-1.2, 1.0]).max_iters(3))
+        .run()
+        .unwrap();
+    assert_eq!(result.state.get_iter(), 3);
+    assert_eq!(
+        result.state.termination_status,
+        TerminationStatus::Terminated(TerminationReason::MaxItersReached)
+    );
+}
+
+#[test]
+fn scaling_residuals_keeps_the_minimiser() {
+    let scaled = Scaled { problem: &Rosenbrock, scale: 1e-3 };
+    let report = LevenbergMarquardt::default().minimize(&scaled, &[-1.2, 1.0]).unwrap();
+    assert!(report.converged, "{report:?}");
+    assert!((report.params[0] - 1.0).abs() < 1e-10 && (report.params[1] - 1.0).abs() < 1e-10);
+}
+
+#[test]
+fn termination_reasons_classify() {
+    assert!(Termination::SmallStep.is_convergence());
+    assert!(Termination::SmallCostChange.is_convergence());
+    assert!(Termination::SmallGradient.is_convergence());
+    for t in [
+        Termination::MaxIterations,
+        Termination::NonFinite,
+        Termination::LineSearchFailed,
+        Termination::Other("x".into()),
+    ] {
+        assert!(!t.is_convergence(), "{t}");
+        assert!(!t.to_string().is_empty());
+    }
+}

@@ -1,0 +1,46 @@
+//! The common setup of the paper's section 4 (`conventions.md`).
+
+use jitterid::estimate::montecarlo::realization_rng;
+use jitterid::prelude::*;
+use jitterid::signal::PiecewiseConstant;
+use rand::rngs::StdRng;
+use rand::Rng;
+
+/// Sampling interval (s).
+pub const T: f64 = 1.0;
+/// Samples per record.
+pub const N: usize = 200;
+/// Measurement-noise standard deviation.
+pub const NOISE_STD: f64 = 0.01;
+/// Realisations per case.
+pub const RUNS: u64 = 128;
+
+/// The grid `t_k = kT`.
+pub fn grid() -> SampleGrid {
+    SampleGrid::new(0.0, T, N).expect("valid constants")
+}
+
+/// The random binary input on `[0, NT + 1)`, system at rest before 0.
+pub fn input(rng: &mut StdRng, mean_dwell: f64) -> PiecewiseConstant {
+    RandomBinary::new(mean_dwell, 0.0, 1.0)
+        .and_then(|b| b.generate(0.0, N as f64 * T + 1.0, rng))
+        .expect("valid constants")
+}
+
+/// `θ ∘ (1 + U(−r, r))`, componentwise.
+pub fn perturb(theta: &[f64], r: f64, rng: &mut StdRng) -> Vec<f64> {
+    theta
+        .iter()
+        .map(|x| x * (1.0 + rng.random_range(-r..=r)))
+        .collect()
+}
+
+/// The eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)`.
+pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Result<Zpk, jitterid::signal::SignalError> {
+    Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }])
+}
+
+/// The generator of realisation `r` (same derivation as the library's Monte Carlo).
+pub fn rng(seed: u64, r: u64) -> StdRng {
+    realization_rng(seed, r)
+}
