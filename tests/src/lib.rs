@@ -1,1 +1,62 @@
-//! Cross-crate integration tests live in tests/.
+//! Shared fixtures of the cross-crate tests (in `tests/`).
+
+use jitterid::jitter::{
+    ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
+};
+use jitterid::signal::{LtiResponse, PiecewiseConstant, RandomBinary, Root, Zpk};
+use proptest::prelude::*;
+use rand::SeedableRng;
+
+/// The paper's eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)`.
+pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Zpk {
+    Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }]).expect("valid")
+}
+
+/// A random binary input on `[start, end)` from a seed.
+pub fn binary(seed: u64, dwell: f64, start: f64, end: f64) -> PiecewiseConstant {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    RandomBinary::new(dwell, 0.0, 1.0)
+        .and_then(|b| b.generate(start, end, &mut rng))
+        .expect("valid")
+}
+
+/// A stable zero–pole–gain model with distinct poles.
+pub fn arb_system() -> impl Strategy<Value = Zpk> {
+    (
+        0.1f64..3.0,
+        prop::option::of(-3.0f64..3.0),
+        -3.0f64..-0.1,
+        prop::option::of((-2.0f64..-0.1, 0.1f64..3.0)),
+    )
+        .prop_filter_map("distinct poles", |(k, zero, real, pair)| {
+            let zeros = zero.map(Root::Real).into_iter().collect();
+            let mut poles = vec![Root::Real(real)];
+            poles.extend(pair.map(|(re, im)| Root::Pair { re, im }));
+            Zpk::new(k, zeros, poles).ok()
+        })
+}
+
+/// A jitter model from every family, with random parameters.
+pub fn arb_jitter() -> impl Strategy<Value = Box<dyn JitterModel>> {
+    prop_oneof![
+        Just(Box::new(NoJitter) as Box<dyn JitterModel>),
+        (0u32..6, 0.01f64..0.8)
+            .prop_map(|(n, a)| Box::new(UniformSum::new(n, a).unwrap()) as Box<dyn JitterModel>),
+        (0.01f64..0.3)
+            .prop_map(|s| Box::new(Gaussian::new(s).unwrap()) as Box<dyn JitterModel>),
+        (0.01f64..0.1).prop_map(|b| Box::new(Laplace::new(b).unwrap()) as Box<dyn JitterModel>),
+        (0.01f64..0.5).prop_map(|d| Box::new(TwoPoint::new(d).unwrap()) as Box<dyn JitterModel>),
+        (0.01f64..0.1)
+            .prop_map(|m| Box::new(ExponentialDelay::new(m).unwrap()) as Box<dyn JitterModel>),
+        (-0.3f64..0.3, 0.01f64..0.4).prop_map(|(c, a)| {
+            Box::new(Shifted::new(UniformSum::new(1, a).unwrap(), c).unwrap())
+                as Box<dyn JitterModel>
+        }),
+    ]
+}
+
+/// The response of a random system to a random binary input that covers `[-2, end)`.
+pub fn arb_response(end: f64) -> impl Strategy<Value = LtiResponse<Zpk>> {
+    (arb_system(), any::<u64>(), 0.5f64..10.0)
+        .prop_map(move |(g, seed, dwell)| LtiResponse::new(g, binary(seed, dwell, -2.0, end)))
+}

@@ -3,6 +3,8 @@
 mod demo;
 mod paper;
 mod reproduce;
+mod reproduce_ml;
+mod reproduce_starts;
 
 use std::process::ExitCode;
 
@@ -10,7 +12,7 @@ const USAGE: &str = "usage:
   cargo xtask demo
       simulate the paper's Table 2 setup and print μ_Y by both routes
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
-      cases: table1, table2, ls-bias, alias, all";
+      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, all";
 
 /// Options of `reproduce`.
 #[derive(Debug, Clone)]

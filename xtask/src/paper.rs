@@ -15,16 +15,26 @@ pub const NOISE_STD: f64 = 0.01;
 /// Realisations per case.
 pub const RUNS: u64 = 128;
 
-/// The grid `t_k = kT`.
-pub fn grid() -> SampleGrid {
-    SampleGrid::new(0.0, T, N).expect("valid constants")
+/// The grid `t_k = kT`, `k < n`.
+pub fn grid_of(n: usize) -> SampleGrid {
+    SampleGrid::new(0.0, T, n).expect("valid constants")
 }
 
-/// The random binary input on `[0, NT + 1)`, system at rest before 0.
-pub fn input(rng: &mut StdRng, mean_dwell: f64) -> PiecewiseConstant {
+/// The paper's grid (`N = 200`).
+pub fn grid() -> SampleGrid {
+    grid_of(N)
+}
+
+/// The random binary input on `[0, nT + 1)`, system at rest before 0.
+pub fn input_of(rng: &mut StdRng, mean_dwell: f64, n: usize) -> PiecewiseConstant {
     RandomBinary::new(mean_dwell, 0.0, 1.0)
-        .and_then(|b| b.generate(0.0, N as f64 * T + 1.0, rng))
+        .and_then(|b| b.generate(0.0, n as f64 * T + 1.0, rng))
         .expect("valid constants")
+}
+
+/// The paper's input on `[0, NT + 1)`.
+pub fn input(rng: &mut StdRng, mean_dwell: f64) -> PiecewiseConstant {
+    input_of(rng, mean_dwell, N)
 }
 
 /// `θ ∘ (1 + U(−r, r))`, componentwise.

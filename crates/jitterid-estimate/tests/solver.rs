@@ -129,13 +129,17 @@ impl LeastSquares for NanWall {
         Ok(vec![if p[0] <= 1.0 { p[0] - 3.0 } else { f64::NAN }])
     }
     fn jacobian(&self, p: &[f64]) -> Result<Mat<f64>, SolverError> {
-        Ok(Mat::from_fn(1, 1, |_, _| {
-            if p[0] <= 1.0 {
-                1.0
-            } else {
-                f64::NAN
-            }
-        }))
+        Ok(Mat::from_fn(
+            1,
+            1,
+            |_, _| {
+                if p[0] <= 1.0 {
+                    1.0
+                } else {
+                    f64::NAN
+                }
+            },
+        ))
     }
 }
 
@@ -188,7 +192,10 @@ impl LeastSquares for Underdetermined {
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 fn assert_sane(report: &SolverReport) {
@@ -235,7 +242,10 @@ fn lm_with_finite_difference_jacobian_solves_rosenbrock() {
         .minimize(&FdRosenbrock, &[-1.2, 1.0])
         .unwrap();
     assert!(report.converged, "{report:?}");
-    assert!(max_abs_diff(&report.params, &[1.0, 1.0]) < 1e-10, "{report:?}");
+    assert!(
+        max_abs_diff(&report.params, &[1.0, 1.0]) < 1e-10,
+        "{report:?}"
+    );
 }
 
 #[test]
@@ -267,8 +277,14 @@ fn lm_and_gauss_newton_agree_on_a_noisy_fit() {
     assert!(lm.converged, "{lm:?}");
     assert!(gn.converged, "{gn:?}");
     assert!(lm.cost > 1e-4, "the fit has a nonzero residual: {lm:?}");
-    assert!(max_abs_diff(&lm.params, &gn.params) < 1e-6, "{lm:?}\n{gn:?}");
-    assert!((lm.cost - gn.cost).abs() <= 1e-10 * lm.cost, "{lm:?}\n{gn:?}");
+    assert!(
+        max_abs_diff(&lm.params, &gn.params) < 1e-6,
+        "{lm:?}\n{gn:?}"
+    );
+    assert!(
+        (lm.cost - gn.cost).abs() <= 1e-10 * lm.cost,
+        "{lm:?}\n{gn:?}"
+    );
 }
 
 #[test]
@@ -287,7 +303,10 @@ fn nelder_mead_solves_rosenbrock() {
         .minimize(&Rosenbrock, &[-1.2, 1.0])
         .unwrap();
     assert!(report.converged, "{report:?}");
-    assert!(max_abs_diff(&report.params, &[1.0, 1.0]) < 1e-6, "{report:?}");
+    assert!(
+        max_abs_diff(&report.params, &[1.0, 1.0]) < 1e-6,
+        "{report:?}"
+    );
 }
 
 #[test]
@@ -614,4 +633,61 @@ fn multistart_is_deterministic_for_a_seed() {
         nm.minimize(&Rosenbrock, &[-1.2, 1.0]).unwrap(),
         nm.minimize(&Rosenbrock, &[-1.2, 1.0]).unwrap()
     );
+}
+
+/// The second parameter has no influence: `JᵀJ` is singular.
+struct Inert;
+
+impl LeastSquares for Inert {
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn num_residuals(&self) -> usize {
+        2
+    }
+    fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, SolverError> {
+        Ok(vec![p[0] - 1.0, 2.0 * (p[0] - 1.0)])
+    }
+    fn jacobian(&self, _p: &[f64]) -> Result<Mat<f64>, SolverError> {
+        Ok(Mat::from_fn(2, 2, |r, c| {
+            if c == 0 {
+                1.0 + r as f64
+            } else {
+                0.0
+            }
+        }))
+    }
+}
+
+#[test]
+fn singular_normal_equations_do_not_panic() {
+    let lm = LevenbergMarquardt::default()
+        .minimize(&Inert, &[3.0, 5.0])
+        .unwrap();
+    assert!(lm.converged, "{lm:?}");
+    assert!((lm.params[0] - 1.0).abs() < 1e-10, "{lm:?}");
+    assert_eq!(lm.params[1], 5.0, "an inert parameter stays put: {lm:?}");
+
+    // argmin's Gauss–Newton inverts JᵀJ: it stops at the start with a reason, not a panic.
+    let gn = GaussNewtonLineSearch::default()
+        .minimize(&Inert, &[3.0, 5.0])
+        .unwrap();
+    assert_sane(&gn);
+    assert!(!gn.converged, "{gn:?}");
+    assert!(matches!(gn.termination, Termination::Other(_)), "{gn:?}");
+    assert_eq!(gn.params, vec![3.0, 5.0]);
+}
+
+#[test]
+fn solvers_accept_trait_objects_and_extreme_options() {
+    let problem: &dyn LeastSquares = &Rosenbrock;
+    let report = LevenbergMarquardt::default()
+        .minimize(problem, &[-1.2, 1.0])
+        .unwrap();
+    assert!(report.converged);
+    // A huge radius gives absurd starts, but no panic; the unperturbed run still counts.
+    let report = MultiStart::new(LevenbergMarquardt::default(), 3, 1e308, 0)
+        .minimize(problem, &[-1.2, 1.0])
+        .unwrap();
+    assert!(report.converged, "{report:?}");
 }

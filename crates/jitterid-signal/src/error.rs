@@ -133,7 +133,7 @@ pub(crate) fn all_finite(name: &'static str, values: &[f64]) -> Result<(), Signa
 pub(crate) fn increasing(name: &'static str, values: &[f64]) -> Result<(), SignalError> {
     all_finite(name, values)?;
     for (i, w) in values.windows(2).enumerate() {
-        if !(w[1] > w[0]) {
+        if w[1] <= w[0] {
             return Err(SignalError::NotIncreasing {
                 name,
                 index: i + 1,

@@ -249,7 +249,7 @@ impl RandomBinary {
     ) -> Result<PiecewiseConstant, SignalError> {
         crate::error::finite("start", start)?;
         crate::error::finite("end", end)?;
-        if !(end > start) {
+        if end <= start {
             return Err(SignalError::NotIncreasing {
                 name: "input span",
                 index: 1,

@@ -132,8 +132,8 @@ impl<M: RationalModel> LtiResponse<M> {
                     }
                     let xj = tau - c;
                     out.c[k] += w * du;
-                    for i in 0..np {
-                        let e = (poles[i] * xj).exp() * (w * du);
+                    for (i, p) in poles.iter().enumerate() {
+                        let e = (p * xj).exp() * (w * du);
                         out.a[i][k] += e;
                         if with_b {
                             out.b[i][k] += e * xj;

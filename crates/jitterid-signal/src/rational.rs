@@ -50,7 +50,7 @@ impl Rational {
         d_den: Vec<Vec<f64>>,
     ) -> Result<Self, SignalError> {
         for p in &poles {
-            if !(p.re < 0.0) {
+            if p.re >= 0.0 || p.re.is_nan() {
                 return Err(SignalError::Unstable { re: p.re, im: p.im });
             }
         }

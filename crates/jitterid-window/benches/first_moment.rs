@@ -38,9 +38,7 @@ fn transforms(c: &mut Criterion) {
     c.bench_function("dtft_n200_101_freqs", |b| {
         b.iter(|| dtft(black_box(&grid), black_box(&y), None, black_box(&freqs)))
     });
-    c.bench_function("fft_n200", |b| {
-        b.iter(|| fft_grid(black_box(&y), None))
-    });
+    c.bench_function("fft_n200", |b| b.iter(|| fft_grid(black_box(&y), None)));
     c.bench_function("transform_n200_dft_set", |b| {
         b.iter(|| transform(black_box(&grid), &DirichletWindow, black_box(&y), &set))
     });

@@ -10,10 +10,13 @@
 //! computing `f·k·T` directly loses the digits of the product above the unit. Here the phase
 //! `f·T` is split exactly into a double-double with a fused multiply-add and reduced modulo 1;
 //! every 64 samples the rotation is re-anchored from `k·(fT) mod 1`, itself computed with an
-//! exact product, and the 64-term block sums are added with Neumaier's compensated summation.
-//! The error is then a few `1e-16 · Σ|w_k x_k|`, independent of `N` and `f`
-//! (measured: about `1e-15` relative at `N = 10^5` against a compensated direct sum; see
-//! `tests/dtft.rs`).
+//! exact product (within a block four interleaved chains each advance by `e^{-i2π·4fT}`, at
+//! most 16 steps from an anchor), and the 64-term block sums are added with Neumaier's
+//! compensated summation.
+//! The error is then a few `1e-16 · Σ|w_k x_k|` at most, independent of `N` and `f`. Measured
+//! against a compensated direct sum with every phase reduced exactly (`tests/dtft.rs`): below
+//! `2e-15 · |X(f)|` (about `1e-18 · Σ|x_k|`) for random data at `N = 10^5` and `N = 10^6`, for
+//! `f·k·T` up to `10^7` cycles.
 
 use crate::frequencies::FrequencySet;
 use crate::phase::{cis_neg_cycles, Cycles};
@@ -60,18 +63,51 @@ impl CompensatedSum {
     }
 }
 
+/// Number of interleaved rotation chains (shorter dependency chains, fewer rounding steps).
+const CHAINS: usize = 4;
+
 /// `Σ_k v_k e^{-i2πkx}` for `x` in cycles per sample: `O(N)`, stable for any `N` and `x`.
+///
+/// Each block of [`BLOCK`] samples starts from a rotation computed directly from the exactly
+/// reduced phase `k·x mod 1`; inside a block four interleaved chains advance by `e^{-i2π4x}`, so
+/// no rotation is more than 16 multiplications away from a direct evaluation.
 pub(crate) fn dtft_at(values: &[f64], x: Cycles) -> Complex64 {
-    let step = cis_neg_cycles(x.value());
+    let one = Complex64::new(1.0, 0.0);
+    let offsets = [
+        one,
+        cis_neg_cycles(x.times(1.0)),
+        cis_neg_cycles(x.times(2.0)),
+        cis_neg_cycles(x.times(3.0)),
+    ];
+    let step = cis_neg_cycles(x.times(CHAINS as f64));
+    let (sr, si) = (step.re, step.im);
     let mut sum = CompensatedSum::default();
     for (b, chunk) in values.chunks(BLOCK).enumerate() {
-        let mut z = cis_neg_cycles(x.times((b * BLOCK) as f64));
-        let mut acc = Complex64::new(0.0, 0.0);
-        for &v in chunk {
-            acc += z * v;
-            z *= step;
+        let anchor = cis_neg_cycles(x.times((b * BLOCK) as f64));
+        let z = offsets.map(|o| anchor * o);
+        let mut zr = z.map(|c| c.re);
+        let mut zi = z.map(|c| c.im);
+        let mut ar = [0.0; CHAINS];
+        let mut ai = [0.0; CHAINS];
+        let mut quads = chunk.chunks_exact(CHAINS);
+        for quad in &mut quads {
+            for j in 0..CHAINS {
+                let v = quad[j];
+                ar[j] += zr[j] * v;
+                ai[j] += zi[j] * v;
+                let r = zr[j] * sr - zi[j] * si;
+                zi[j] = zr[j] * si + zi[j] * sr;
+                zr[j] = r;
+            }
         }
-        sum.add(acc);
+        for (j, &v) in quads.remainder().iter().enumerate() {
+            ar[j] += zr[j] * v;
+            ai[j] += zi[j] * v;
+        }
+        sum.add(Complex64::new(
+            (ar[0] + ar[1]) + (ar[2] + ar[3]),
+            (ai[0] + ai[1]) + (ai[2] + ai[3]),
+        ));
     }
     sum.value()
 }

@@ -29,10 +29,7 @@ fn dtft_equals_fft_on_the_dft_grid() {
             let direct = dtft(&grid, &y, weights, &freqs).unwrap();
             let scale: f64 = y.iter().map(|v| v.abs()).sum();
             for (j, (a, b)) in fft.iter().zip(&direct).enumerate() {
-                assert!(
-                    (a - b).norm() <= 1e-13 * scale,
-                    "N={n} j={j}: {a} vs {b}"
-                );
+                assert!((a - b).norm() <= 1e-13 * scale, "N={n} j={j}: {a} vs {b}");
             }
         }
     }
@@ -46,7 +43,15 @@ fn dtft_is_accurate_at_large_n() {
     let grid = SampleGrid::new(0.0, t, n).unwrap();
     let y = random_data(n, 99);
     let scale: f64 = y.iter().map(|v| v.abs()).sum();
-    let freqs = [0.0, 1e-3, 0.123_456_789, 17.3, 76.923_076_9, 1234.567_89, 1e4 + 0.1];
+    let freqs = [
+        0.0,
+        1e-3,
+        0.123_456_789,
+        17.3,
+        76.923_076_9,
+        1234.567_89,
+        1e4 + 0.1,
+    ];
     let got = dtft(&grid, &y, None, &freqs).unwrap();
     let mut worst = 0.0_f64;
     for (&f, a) in freqs.iter().zip(&got) {
@@ -55,24 +60,31 @@ fn dtft_is_accurate_at_large_n() {
         worst = worst.max(rel);
         assert!(rel <= 1e-10, "f={f}: {a} vs {b} (rel {rel:e})");
     }
-    // Observed: worst ≈ 1e-16 relative to Σ|y_k| (a few 1e-15 relative to |Y(f)|).
+    // Observed: worst ≈ 2e-18 relative to Σ|y_k| (below 1e-15 relative to |Y(f)|).
     assert!(worst <= 1e-14, "worst {worst:e}");
 }
 
 #[test]
-fn dtft_recurrence_keeps_1e13_at_a_million_samples() {
+fn dtft_keeps_1e13_at_a_million_samples() {
     let n = 1_000_000;
-    let t = 1.0;
+    let t = 0.013;
     let grid = SampleGrid::new(0.0, t, n).unwrap();
-    let y = vec![1.0; n];
-    // At f close to (but not on) 1/T the sum is a Dirichlet kernel with a known value.
-    let f = 0.25 + 1e-7;
-    let got = dtft(&grid, &y, None, &[f]).unwrap()[0];
-    let want = jitterid_window::dirichlet(&grid, f);
-    assert!(
-        (got - want).norm() <= 1e-13 * n as f64,
-        "{got} vs {want}"
-    );
+    let y = random_data(n, 1);
+    let freqs = [0.123_456_789, 1234.567_89];
+    let got = dtft(&grid, &y, None, &freqs).unwrap();
+    for (&f, a) in freqs.iter().zip(&got) {
+        let b = reference_dtft(&y, f, t);
+        // Observed: about 3e-16 relative.
+        assert!((a - b).norm() <= 1e-13 * b.norm(), "f={f}: {a} vs {b}");
+    }
+    // All ones near (not on) a multiple of 1/T: the sum is the Dirichlet kernel.
+    let ones = vec![1.0; n];
+    for f in [0.25 / t + 1e-7, 3.0 / t + 1e-3] {
+        let got = dtft(&grid, &ones, None, &[f]).unwrap()[0];
+        let want = jitterid_window::dirichlet(&grid, f);
+        // Observed: below 1e-16 · N.
+        assert!((got - want).norm() <= 1e-13 * n as f64, "{got} vs {want}");
+    }
 }
 
 #[test]

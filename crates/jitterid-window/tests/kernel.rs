@@ -103,7 +103,13 @@ fn non_finite_frequency_gives_nan_not_a_panic() {
 #[test]
 fn hann_weights_are_the_periodic_variant() {
     let w = HannWindow.weights(8);
-    let expect = [0.0, 0.146_446_609_406_726_24, 0.5, 0.853_553_390_593_273_8, 1.0];
+    let expect = [
+        0.0,
+        0.146_446_609_406_726_24,
+        0.5,
+        0.853_553_390_593_273_8,
+        1.0,
+    ];
     for (k, e) in expect.iter().enumerate() {
         assert!((w[k] - e).abs() < 1e-15, "w[{k}] = {}", w[k]);
         if k > 0 {
@@ -131,8 +137,14 @@ fn hann_kernel_matches_the_weighted_sum() {
         let a = HannWindow.kernel(&grid, nu);
         let b = reference_dtft(&HannWindow.weights(n), nu, t);
         let c = Generic(HannWindow).kernel(&grid, nu);
-        assert!((a - b).norm() <= 1e-12 * n as f64, "N={n} ν={nu}: {a} vs {b}");
-        assert!((c - b).norm() <= 1e-12 * n as f64, "N={n} ν={nu}: {c} vs {b}");
+        assert!(
+            (a - b).norm() <= 1e-12 * n as f64,
+            "N={n} ν={nu}: {a} vs {b}"
+        );
+        assert!(
+            (c - b).norm() <= 1e-12 * n as f64,
+            "N={n} ν={nu}: {c} vs {b}"
+        );
     }
 }
 

@@ -6,11 +6,11 @@ mod common;
 use common::{ExpPulse, GaussPulse, Sum, Tones};
 use jitterid_jitter::{Gaussian, JitterModel, NoJitter, Shifted, UniformSum};
 use jitterid_signal::{LtiResponse, PiecewiseConstant, SampleGrid, Signal, TransferFunction};
-use proptest::prelude::*;
 use jitterid_window::{
     dtft, first_moment, first_moment_integral, DirichletWindow, FrequencySet, HannWindow,
     IntegralOptions, Window, WindowError,
 };
+use proptest::prelude::*;
 
 /// Checks |a − b| ≤ bound_a + 1e-13·scale at every frequency (the second term is route (b)'s
 /// own quadrature and rounding error) and returns the largest |a − b| / scale.

@@ -59,7 +59,10 @@ impl Default for GaussNewtonLineSearch {
 /// Keeps the latest iterate, so that a run that argmin aborts (singular `JᵀJ`) still reports
 /// where it got to.
 #[derive(Clone, Default)]
-struct LastIterate(Arc<Mutex<Option<(Vec<f64>, u64)>>>);
+struct LastIterate(Arc<Mutex<Option<Iterate>>>);
+
+/// An iterate and the number of iterations that produced it.
+type Iterate = (Vec<f64>, u64);
 
 impl LastIterate {
     fn record(&self, state: &GnState, iters: u64) {
@@ -68,7 +71,7 @@ impl LastIterate {
         }
     }
 
-    fn take(&self) -> Option<(Vec<f64>, u64)> {
+    fn take(&self) -> Option<Iterate> {
         self.0.lock().ok().and_then(|mut slot| slot.take())
     }
 }

@@ -22,7 +22,7 @@
 //! positive; then `μ ← μ · max(1/3, 1 − (2ρ − 1)³)`, otherwise `μ ← μν`, `ν ← 2ν` and the step is
 //! recomputed within the same iteration (Nielsen's update; Madsen, Nielsen & Tingleff, *Methods
 //! for non-linear least squares problems*, 2004, §3.2). One argmin iteration is therefore one
-//! *accepted* step. A trial point with non-finite residuals or Jacobian, and a damped matrix that
+//! *accepted* step (except the last, which may end on a stopping test without one). A trial point with non-finite residuals or Jacobian, and a damped matrix that
 //! is not numerically positive definite, are treated as rejections.
 //!
 //! `D` is the identity ([`Scaling::Identity`]) or the running maximum of `diag(JᵀJ)`

@@ -66,9 +66,7 @@ pub use gauss_newton::GaussNewtonLineSearch;
 pub use lm::{LevenbergMarquardt, LmOptions, Scaling};
 pub use multistart::MultiStart;
 pub use nelder_mead::NelderMead;
-pub use problem::{
-    fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, DEFAULT_FD_STEP,
-};
+pub use problem::{fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, DEFAULT_FD_STEP};
 pub use transform::{Transform, Transformed};
 
 /// A minimiser of `V(θ) = ½ Σ rᵢ(θ)²`.

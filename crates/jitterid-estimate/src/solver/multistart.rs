@@ -79,9 +79,11 @@ impl<S: Solver> Solver for MultiStart<S> {
         for _ in 0..self.starts {
             // Draw the whole start before running, so that the sequence of starts does not
             // depend on how the runs end.
+            // `(2u − 1) r` with `u ~ U[0, 1)` rather than `random_range`, which panics when the
+            // width of the range overflows.
             let perturbed: Vec<f64> = start
                 .iter()
-                .map(|&t| t * (1.0 + rng.random_range(-r..=r)))
+                .map(|&t| t * (1.0 + (2.0 * rng.random::<f64>() - 1.0) * r))
                 .collect();
             if let Ok(report) = self.solver.minimize(problem, &perturbed) {
                 iterations = iterations.saturating_add(report.iterations);

@@ -1,7 +1,9 @@
 //! Derivative-free minimisation: argmin's Nelder–Mead on the cost.
 
 use super::error::check_option;
-use super::problem::{checked_residuals, half_sum_sq, start_residuals, validate_start, LeastSquares};
+use super::problem::{
+    checked_residuals, half_sum_sq, start_residuals, validate_start, LeastSquares,
+};
 use super::{from_argmin_reason, Solver, SolverError, SolverReport, Termination};
 use argmin::core::{CostFunction, Error, Executor, IterState, State};
 use argmin::solver::neldermead::NelderMead as ArgminNelderMead;
@@ -52,9 +54,8 @@ impl<P: LeastSquares + ?Sized> CostFunction for RelativeCost<'_, P> {
     type Output = f64;
 
     fn cost(&self, theta: &Vec<f64>) -> Result<f64, Error> {
-        let v = checked_residuals(self.problem, theta).map_or(f64::INFINITY, |r| {
-            self.scale * half_sum_sq(&r)
-        });
+        let v = checked_residuals(self.problem, theta)
+            .map_or(f64::INFINITY, |r| self.scale * half_sum_sq(&r));
         Ok(if v.is_finite() { v } else { f64::INFINITY })
     }
 }

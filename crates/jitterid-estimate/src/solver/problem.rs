@@ -209,10 +209,7 @@ pub(crate) fn start_residuals<P: LeastSquares + ?Sized>(
 
 /// First non-finite entry, if any.
 pub(crate) fn first_non_finite(v: &[f64]) -> Option<(usize, f64)> {
-    v.iter()
-        .copied()
-        .enumerate()
-        .find(|(_, x)| !x.is_finite())
+    v.iter().copied().enumerate().find(|(_, x)| !x.is_finite())
 }
 
 /// `½ Σ rᵢ²`.
@@ -436,6 +433,8 @@ impl<P: LeastSquares + ?Sized> LeastSquares for Scaled<'_, P> {
     }
     fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
         let j = self.problem.jacobian(theta)?;
-        Ok(Mat::from_fn(j.nrows(), j.ncols(), |r, c| j[(r, c)] * self.scale))
+        Ok(Mat::from_fn(j.nrows(), j.ncols(), |r, c| {
+            j[(r, c)] * self.scale
+        }))
     }
 }

@@ -39,10 +39,17 @@ fn transforms_round_trip_and_differentiate() {
     ];
     for (t, theta) in cases {
         let phi = t.to_internal(theta).unwrap();
-        assert!((t.to_external(phi) - theta).abs() <= 1e-13 * theta.abs().max(1.0), "{t:?}");
+        assert!(
+            (t.to_external(phi) - theta).abs() <= 1e-13 * theta.abs().max(1.0),
+            "{t:?}"
+        );
         let h = 1e-6;
         let fd = (t.to_external(phi + h) - t.to_external(phi - h)) / (2.0 * h);
-        assert!((fd - t.derivative(phi)).abs() < 1e-8, "{t:?}: {fd} vs {}", t.derivative(phi));
+        assert!(
+            (fd - t.derivative(phi)).abs() < 1e-8,
+            "{t:?}: {fd} vs {}",
+            t.derivative(phi)
+        );
     }
 }
 
@@ -58,7 +65,11 @@ fn bounded_transform_saturates_without_overflow() {
     assert_eq!(t.to_internal(1.0), None);
     assert_eq!(t.to_internal(f64::NAN), None);
     assert_eq!(Transform::Positive.to_internal(f64::INFINITY), None);
-    assert!(!Transform::Bounded { lo: 0.0, hi: f64::INFINITY }.is_valid());
+    assert!(!Transform::Bounded {
+        lo: 0.0,
+        hi: f64::INFINITY
+    }
+    .is_valid());
 }
 
 #[test]
@@ -78,7 +89,10 @@ fn argmin_adapter_matches_the_problem() {
     let err = a.apply(&vec![1.0]).unwrap_err();
     assert_eq!(
         SolverError::from_argmin(err),
-        SolverError::WrongStartLength { expected: 2, got: 1 }
+        SolverError::WrongStartLength {
+            expected: 2,
+            got: 1
+        }
     );
     let f = ArgminFaerProblem::new(&Rosenbrock);
     let xc = Mat::from_fn(2, 1, |i, _| x[i]);
@@ -99,15 +113,21 @@ fn argmin_solvers_run_on_the_adapter() {
         .run()
         .unwrap();
     let best = result.state.get_best_param().unwrap();
-    assert!((best[0] - 1.0).abs() < 1e-5 && (best[1] - 1.0).abs() < 1e-5, "{best:?}");
+    assert!(
+        (best[0] - 1.0).abs() < 1e-5 && (best[1] - 1.0).abs() < 1e-5,
+        "{best:?}"
+    );
 }
 
 #[test]
 fn lm_as_argmin_solver_reports_through_termination_status() {
-    let result = Executor::new(ArgminProblem::new(&Rosenbrock), LevenbergMarquardt::default())
-        .configure(|s: LmState| s.param(vec![-1.2, 1.0]))
-        .run()
-        .unwrap();
+    let result = Executor::new(
+        ArgminProblem::new(&Rosenbrock),
+        LevenbergMarquardt::default(),
+    )
+    .configure(|s: LmState| s.param(vec![-1.2, 1.0]))
+    .run()
+    .unwrap();
     assert_eq!(
         result.state.termination_status,
         TerminationStatus::Terminated(TerminationReason::SolverConverged)
@@ -119,17 +139,24 @@ fn lm_as_argmin_solver_reports_through_termination_status() {
     assert!(state.get_jacobian().is_some() && state.get_gradient().is_some());
 
     // Without a start, `init` fails with a typed error rather than panicking.
-    let run = Executor::new(ArgminProblem::new(&Rosenbrock), LevenbergMarquardt::default()).run();
+    let run = Executor::new(
+        ArgminProblem::new(&Rosenbrock),
+        LevenbergMarquardt::default(),
+    )
+    .run();
     let Err(err) = run else {
         panic!("ran without a start")
     };
     assert_eq!(SolverError::from_argmin(err), SolverError::MissingStart);
 
     // The executor's own iteration limit is honoured as well as the solver's option.
-    let result = Executor::new(ArgminProblem::new(&Rosenbrock), LevenbergMarquardt::default())
-        .configure(|s: LmState| s.param(vec![-1.2, 1.0]).max_iters(3))
-        .run()
-        .unwrap();
+    let result = Executor::new(
+        ArgminProblem::new(&Rosenbrock),
+        LevenbergMarquardt::default(),
+    )
+    .configure(|s: LmState| s.param(vec![-1.2, 1.0]).max_iters(3))
+    .run()
+    .unwrap();
     assert_eq!(result.state.get_iter(), 3);
     assert_eq!(
         result.state.termination_status,
@@ -139,8 +166,13 @@ fn lm_as_argmin_solver_reports_through_termination_status() {
 
 #[test]
 fn scaling_residuals_keeps_the_minimiser() {
-    let scaled = Scaled { problem: &Rosenbrock, scale: 1e-3 };
-    let report = LevenbergMarquardt::default().minimize(&scaled, &[-1.2, 1.0]).unwrap();
+    let scaled = Scaled {
+        problem: &Rosenbrock,
+        scale: 1e-3,
+    };
+    let report = LevenbergMarquardt::default()
+        .minimize(&scaled, &[-1.2, 1.0])
+        .unwrap();
     assert!(report.converged, "{report:?}");
     assert!((report.params[0] - 1.0).abs() < 1e-10 && (report.params[1] - 1.0).abs() < 1e-10);
 }

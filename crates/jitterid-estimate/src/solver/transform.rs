@@ -195,12 +195,11 @@ impl<P: LeastSquares> Transformed<P> {
             .zip(&self.transforms)
             .enumerate()
             .map(|(index, (&value, &t))| {
-                t.to_internal(value)
-                    .ok_or(SolverError::OutsideConstraint {
-                        index,
-                        value,
-                        constraint: t,
-                    })
+                t.to_internal(value).ok_or(SolverError::OutsideConstraint {
+                    index,
+                    value,
+                    constraint: t,
+                })
             })
             .collect()
     }

@@ -341,8 +341,7 @@ fn evaluate<S: Signal + ?Sized, W: Window + ?Sized>(
         let fine = fine.value();
         out.values.push(fine + line_sum.value());
         out.quadrature.push((fine - coarse.value()).norm());
-        out.rounding
-            .push(ROUNDING_FACTOR * f64::EPSILON * absolute);
+        out.rounding.push(ROUNDING_FACTOR * f64::EPSILON * absolute);
     }
     out
 }
@@ -384,8 +383,9 @@ where
     // The line part, in closed form: a_l = c_l γ(-f_l) e^{i2πf_l t0}.
     let mut lines = Vec::new();
     for line in signal.lines() {
-        let a =
-            line.coefficient * jitter.cf(-line.frequency) * cis_cycles(frac_prod(line.frequency, t0));
+        let a = line.coefficient
+            * jitter.cf(-line.frequency)
+            * cis_cycles(frac_prod(line.frequency, t0));
         if !(line.frequency.is_finite() && a.re.is_finite() && a.im.is_finite()) {
             return Err(WindowError::NonFiniteSpectrum {
                 frequency: line.frequency,
@@ -430,17 +430,18 @@ where
             .map(|(q, r)| q + r + tail)
             .collect();
         // The frequency furthest over its target (all share one target).
-        let (worst, worst_bound) = bounds
-            .iter()
-            .copied()
-            .enumerate()
-            .fold((0, f64::NEG_INFINITY), |acc, (i, b)| {
-                if b > acc.1 || b.is_nan() {
-                    (i, b)
-                } else {
-                    acc
-                }
-            });
+        let (worst, worst_bound) =
+            bounds
+                .iter()
+                .copied()
+                .enumerate()
+                .fold((0, f64::NEG_INFINITY), |acc, (i, b)| {
+                    if b > acc.1 || b.is_nan() {
+                        (i, b)
+                    } else {
+                        acc
+                    }
+                });
         if worst_bound <= target {
             return Ok(IntegralMoment {
                 values: eval.values,
@@ -484,7 +485,9 @@ mod tests {
     #[test]
     fn tail_of_a_power_law() {
         // e_m = m^-4: the tail beyond M = 64 is about ∫_64^∞ x^-4 dx = 1.27e-6.
-        let e: Vec<f64> = (0..=64).map(|m| if m == 0 { 0.0 } else { (m as f64).powi(-4) }).collect();
+        let e: Vec<f64> = (0..=64)
+            .map(|m| if m == 0 { 0.0 } else { (m as f64).powi(-4) })
+            .collect();
         let t = tail_side(&e);
         let exact: f64 = (65..100_000).map(|m| (m as f64).powi(-4)).sum();
         assert!(t >= exact && t < 20.0 * exact, "{t} vs {exact}");
