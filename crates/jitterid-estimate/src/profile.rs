@@ -54,6 +54,13 @@ where
     W: Window + Clone,
 {
     let sigma = structure.jitter.std_dev();
+    // The covariance is only wanted at the winner: fit every n without it.
+    let quick = EstimateOptions {
+        frequencies: options.frequencies.clone(),
+        window: options.window.clone(),
+        solver: &options.solver,
+        covariance: false,
+    };
     let mut best: Option<(u32, Estimate)> = None;
     let mut costs = Vec::new();
     let mut first_error = None;
@@ -61,7 +68,7 @@ where
         let a = sigma * (3.0 * (n as f64 + 1.0)).sqrt();
         let mut s = structure.clone();
         s.jitter = UniformSum::new(n, a)?;
-        match estimate(&s, record, criterion, options) {
+        match estimate(&s, record, criterion, &quick) {
             Ok(e) => {
                 costs.push((n, Some(e.cost)));
                 let better = match &best {
@@ -80,8 +87,22 @@ where
             }
         }
     }
-    match best {
-        Some((n, estimate)) => Ok(ProfileEstimate { n, estimate, costs }),
-        None => Err(first_error.unwrap_or(EstimateError::NothingToEstimate)),
+    let Some((n, mut winner)) = best else {
+        return Err(first_error.unwrap_or(EstimateError::NothingToEstimate));
+    };
+    if options.covariance {
+        // Restart at the winner: the solver stops at once and the covariance is computed there.
+        let mut s = structure.clone();
+        s.jitter = UniformSum::new(n, structure.jitter.a())?;
+        let at = s.with_params(&winner.params)?;
+        let refit = estimate(&at, record, criterion, options)?;
+        winner.covariance = refit.covariance;
+        winner.std_errors = refit.std_errors;
+        winner.noise_std = refit.noise_std;
     }
+    Ok(ProfileEstimate {
+        n,
+        estimate: winner,
+        costs,
+    })
 }

@@ -61,3 +61,8 @@ pub mod prelude {
     };
     pub use num_complex::Complex64;
 }
+
+// The README's library example is compiled and run with the doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+struct ReadmeDoctests;

@@ -88,6 +88,16 @@ pub trait Solver {
     ) -> Result<SolverReport, SolverError>;
 }
 
+impl<S: Solver + ?Sized> Solver for &S {
+    fn minimize<P: LeastSquares + ?Sized>(
+        &self,
+        problem: &P,
+        start: &[f64],
+    ) -> Result<SolverReport, SolverError> {
+        (**self).minimize(problem, start)
+    }
+}
+
 /// Outcome of [`Solver::minimize`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SolverReport {

@@ -48,22 +48,32 @@
 //! of `Q`; its whole error is therefore the *time-domain wrap*
 //! `Σ_k w_k e^{-i2πfkT} Σ_{j≠0} m(t0 + (k + jQ)T)`: the part of the (jitter-smoothed) signal that
 //! lies more than `(Q − N)T` outside the record. With `Q = 4·max(N, 8)` to start (four nodes per
-//! lobe of `K`) this is zero for signals inside the record and tiny for decaying ones; it
-//! converges geometrically, faster than Gauss–Legendre on lobe-wise panels at a fraction of the
-//! nodes. The error is estimated per frequency as the difference between the rule with `Q`
-//! intervals and the nested rule with `Q/2` (every other node, no new evaluations); `Q` is
-//! doubled while that estimate exceeds the target. The closed trapezoidal rule (half weights at
-//! `±P/2`) is used, so the small non-periodicity left by cutting the alias sum only enters at
-//! second order.
+//! lobe of `K`) this is zero for signals inside the record and tiny for decaying ones, and it
+//! falls geometrically as `Q` grows; a lobe-wise Gauss–Legendre rule would need several times
+//! the nodes for the same accuracy. The error is estimated per frequency as the difference
+//! between the rule with `Q` intervals and the nested rule with `Q/2` (every other node, no new
+//! evaluations); `Q` is doubled while that estimate exceeds the target. The closed trapezoidal
+//! rule (half weights at `±P/2`) is used, so the small non-periodicity left by cutting the alias
+//! sum only enters at second order.
 //!
 //! # Error bound and target
 //!
 //! Per frequency, `bound = |I_Q − I_{Q/2}| + tail + 64 ε Σ_q w_q Σ_m |G| |K|` (quadrature
 //! estimate, tail estimate, rounding allowance). The target is
-//! `abs_tol + rel_tol · max_f |μ_Y(f)|` over the requested set. Measured against the
-//! time-domain route (`tests/moment.rs`): largest difference `≈ 3e-14` relative for jitter with
-//! Gaussian or uniform-sum (`n = 2`, 4) density and smooth or jump signals, always well inside
-//! the reported bound.
+//! `abs_tol + rel_tol · max_f |μ_Y(f)|` over the requested set (default `rel_tol = 1e-10`).
+//!
+//! # Accuracy reached
+//!
+//! Measured against the time-domain route (`tests/moment.rs`, `N = 32…200`, `t0 = 0` and
+//! `t0 ≠ 0`, rectangular and Hann windows, DFT-grid and off-grid frequencies): the largest
+//! difference is `2e-14 · max|μ_Y|`, for no jitter (smooth signals and lines), Gaussian and
+//! shifted-Gaussian jitter, uniform-sum jitter with `n = 2` and `n = 4`, and the paper's Table-2
+//! case (`N = 200`, 101 frequencies, second-order LTI response to a 25-switch input, uniform sum
+//! `n = 2`, `a = 1/(2√3)`: `M = 256`, `Q = 800`, about 0.5 s). The reported bounds are honest and
+//! pessimistic: up to `1e-11 … 8e-10 · max|μ_Y|`, dominated by the tail estimate, whose
+//! `sup |G| · ‖K‖_{L¹}` ignores the cancellation between aliases. The slow case is a spectrum
+//! decaying like `|ψ|^{-4}` (a signal with jumps under `n = 2` uniform-sum jitter): `1e-9` takes
+//! about 2000 aliases.
 
 use crate::dtft::CompensatedSum;
 use crate::phase::{cis_cycles, frac_prod};
@@ -278,7 +288,7 @@ fn tail_side(e: &[f64]) -> f64 {
     let mid = octave(m / 4, m / 2);
     let first = octave(m / 8, m / 4);
     let p = (mid / last).log2().min((first / mid).log2());
-    if !(p > MIN_DECAY) {
+    if p.is_nan() || p <= MIN_DECAY {
         return f64::INFINITY;
     }
     let q = (1.0 - p).exp2();
