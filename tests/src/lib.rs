@@ -9,7 +9,12 @@ use rand::SeedableRng;
 
 /// The paper's eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)`.
 pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Zpk {
-    Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }]).expect("valid")
+    Zpk::new(
+        k0,
+        vec![Root::Real(-z)],
+        vec![Root::Pair { re: pr, im: pi }],
+    )
+    .expect("valid")
 }
 
 /// A random binary input on `[start, end)` from a seed.
@@ -42,8 +47,7 @@ pub fn arb_jitter() -> impl Strategy<Value = Box<dyn JitterModel>> {
         Just(Box::new(NoJitter) as Box<dyn JitterModel>),
         (0u32..6, 0.01f64..0.8)
             .prop_map(|(n, a)| Box::new(UniformSum::new(n, a).unwrap()) as Box<dyn JitterModel>),
-        (0.01f64..0.3)
-            .prop_map(|s| Box::new(Gaussian::new(s).unwrap()) as Box<dyn JitterModel>),
+        (0.01f64..0.3).prop_map(|s| Box::new(Gaussian::new(s).unwrap()) as Box<dyn JitterModel>),
         (0.01f64..0.1).prop_map(|b| Box::new(Laplace::new(b).unwrap()) as Box<dyn JitterModel>),
         (0.01f64..0.5).prop_map(|d| Box::new(TwoPoint::new(d).unwrap()) as Box<dyn JitterModel>),
         (0.01f64..0.1)

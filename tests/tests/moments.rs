@@ -98,17 +98,34 @@ fn monte_carlo_mean_of_jittered_dtfts_is_the_first_moment() {
     let mut damped = false;
     for j in 0..freqs.len() {
         let mean = sum[j] / r;
-        let se_re = ((sq[j].0 / r - mean.re * mean.re) / (r - 1.0)).max(0.0).sqrt();
-        let se_im = ((sq[j].1 / r - mean.im * mean.im) / (r - 1.0)).max(0.0).sqrt();
-        assert!((mean.re - mu[j].re).abs() <= 5.0 * se_re + 1e-12, "f {j}: re {} vs {}", mean.re, mu[j].re);
-        assert!((mean.im - mu[j].im).abs() <= 5.0 * se_im + 1e-12, "f {j}: im {} vs {}", mean.im, mu[j].im);
+        let se_re = ((sq[j].0 / r - mean.re * mean.re) / (r - 1.0))
+            .max(0.0)
+            .sqrt();
+        let se_im = ((sq[j].1 / r - mean.im * mean.im) / (r - 1.0))
+            .max(0.0)
+            .sqrt();
+        assert!(
+            (mean.re - mu[j].re).abs() <= 5.0 * se_re + 1e-12,
+            "f {j}: re {} vs {}",
+            mean.re,
+            mu[j].re
+        );
+        assert!(
+            (mean.im - mu[j].im).abs() <= 5.0 * se_im + 1e-12,
+            "f {j}: im {} vs {}",
+            mean.im,
+            mu[j].im
+        );
         // The undamped model is rejected somewhere: the test can fail for the wrong μ_Y.
         let undamped = first_moment(&s, &NoJitter, &grid, &DirichletWindow, &freqs)[j];
         if (mean - undamped).norm() > 5.0 * (se_re + se_im) {
             damped = true;
         }
     }
-    assert!(damped, "the Monte Carlo mean should tell the jittered moment from the undamped one");
+    assert!(
+        damped,
+        "the Monte Carlo mean should tell the jittered moment from the undamped one"
+    );
 }
 
 /// The exact simulator: the noise-free, jitter-free record is the signal on the grid, and a

@@ -47,7 +47,11 @@ pub fn perturb(theta: &[f64], r: f64, rng: &mut StdRng) -> Vec<f64> {
 
 /// The eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)`.
 pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Result<Zpk, jitterid::signal::SignalError> {
-    Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }])
+    Zpk::new(
+        k0,
+        vec![Root::Real(-z)],
+        vec![Root::Pair { re: pr, im: pi }],
+    )
 }
 
 /// The generator of realisation `r` (same derivation as the library's Monte Carlo).

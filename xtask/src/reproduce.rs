@@ -25,7 +25,12 @@ pub(crate) struct ParamRow {
     pub asymptotic_std: Option<f64>,
 }
 
-pub(crate) fn row(name: &str, truth: Option<f64>, values: &Summary, asym: Option<&Summary>) -> ParamRow {
+pub(crate) fn row(
+    name: &str,
+    truth: Option<f64>,
+    values: &Summary,
+    asym: Option<&Summary>,
+) -> ParamRow {
     ParamRow {
         name: name.to_string(),
         truth,
@@ -47,8 +52,12 @@ pub(crate) fn table(rows: &[ParamRow], paper: Option<&[(f64, f64)]>) -> String {
     for (i, r) in rows.iter().enumerate() {
         let (pm, ps) = paper
             .and_then(|p| p.get(i))
-            .map_or(("–".into(), "–".into()), |(m, s)| (format!("{m:.4}"), format!("{s:.4}")));
-        let z = r.truth.map_or("–".into(), |t| format!("{:+.2}", (r.mean - t) / r.se));
+            .map_or(("–".into(), "–".into()), |(m, s)| {
+                (format!("{m:.4}"), format!("{s:.4}"))
+            });
+        let z = r
+            .truth
+            .map_or("–".into(), |t| format!("{:+.2}", (r.mean - t) / r.se));
         let _ = writeln!(
             s,
             "| {} | {} | {pm} | {ps} | {:.4} | {:.4} | {:.4} | {} | {z} |",
@@ -63,7 +72,12 @@ pub(crate) fn table(rows: &[ParamRow], paper: Option<&[(f64, f64)]>) -> String {
     s
 }
 
-pub(crate) fn write_outputs(case: &str, o: &Options, value: &serde_json::Value, md: &str) -> Result<(), String> {
+pub(crate) fn write_outputs(
+    case: &str,
+    o: &Options,
+    value: &serde_json::Value,
+    md: &str,
+) -> Result<(), String> {
     std::fs::create_dir_all(&o.out).map_err(|e| format!("{}: {e}", o.out))?;
     let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
     let suffix = if o.shard.1 > 1 {
@@ -130,17 +144,22 @@ fn fit_eq17<C: Criterion>(
     let Ok(start_model) = paper::eq17(start[0], start[1], start[2], start[3]) else {
         return vec![(false, vec![f64::NAN; 4], None); criteria.len()];
     };
-    let structure = ModelStructure::oe(LtiResponse::new(start_model, signal.input().clone()), *jitter);
+    let structure = ModelStructure::oe(
+        LtiResponse::new(start_model, signal.input().clone()),
+        *jitter,
+    );
     criteria
         .iter()
-        .map(|c| match estimate(&structure, &record, *c, &EstimateOptions::default()) {
-            // Parameters are [gain, zero, pole.re, pole.im]; the paper's z is −zero.
-            Ok(e) => {
-                let p = vec![e.params[0], -e.params[1], e.params[2], e.params[3]];
-                (e.converged, p, e.std_errors)
-            }
-            Err(_) => (false, vec![f64::NAN; 4], None),
-        })
+        .map(
+            |c| match estimate(&structure, &record, *c, &EstimateOptions::default()) {
+                // Parameters are [gain, zero, pole.re, pole.im]; the paper's z is −zero.
+                Ok(e) => {
+                    let p = vec![e.params[0], -e.params[1], e.params[2], e.params[3]];
+                    (e.converged, p, e.std_errors)
+                }
+                Err(_) => (false, vec![f64::NAN; 4], None),
+            },
+        )
         .collect()
 }
 
@@ -176,7 +195,12 @@ fn table2(o: &Options) -> Result<(), String> {
     });
     let secs = t.elapsed().as_secs_f64();
     let (converged, rows) = summarize_eq17(&results, truth);
-    let paper = [(0.2000, 0.0025), (0.5012, 0.0135), (-0.2504, 0.0019), (0.3001, 0.0029)];
+    let paper = [
+        (0.2000, 0.0025),
+        (0.5012, 0.0135),
+        (-0.2504, 0.0019),
+        (0.3001, 0.0029),
+    ];
     let mut md = format!(
         "## Table 2: BCLS, second-order OE model, known jitter (uniform-sum n = 2, a = 1/(2√3))\n\n{n} realisations, {converged} converged, {secs:.2} s wall. Start: truth × (1 + U(−0.2, 0.2)).\n\n"
     );
@@ -184,7 +208,13 @@ fn table2(o: &Options) -> Result<(), String> {
     md += "\nMonte Carlo std over mean asymptotic std: ";
     md += &rows
         .iter()
-        .map(|r| format!("{} {:.3}", r.name, r.std / r.asymptotic_std.unwrap_or(f64::NAN)))
+        .map(|r| {
+            format!(
+                "{} {:.3}",
+                r.name,
+                r.std / r.asymptotic_std.unwrap_or(f64::NAN)
+            )
+        })
         .collect::<Vec<_>>()
         .join(", ");
     md.push('\n');
@@ -259,7 +289,10 @@ fn alias(o: &Options) -> Result<(), String> {
             &structure,
             &record,
             &Bcls,
-            &EstimateOptions { covariance: false, ..Default::default() },
+            &EstimateOptions {
+                covariance: false,
+                ..Default::default()
+            },
         )
         .map_err(|e| e.to_string())?;
         let _ = writeln!(
@@ -274,27 +307,75 @@ fn alias(o: &Options) -> Result<(), String> {
            moment identifies the aliased frequency and the damped amplitude, never which alias. The \
            jitter's second moment does tell them apart (issue #4).\n";
     let _ = o.runs;
-    write_outputs("alias", o, &json!({"case": "alias", "damping": cases, "fits": fits}), &md)
+    write_outputs(
+        "alias",
+        o,
+        &json!({"case": "alias", "damping": cases, "fits": fits}),
+        &md,
+    )
 }
 
 fn table1(o: &Options) -> Result<(), String> {
     let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).map_err(|e| e.to_string())?;
     let s3 = 3f64.sqrt();
     // (name, truth, paper E[n, a, σ], paper Std[n, a, σ])
-    type Case = (&'static str, Box<dyn JitterModel>, Option<(u32, f64)>, f64, [f64; 3], [f64; 3]);
+    type Case = (
+        &'static str,
+        Box<dyn JitterModel>,
+        Option<(u32, f64)>,
+        f64,
+        [f64; 3],
+        [f64; 3],
+    );
     let cases: Vec<Case> = vec![
-        ("uniform-sum n=0 a=1/2", Box::new(UniformSum::new(0, 0.5).unwrap()), Some((0, 0.5)), 0.5 / s3,
-            [0.2145, 0.4683, 0.2599], [0.7360, 0.0678, 0.0489]),
-        ("uniform-sum n=0 a=1/(2√3)", Box::new(UniformSum::new(0, 0.5 / s3).unwrap()), Some((0, 0.5 / s3)), 0.5 / 3.0,
-            [1.1818, 0.3759, 0.1682], [1.6815, 0.1186, 0.0649]),
-        ("uniform-sum n=2 a=1/2", Box::new(UniformSum::new(2, 0.5).unwrap()), Some((2, 0.5)), 0.5 / 3.0,
-            [1.1386, 0.3752, 0.1676], [1.6608, 0.1088, 0.0592]),
-        ("uniform-sum n=2 a=1/(2√3)", Box::new(UniformSum::new(2, 0.5 / s3).unwrap()), Some((2, 0.5 / s3)), 0.5 / (3.0 * s3),
-            [1.6816, 0.2618, 0.1018], [1.9972, 0.1553, 0.0607]),
-        ("gaussian σ=1/6", Box::new(Gaussian::new(1.0 / 6.0).unwrap()), None, 1.0 / 6.0,
-            [1.8175, 0.3267, 0.1281], [2.0357, 0.1607, 0.0678]),
-        ("gaussian σ=1/(6√3)", Box::new(Gaussian::new(1.0 / (6.0 * s3)).unwrap()), None, 1.0 / (6.0 * s3),
-            [1.8807, 0.1958, 0.0752], [2.1966, 0.1425, 0.0530]),
+        (
+            "uniform-sum n=0 a=1/2",
+            Box::new(UniformSum::new(0, 0.5).unwrap()),
+            Some((0, 0.5)),
+            0.5 / s3,
+            [0.2145, 0.4683, 0.2599],
+            [0.7360, 0.0678, 0.0489],
+        ),
+        (
+            "uniform-sum n=0 a=1/(2√3)",
+            Box::new(UniformSum::new(0, 0.5 / s3).unwrap()),
+            Some((0, 0.5 / s3)),
+            0.5 / 3.0,
+            [1.1818, 0.3759, 0.1682],
+            [1.6815, 0.1186, 0.0649],
+        ),
+        (
+            "uniform-sum n=2 a=1/2",
+            Box::new(UniformSum::new(2, 0.5).unwrap()),
+            Some((2, 0.5)),
+            0.5 / 3.0,
+            [1.1386, 0.3752, 0.1676],
+            [1.6608, 0.1088, 0.0592],
+        ),
+        (
+            "uniform-sum n=2 a=1/(2√3)",
+            Box::new(UniformSum::new(2, 0.5 / s3).unwrap()),
+            Some((2, 0.5 / s3)),
+            0.5 / (3.0 * s3),
+            [1.6816, 0.2618, 0.1018],
+            [1.9972, 0.1553, 0.0607],
+        ),
+        (
+            "gaussian σ=1/6",
+            Box::new(Gaussian::new(1.0 / 6.0).unwrap()),
+            None,
+            1.0 / 6.0,
+            [1.8175, 0.3267, 0.1281],
+            [2.0357, 0.1607, 0.0678],
+        ),
+        (
+            "gaussian σ=1/(6√3)",
+            Box::new(Gaussian::new(1.0 / (6.0 * s3)).unwrap()),
+            None,
+            1.0 / (6.0 * s3),
+            [1.8807, 0.1958, 0.0752],
+            [2.1966, 0.1425, 0.0530],
+        ),
     ];
     let runs = runs_range(o, RUNS);
     let n_runs = runs.end - runs.start;
@@ -304,20 +385,40 @@ fn table1(o: &Options) -> Result<(), String> {
     let mut out = Vec::new();
     let t = Instant::now();
     for (name, truth, nu, sigma, pm, ps) in &cases {
-        let results: Vec<Option<(f64, f64, f64, Option<f64>)>> = mc_run(o.seed, runs.clone(), |_, rng| {
-            let u = paper::input(rng, 8.0);
-            let grid = paper::grid();
-            let signal = LtiResponse::new(g.clone(), u);
-            let data = simulate(&signal, truth.as_ref(), &grid, NOISE_STD, rng).ok()?;
-            let record = Record::new(grid, data.y).ok()?;
-            // Start: the truth's σ perturbed by 1 + U(−0.2, 0.2); n is profiled.
-            let s0 = paper::perturb(&[*sigma], 0.2, rng)[0];
-            let start = UniformSum::new(0, s0 * 3f64.sqrt()).ok()?;
-            let structure = ModelStructure::oe(signal, start).with_estimated(false, true, false);
-            let p = profile_uniform_sum(&structure, &record, &Bcls, &EstimateOptions::default(), 0..=9).ok()?;
-            let a_se = p.estimate.std_errors.as_ref().map(|s| s[0] / (3.0 * (p.n as f64 + 1.0)).sqrt());
-            p.estimate.converged.then(|| (p.n as f64, p.estimate.params[0], p.sigma().unwrap_or(f64::NAN), a_se))
-        });
+        let results: Vec<Option<(f64, f64, f64, Option<f64>)>> =
+            mc_run(o.seed, runs.clone(), |_, rng| {
+                let u = paper::input(rng, 8.0);
+                let grid = paper::grid();
+                let signal = LtiResponse::new(g.clone(), u);
+                let data = simulate(&signal, truth.as_ref(), &grid, NOISE_STD, rng).ok()?;
+                let record = Record::new(grid, data.y).ok()?;
+                // Start: the truth's σ perturbed by 1 + U(−0.2, 0.2); n is profiled.
+                let s0 = paper::perturb(&[*sigma], 0.2, rng)[0];
+                let start = UniformSum::new(0, s0 * 3f64.sqrt()).ok()?;
+                let structure =
+                    ModelStructure::oe(signal, start).with_estimated(false, true, false);
+                let p = profile_uniform_sum(
+                    &structure,
+                    &record,
+                    &Bcls,
+                    &EstimateOptions::default(),
+                    0..=9,
+                )
+                .ok()?;
+                let a_se = p
+                    .estimate
+                    .std_errors
+                    .as_ref()
+                    .map(|s| s[0] / (3.0 * (p.n as f64 + 1.0)).sqrt());
+                p.estimate.converged.then(|| {
+                    (
+                        p.n as f64,
+                        p.estimate.params[0],
+                        p.sigma().unwrap_or(f64::NAN),
+                        a_se,
+                    )
+                })
+            });
         let ok: Vec<_> = results.iter().flatten().collect();
         let sn: Summary = ok.iter().map(|r| r.0).collect();
         let sa: Summary = ok.iter().map(|r| r.1).collect();
@@ -343,5 +444,10 @@ fn table1(o: &Options) -> Result<(), String> {
     }
     let secs = t.elapsed().as_secs_f64();
     let _ = writeln!(md, "{secs:.1} s wall for all cases. The asymptotic std column of σ̂ is the median over runs of the sandwich std at the chosen n̂ (conditional on n̂).");
-    write_outputs("table1", o, &json!({"case": "table1", "seconds": secs, "cases": out}), &md)
+    write_outputs(
+        "table1",
+        o,
+        &json!({"case": "table1", "seconds": secs, "cases": out}),
+        &md,
+    )
 }

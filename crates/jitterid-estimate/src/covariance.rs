@@ -40,7 +40,11 @@ where
     // The data's true variance always involves the jitter, whatever the criterion models.
     let m = model.signal.expected_values(grid, &model.jitter);
     let sq = model.signal.expected_squares(grid, &model.jitter);
-    let jitter_var: Vec<f64> = sq.iter().zip(&m).map(|(s, m)| (s - m * m).max(0.0)).collect();
+    let jitter_var: Vec<f64> = sq
+        .iter()
+        .zip(&m)
+        .map(|(s, m)| (s - m * m).max(0.0))
+        .collect();
     let mean_jitter_var = jitter_var.iter().sum::<f64>() / n as f64;
     let freqs = data.frequencies();
     let t = grid.interval();
@@ -105,7 +109,11 @@ where
         for (fi, &f) in freqs.frequencies().iter().enumerate() {
             let phi = noise_var * model.noise.shape(f, t) * energy;
             let edge = f == 0.0 || (f - nyquist).abs() < 1e-12 * nyquist;
-            let (vre, vim) = if edge { (phi, 0.0) } else { (phi / 2.0, phi / 2.0) };
+            let (vre, vim) = if edge {
+                (phi, 0.0)
+            } else {
+                (phi / 2.0, phi / 2.0)
+            };
             // Var r = w_f · Var(Re V), w_f · Var(Im V): the rows of J already carry √w_f.
             for a in 0..p {
                 for b in 0..p {
@@ -122,7 +130,9 @@ where
     };
     let hinv = llt.inverse();
     let cov = &hinv * &meat * &hinv;
-    let out: Vec<Vec<f64>> = (0..p).map(|a| (0..p).map(|b| cov[(a, b)]).collect()).collect();
+    let out: Vec<Vec<f64>> = (0..p)
+        .map(|a| (0..p).map(|b| cov[(a, b)]).collect())
+        .collect();
     let finite = out.iter().flatten().all(|v| v.is_finite());
     (finite.then_some(out), noise_var.sqrt())
 }

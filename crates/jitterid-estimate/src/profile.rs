@@ -74,7 +74,8 @@ where
                 let better = match &best {
                     None => true,
                     Some((_, b)) => {
-                        (e.converged && !b.converged) || (e.converged == b.converged && e.cost < b.cost)
+                        (e.converged && !b.converged)
+                            || (e.converged == b.converged && e.cost < b.cost)
                     }
                 };
                 if better {

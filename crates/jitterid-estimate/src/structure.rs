@@ -149,10 +149,20 @@ impl<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel> ModelStructure<S,
             n.extend(self.signal.param_names());
         }
         if self.estimate_jitter {
-            n.extend(self.jitter.param_names().iter().map(|s| format!("jitter.{s}")));
+            n.extend(
+                self.jitter
+                    .param_names()
+                    .iter()
+                    .map(|s| format!("jitter.{s}")),
+            );
         }
         if self.estimate_noise {
-            n.extend(self.noise.param_names().iter().map(|s| format!("noise.{s}")));
+            n.extend(
+                self.noise
+                    .param_names()
+                    .iter()
+                    .map(|s| format!("noise.{s}")),
+            );
         }
         n
     }

@@ -1,4 +1,4 @@
-use crate::rule::{build_rule, QuadratureRule};
+use crate::rule::{build_rule, build_rule_from, QuadratureRule};
 use crate::JitterError;
 use num_complex::Complex64;
 use rand::RngCore;
@@ -108,6 +108,12 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
     /// is `rate` (1/s; the largest `|z|` of a factor `e^{zτ}` or `2πf` of an oscillation).
     fn rule(&self, breaks: &[f64], rate: f64) -> QuadratureRule {
         build_rule(self, breaks, rate)
+    }
+
+    /// The part of [`rule`](Self::rule) on `τ ≥ from`, for `E[h(τ) 1{τ ≥ from}]` (an atom
+    /// exactly at `from` counts): half the nodes of cutting the full rule at `from`.
+    fn rule_from(&self, from: f64, breaks: &[f64], rate: f64) -> QuadratureRule {
+        build_rule_from(self, from, breaks, rate)
     }
 }
 

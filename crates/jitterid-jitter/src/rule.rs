@@ -133,8 +133,22 @@ pub(crate) fn build_rule<J: JitterModel + ?Sized>(
     breaks: &[f64],
     rate: f64,
 ) -> QuadratureRule {
+    build_rule_from(model, f64::NEG_INFINITY, breaks, rate)
+}
+
+/// [`build_rule`] restricted to `τ ≥ from` (an atom exactly at `from` is kept).
+pub(crate) fn build_rule_from<J: JitterModel + ?Sized>(
+    model: &J,
+    from: f64,
+    breaks: &[f64],
+    rate: f64,
+) -> QuadratureRule {
     let mut rule = QuadratureRule::default();
     for (lo, hi) in model.pieces() {
+        if hi <= from {
+            continue;
+        }
+        let lo = lo.max(from);
         let mut cuts: Vec<f64> = breaks
             .iter()
             .copied()
@@ -147,7 +161,7 @@ pub(crate) fn build_rule<J: JitterModel + ?Sized>(
             a = b;
         }
     }
-    for atom in model.atoms() {
+    for atom in model.atoms().into_iter().filter(|a| a.position >= from) {
         rule.nodes.push(atom.position);
         rule.weights.push(atom.mass);
     }

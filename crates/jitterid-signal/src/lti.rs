@@ -114,34 +114,38 @@ impl<M: RationalModel> LtiResponse<M> {
                 Vec::new()
             },
         };
-        self.walk(grid, lo, hi, &poles, with_b, |k, t, u_past, x, y, in_reach| {
-            out.c[k] = u_past * mass;
-            for i in 0..np {
-                out.a[i][k] = x[i] * m0[i];
-                if with_b {
-                    out.b[i][k] = y[i] * m0[i] + x[i] * m1[i];
-                }
-            }
-            // Steps inside the reach: quadrature over τ ≥ c = t_j − t_k.
-            for &(tj, du) in in_reach {
-                let c = tj - t;
-                let rule = jitter.rule(&[c], rate);
-                for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
-                    if tau < c {
-                        continue;
+        self.walk(
+            grid,
+            lo,
+            hi,
+            &poles,
+            with_b,
+            |k, t, u_past, x, y, in_reach| {
+                out.c[k] = u_past * mass;
+                for i in 0..np {
+                    out.a[i][k] = x[i] * m0[i];
+                    if with_b {
+                        out.b[i][k] = y[i] * m0[i] + x[i] * m1[i];
                     }
-                    let xj = tau - c;
-                    out.c[k] += w * du;
-                    for (i, p) in poles.iter().enumerate() {
-                        let e = (p * xj).exp() * (w * du);
-                        out.a[i][k] += e;
-                        if with_b {
-                            out.b[i][k] += e * xj;
+                }
+                // Steps inside the reach: quadrature over τ ≥ c = t_j − t_k.
+                for &(tj, du) in in_reach {
+                    let c = tj - t;
+                    let rule = jitter.rule_from(c, &[], rate);
+                    for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                        let xj = tau - c;
+                        out.c[k] += w * du;
+                        for (i, p) in poles.iter().enumerate() {
+                            let e = (p * xj).exp() * (w * du);
+                            out.a[i][k] += e;
+                            if with_b {
+                                out.b[i][k] += e * xj;
+                            }
                         }
                     }
                 }
-            }
-        });
+            },
+        );
         out
     }
 
@@ -208,35 +212,42 @@ impl<M: RationalModel> LtiResponse<M> {
         let rate = 2.0 * self.rate();
         let full = jitter.rule(&[], rate);
         let mut out = vec![0.0; grid.len()];
-        self.walk(grid, lo, hi, &poles, false, |k, t, u_past, x, _, in_reach| {
-            let local;
-            let rule = if in_reach.is_empty() {
-                &full
-            } else {
-                let cuts: Vec<f64> = in_reach.iter().map(|s| s.0 - t).collect();
-                local = jitter.rule(&cuts, rate);
-                &local
-            };
-            let mut acc = 0.0;
-            for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
-                let mut s = m.dc_gain * u_past;
-                for i in 0..poles.len() {
-                    s += (coef[i] * x[i] * (poles[i] * (tau - lo)).exp()).re;
-                }
-                for &(tj, du) in in_reach {
-                    let xj = tau - (tj - t);
-                    if xj >= 0.0 {
-                        let mut step = m.dc_gain;
-                        for i in 0..poles.len() {
-                            step += (coef[i] * (poles[i] * xj).exp()).re;
-                        }
-                        s += du * step;
+        self.walk(
+            grid,
+            lo,
+            hi,
+            &poles,
+            false,
+            |k, t, u_past, x, _, in_reach| {
+                let local;
+                let rule = if in_reach.is_empty() {
+                    &full
+                } else {
+                    let cuts: Vec<f64> = in_reach.iter().map(|s| s.0 - t).collect();
+                    local = jitter.rule(&cuts, rate);
+                    &local
+                };
+                let mut acc = 0.0;
+                for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                    let mut s = m.dc_gain * u_past;
+                    for i in 0..poles.len() {
+                        s += (coef[i] * x[i] * (poles[i] * (tau - lo)).exp()).re;
                     }
+                    for &(tj, du) in in_reach {
+                        let xj = tau - (tj - t);
+                        if xj >= 0.0 {
+                            let mut step = m.dc_gain;
+                            for i in 0..poles.len() {
+                                step += (coef[i] * (poles[i] * xj).exp()).re;
+                            }
+                            s += du * step;
+                        }
+                    }
+                    acc += w * s * s;
                 }
-                acc += w * s * s;
-            }
-            out[k] = acc;
-        });
+                out[k] = acc;
+            },
+        );
         out
     }
 
@@ -296,8 +307,9 @@ impl<M: RationalModel> LtiResponse<M> {
             // E[e^{i2πf τ}] = γ(−f).
             let damp = jitter.cf(-tone.frequency);
             for (k, t) in grid.times().enumerate() {
-                let e = Complex64::from_polar(tone.amplitude, TAU * tone.frequency * t + tone.phase)
-                    * damp;
+                let e =
+                    Complex64::from_polar(tone.amplitude, TAU * tone.frequency * t + tone.phase)
+                        * damp;
                 out[k] += (g * e).im;
                 if let Some(cols) = grad.as_deref_mut() {
                     for (col, d) in cols.iter_mut().zip(&dg) {

@@ -95,9 +95,11 @@ pub fn roots(p: &[f64]) -> Option<Vec<Complex64>> {
             out.push(z);
             continue;
         }
-        let partner = (0..n)
-            .filter(|&j| !used[j])
-            .min_by(|&a, &b| (r[a] - z.conj()).norm().total_cmp(&(r[b] - z.conj()).norm()))?;
+        let partner = (0..n).filter(|&j| !used[j]).min_by(|&a, &b| {
+            (r[a] - z.conj())
+                .norm()
+                .total_cmp(&(r[b] - z.conj()).norm())
+        })?;
         used[partner] = true;
         let avg = 0.5 * (z + r[partner].conj());
         let upper = Complex64::new(avg.re, avg.im.abs());

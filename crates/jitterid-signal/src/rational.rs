@@ -526,10 +526,7 @@ mod tests {
         Zpk::new(
             0.2,
             vec![Root::Real(-0.5)],
-            vec![Root::Pair {
-                re: -0.25,
-                im: 0.3,
-            }],
+            vec![Root::Pair { re: -0.25, im: 0.3 }],
         )
         .unwrap()
     }
@@ -571,7 +568,10 @@ mod tests {
                 g.with_params(&pm).unwrap().modal().clone(),
             );
             let fd_gain = (mp.dc_gain - mm.dc_gain) / (2.0 * h);
-            assert!((fd_gain - m.d_dc_gain[j]).abs() < 1e-7, "dc gain, param {j}");
+            assert!(
+                (fd_gain - m.d_dc_gain[j]).abs() < 1e-7,
+                "dc gain, param {j}"
+            );
             for i in 0..m.poles.len() {
                 // Match poles by proximity: root order may differ between solves.
                 let find = |mm: &Modal| {
@@ -587,7 +587,10 @@ mod tests {
                 let fd_p = (mp.poles[ip] - mm.poles[im]) / (2.0 * h);
                 let fd_r = (mp.residues[ip] - mm.residues[im]) / (2.0 * h);
                 assert!((fd_p - m.d_poles[i][j]).norm() < 1e-6, "pole {i} param {j}");
-                assert!((fd_r - m.d_residues[i][j]).norm() < 1e-6, "residue {i} param {j}");
+                assert!(
+                    (fd_r - m.d_residues[i][j]).norm() < 1e-6,
+                    "residue {i} param {j}"
+                );
             }
         }
     }
@@ -599,7 +602,11 @@ mod tests {
             Err(SignalError::Unstable { .. })
         ));
         assert!(matches!(
-            Zpk::new(1.0, vec![Root::Real(1.0), Root::Real(2.0)], vec![Root::Real(-1.0)]),
+            Zpk::new(
+                1.0,
+                vec![Root::Real(1.0), Root::Real(2.0)],
+                vec![Root::Real(-1.0)]
+            ),
             Err(SignalError::Improper { .. })
         ));
         assert!(matches!(

@@ -52,10 +52,7 @@ fn paper_system() -> Zpk {
     Zpk::new(
         0.2,
         vec![Root::Real(-0.5)],
-        vec![Root::Pair {
-            re: -0.25,
-            im: 0.3,
-        }],
+        vec![Root::Pair { re: -0.25, im: 0.3 }],
     )
     .unwrap()
 }
@@ -89,7 +86,13 @@ fn jitters() -> Vec<Box<dyn JitterModel>> {
 
 /// RK4 on the controllable canonical form of `N(s)/A(s)` with `A` monic:
 /// `ẋ = A_c x + B u`, `y = C x + D u` with `C_i = b_i − D a_i`.
-fn ode_response(num: &[f64], den: &[f64], u: &PiecewiseConstant, t_end: f64, h: f64) -> Vec<(f64, f64)> {
+fn ode_response(
+    num: &[f64],
+    den: &[f64],
+    u: &PiecewiseConstant,
+    t_end: f64,
+    h: f64,
+) -> Vec<(f64, f64)> {
     let n = den.len() - 1;
     let d = num[0];
     let c: Vec<f64> = (0..n).map(|i| num[i + 1] - d * den[i + 1]).collect();
@@ -211,8 +214,16 @@ fn first_moment_gradient_matches_finite_differences() {
     let grid = SampleGrid::new(0.0, 1.0, 40).unwrap();
     let u = binary_input(3, 50.0);
     for jitter in jitters() {
-        check_gradient(&LtiResponse::new(paper_system(), u.clone()), &grid, jitter.as_ref());
-        check_gradient(&LtiResponse::new(third_order(), u.clone()), &grid, jitter.as_ref());
+        check_gradient(
+            &LtiResponse::new(paper_system(), u.clone()),
+            &grid,
+            jitter.as_ref(),
+        );
+        check_gradient(
+            &LtiResponse::new(third_order(), u.clone()),
+            &grid,
+            jitter.as_ref(),
+        );
     }
 }
 
@@ -231,7 +242,11 @@ fn value_gradient_matches_finite_differences() {
             pm[j] -= h;
             let fd = (s.with_params(&pp).unwrap().value(t) - s.with_params(&pm).unwrap().value(t))
                 / (2.0 * h);
-            assert!((fd - g[j]).abs() < 1e-7, "t {t} param {j}: {fd} vs {}", g[j]);
+            assert!(
+                (fd - g[j]).abs() < 1e-7,
+                "t {t} param {j}: {fd} vs {}",
+                g[j]
+            );
         }
     }
 }
@@ -311,7 +326,11 @@ fn fast_second_moment_equals_quadrature_route() {
             ),
         ] {
             for (a, b) in fast.iter().zip(&slow) {
-                assert!((a - b).abs() < 1e-12 * b.abs().max(1.0), "{}: {a} vs {b}", jitter.name());
+                assert!(
+                    (a - b).abs() < 1e-12 * b.abs().max(1.0),
+                    "{}: {a} vs {b}",
+                    jitter.name()
+                );
             }
         }
     }

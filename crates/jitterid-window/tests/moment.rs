@@ -380,7 +380,6 @@ fn routes_agree_on_the_table_2_case() {
         &IntegralOptions::default(),
     );
     let elapsed = start.elapsed().as_secs_f64();
-    eprintln!("TABLE2 elapsed {elapsed}");
     // Observed: largest |a − b| ≈ 1.6e-14 · max|μ_Y|, bounds ≤ 8.7e-12 · max|μ_Y|, with
     // M = 256 aliases and Q = 800 intervals; about 0.5 s in the test profile.
     assert!(worst < 1e-10, "{worst:e}");

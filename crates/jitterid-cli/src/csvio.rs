@@ -1,0 +1,260 @@
+//! Reading and writing the plain numeric CSV files of the command line.
+//!
+//! The format: a header line of column names, then one line per row of numbers, all separated by
+//! commas. Blank lines and lines starting with `#` are skipped. Every cell must parse as a
+//! finite number (`1`, `-0.25`, `3e-4`); every row has as many cells as the header. There is no
+//! quoting (names may be wrapped in double quotes, which are removed).
+
+use crate::cli_err;
+use crate::error::{CliError, CliResult};
+use std::path::Path;
+
+/// A parsed CSV file: named numeric columns of equal length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// The file's name, for messages.
+    pub name: String,
+    /// Line of the header (1-based).
+    pub header_line: usize,
+    /// Column names, in file order.
+    pub columns: Vec<String>,
+    /// The values, one vector per column.
+    pub values: Vec<Vec<f64>>,
+    /// The line (1-based) of every row.
+    pub lines: Vec<usize>,
+}
+
+impl Table {
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Index of a column.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.columns.iter().position(|c| c == name)
+    }
+
+    /// The values of a column, or an error naming the header and what was expected.
+    pub fn column(&self, name: &str) -> CliResult<&[f64]> {
+        match self.index(name) {
+            Some(i) => Ok(&self.values[i]),
+            None => Err(cli_err!(
+                "{}:{}: header: expected a column named `{name}`, found {}",
+                self.name,
+                self.header_line,
+                self.columns
+                    .iter()
+                    .map(|c| format!("`{c}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        }
+    }
+
+    /// The values of a column if it is there.
+    pub fn optional(&self, name: &str) -> Option<&[f64]> {
+        self.index(name).map(|i| self.values[i].as_slice())
+    }
+}
+
+fn clean_name(s: &str) -> &str {
+    let s = s.trim();
+    s.strip_prefix('"')
+        .and_then(|s| s.strip_suffix('"'))
+        .unwrap_or(s)
+        .trim()
+}
+
+fn shorten(s: &str) -> String {
+    let mut out: String = s.chars().take(40).collect();
+    if s.chars().count() > 40 {
+        out.push('…');
+    }
+    out.escape_debug().to_string()
+}
+
+/// Parses CSV text; `name` is used in messages.
+pub fn parse(name: &str, text: &str) -> CliResult<Table> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = text
+        .split('\n')
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err(cli_err!(
+            "{name}: empty file; expected a header line of column names (for example k,t,y)"
+        ));
+    };
+    let mut columns: Vec<String> = Vec::new();
+    for (i, cell) in header.split(',').enumerate() {
+        let c = clean_name(cell);
+        if c.is_empty() {
+            return Err(cli_err!(
+                "{name}:{header_line}: header: column {} has no name; expected a comma-separated list of names such as k,t,y",
+                i + 1
+            ));
+        }
+        if c.parse::<f64>().is_ok() {
+            return Err(cli_err!(
+                "{name}:{header_line}: header: expected column names, found the number `{}` (is the header line missing?)",
+                shorten(c)
+            ));
+        }
+        if columns.iter().any(|x| x == c) {
+            return Err(cli_err!(
+                "{name}:{header_line}: header: column `{}` appears twice",
+                shorten(c)
+            ));
+        }
+        columns.push(c.to_string());
+    }
+    let mut values = vec![Vec::new(); columns.len()];
+    let mut rows = Vec::new();
+    for (line, text) in lines {
+        let cells: Vec<&str> = text.split(',').collect();
+        if cells.len() != columns.len() {
+            return Err(cli_err!(
+                "{name}:{line}: expected {} cells ({}), found {}",
+                columns.len(),
+                columns.join(","),
+                cells.len()
+            ));
+        }
+        for (j, cell) in cells.iter().enumerate() {
+            let cell = cell.trim();
+            let column = &columns[j];
+            if cell.is_empty() {
+                return Err(cli_err!(
+                    "{name}:{line}: column `{column}`: expected a number, found an empty cell"
+                ));
+            }
+            let v: f64 = cell.parse().map_err(|_| {
+                cli_err!(
+                    "{name}:{line}: column `{column}`: expected a number, found `{}`",
+                    shorten(cell)
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(cli_err!(
+                    "{name}:{line}: column `{column}`: expected a finite number, found `{}`",
+                    shorten(cell)
+                ));
+            }
+            values[j].push(v);
+        }
+        rows.push(line);
+    }
+    if rows.is_empty() {
+        return Err(cli_err!(
+            "{name}:{header_line}: no data rows after the header"
+        ));
+    }
+    Ok(Table {
+        name: name.to_string(),
+        header_line,
+        columns,
+        values,
+        lines: rows,
+    })
+}
+
+/// Reads and parses a CSV file.
+pub fn read(path: &Path) -> CliResult<Table> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| CliError::new(format!("{name}: cannot read: {}", io_reason(&e))))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        cli_err!(
+            "{name}: not UTF-8 text (invalid byte at offset {}); expected a CSV file",
+            e.utf8_error().valid_up_to()
+        )
+    })?;
+    parse(&name, &text)
+}
+
+/// A short reason for an I/O error (`file does not exist`, …).
+pub fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "file does not exist".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string(),
+    }
+}
+
+/// A column to write: a name and its values; integer columns are printed without a fraction.
+#[derive(Debug, Clone, Copy)]
+pub enum Column<'a> {
+    /// Whole numbers.
+    Index(&'a str, &'a [usize]),
+    /// Real numbers, printed with the shortest text that reads back to the same value.
+    Real(&'a str, &'a [f64]),
+}
+
+impl Column<'_> {
+    fn name(&self) -> &str {
+        match self {
+            Column::Index(n, _) | Column::Real(n, _) => n,
+        }
+    }
+    fn len(&self) -> usize {
+        match self {
+            Column::Index(_, v) => v.len(),
+            Column::Real(_, v) => v.len(),
+        }
+    }
+    fn cell(&self, i: usize) -> String {
+        match self {
+            Column::Index(_, v) => v[i].to_string(),
+            Column::Real(_, v) => format!("{:?}", v[i]),
+        }
+    }
+}
+
+/// Formats columns of equal length as CSV text.
+pub fn format(columns: &[Column<'_>]) -> String {
+    let rows = columns.iter().map(Column::len).min().unwrap_or(0);
+    let mut out = columns
+        .iter()
+        .map(Column::name)
+        .collect::<Vec<_>>()
+        .join(",");
+    out.push('\n');
+    for i in 0..rows {
+        let row: Vec<String> = columns.iter().map(|c| c.cell(i)).collect();
+        out.push_str(&row.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip() {
+        let y = [0.1, -2.5e-7, 3.0];
+        let text = format(&[Column::Index("k", &[0, 1, 2]), Column::Real("y", &y)]);
+        let t = parse("x.csv", &text).unwrap();
+        assert_eq!(t.column("y").unwrap(), &y);
+        assert_eq!(t.column("k").unwrap(), &[0.0, 1.0, 2.0]);
+        assert_eq!(t.lines, vec![2, 3, 4]);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let e = parse("d.csv", "k,y\n0,1\n1,abc\n").unwrap_err();
+        assert!(e.message().starts_with("d.csv:3: column `y`"), "{e}");
+        let e = parse("d.csv", "k,y\n0,NaN\n").unwrap_err();
+        assert!(e.message().contains("finite"), "{e}");
+        let e = parse("d.csv", "k,y\n0\n").unwrap_err();
+        assert!(e.message().starts_with("d.csv:2: expected 2 cells"), "{e}");
+        let e = parse("d.csv", "").unwrap_err();
+        assert!(e.message().contains("empty"), "{e}");
+        let e = parse("d.csv", "k,,y\n").unwrap_err();
+        assert!(e.message().starts_with("d.csv:1: header"), "{e}");
+        let e = parse("d.csv", "k,y\n0,1\n").unwrap().column("t").unwrap_err();
+        assert!(e.message().starts_with("d.csv:1: header: expected a column named `t`"), "{e}");
+    }
+}

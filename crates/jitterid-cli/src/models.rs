@@ -1,0 +1,272 @@
+//! Run-time choice of signal, jitter family, noise model and solver: enums that delegate every
+//! trait method to the chosen library type (including the fast exact overrides), so that one
+//! non-generic [`ModelStructure`](jitterid::estimate::ModelStructure) serves every experiment.
+
+use jitterid::estimate::solver::{
+    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, NelderMead, Solver, SolverError,
+    SolverReport,
+};
+use jitterid::estimate::{ArmaNoise, EstimateError, NoiseModel};
+use jitterid::jitter::{
+    Atom, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter,
+    QuadratureRule, Shifted, TwoPoint, UniformSum,
+};
+use jitterid::num_complex::Complex64;
+use jitterid::rand::RngCore;
+use jitterid::signal::{
+    Jacobian, LtiResponse, SampleGrid, Signal, SignalError, Sinusoid, SpectralLine,
+    TransferFunction, Zpk,
+};
+
+/// A signal model chosen at run time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnySignal {
+    /// A zero-pole-gain system driven by a known input.
+    Zpk(LtiResponse<Zpk>),
+    /// A polynomial transfer function driven by a known input.
+    Tf(LtiResponse<TransferFunction>),
+    /// A sinusoid (no input).
+    Sinusoid(Sinusoid),
+}
+
+macro_rules! each_signal {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            AnySignal::Zpk($s) => $e,
+            AnySignal::Tf($s) => $e,
+            AnySignal::Sinusoid($s) => $e,
+        }
+    };
+}
+
+impl Signal for AnySignal {
+    fn param_names(&self) -> Vec<String> {
+        each_signal!(self, s => s.param_names())
+    }
+    fn params(&self) -> Vec<f64> {
+        each_signal!(self, s => s.params())
+    }
+    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
+        Ok(match self {
+            AnySignal::Zpk(s) => AnySignal::Zpk(s.with_params(params)?),
+            AnySignal::Tf(s) => AnySignal::Tf(s.with_params(params)?),
+            AnySignal::Sinusoid(s) => AnySignal::Sinusoid(s.with_params(params)?),
+        })
+    }
+    fn value(&self, t: f64) -> f64 {
+        each_signal!(self, s => s.value(t))
+    }
+    fn value_gradient(&self, t: f64, grad: &mut [f64]) {
+        each_signal!(self, s => s.value_gradient(t, grad))
+    }
+    fn density(&self, f: f64) -> Complex64 {
+        each_signal!(self, s => s.density(f))
+    }
+    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        each_signal!(self, s => s.density_gradient(f, grad))
+    }
+    fn lines(&self) -> Vec<SpectralLine> {
+        each_signal!(self, s => s.lines())
+    }
+    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
+        each_signal!(self, s => s.lines_gradient())
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        each_signal!(self, s => s.breakpoints())
+    }
+    fn rate(&self) -> f64 {
+        each_signal!(self, s => s.rate())
+    }
+    fn num_params(&self) -> usize {
+        each_signal!(self, s => s.num_params())
+    }
+    fn expected_values(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        each_signal!(self, s => s.expected_values(grid, jitter))
+    }
+    fn expected_values_gradient(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Jacobian {
+        each_signal!(self, s => s.expected_values_gradient(grid, jitter))
+    }
+    fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        each_signal!(self, s => s.expected_squares(grid, jitter))
+    }
+}
+
+impl AnySignal {
+    /// `G(i2πf)` for the rational systems, `None` for a sinusoid.
+    pub fn frequency_response(&self, f: f64) -> Option<Complex64> {
+        use jitterid::signal::RationalModel;
+        match self {
+            AnySignal::Zpk(s) => Some(s.model().frequency_response(f)),
+            AnySignal::Tf(s) => Some(s.model().frequency_response(f)),
+            AnySignal::Sinusoid(_) => None,
+        }
+    }
+}
+
+/// A jitter family chosen at run time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyJitter {
+    /// `τ ≡ 0`.
+    None(NoJitter),
+    /// Sum of `n + 1` uniforms on `[-a, a]`.
+    UniformSum(UniformSum),
+    /// Gaussian.
+    Gaussian(Gaussian),
+    /// Laplace.
+    Laplace(Laplace),
+    /// `±d` with probability ½ each.
+    TwoPoint(TwoPoint),
+    /// One-sided exponential delay.
+    Exponential(ExponentialDelay),
+    /// Any of these moved by a constant offset.
+    Shifted(Box<Shifted<AnyJitter>>),
+}
+
+macro_rules! each_jitter {
+    ($self:expr, $j:ident => $e:expr) => {
+        match $self {
+            AnyJitter::None($j) => $e,
+            AnyJitter::UniformSum($j) => $e,
+            AnyJitter::Gaussian($j) => $e,
+            AnyJitter::Laplace($j) => $e,
+            AnyJitter::TwoPoint($j) => $e,
+            AnyJitter::Exponential($j) => $e,
+            AnyJitter::Shifted($j) => $e,
+        }
+    };
+}
+
+impl JitterModel for AnyJitter {
+    fn name(&self) -> &'static str {
+        each_jitter!(self, j => j.name())
+    }
+    fn param_names(&self) -> Vec<&'static str> {
+        each_jitter!(self, j => j.param_names())
+    }
+    fn params(&self) -> Vec<f64> {
+        each_jitter!(self, j => j.params())
+    }
+    fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
+        Ok(match self {
+            AnyJitter::None(j) => AnyJitter::None(j.with_params(params)?),
+            AnyJitter::UniformSum(j) => AnyJitter::UniformSum(j.with_params(params)?),
+            AnyJitter::Gaussian(j) => AnyJitter::Gaussian(j.with_params(params)?),
+            AnyJitter::Laplace(j) => AnyJitter::Laplace(j.with_params(params)?),
+            AnyJitter::TwoPoint(j) => AnyJitter::TwoPoint(j.with_params(params)?),
+            AnyJitter::Exponential(j) => AnyJitter::Exponential(j.with_params(params)?),
+            AnyJitter::Shifted(j) => AnyJitter::Shifted(Box::new(j.with_params(params)?)),
+        })
+    }
+    fn cf(&self, f: f64) -> Complex64 {
+        each_jitter!(self, j => j.cf(f))
+    }
+    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        each_jitter!(self, j => j.cf_gradient(f, grad))
+    }
+    fn mgf(&self, z: Complex64) -> Option<Complex64> {
+        each_jitter!(self, j => j.mgf(z))
+    }
+    fn pdf(&self, tau: f64) -> f64 {
+        each_jitter!(self, j => j.pdf(tau))
+    }
+    fn atoms(&self) -> Vec<Atom> {
+        each_jitter!(self, j => j.atoms())
+    }
+    fn pieces(&self) -> Vec<(f64, f64)> {
+        each_jitter!(self, j => j.pieces())
+    }
+    fn mean(&self) -> f64 {
+        each_jitter!(self, j => j.mean())
+    }
+    fn variance(&self) -> f64 {
+        each_jitter!(self, j => j.variance())
+    }
+    fn sample(&self, rng: &mut dyn RngCore) -> f64 {
+        each_jitter!(self, j => j.sample(rng))
+    }
+    fn num_params(&self) -> usize {
+        each_jitter!(self, j => j.num_params())
+    }
+    fn std_dev(&self) -> f64 {
+        each_jitter!(self, j => j.std_dev())
+    }
+    fn reach(&self) -> (f64, f64) {
+        each_jitter!(self, j => j.reach())
+    }
+    fn rule(&self, breaks: &[f64], rate: f64) -> QuadratureRule {
+        each_jitter!(self, j => j.rule(breaks, rate))
+    }
+}
+
+/// A measurement-noise shape chosen at run time.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyNoise {
+    /// White noise.
+    White,
+    /// ARMA-filtered white noise.
+    Arma(ArmaNoise),
+}
+
+impl NoiseModel for AnyNoise {
+    fn param_names(&self) -> Vec<String> {
+        match self {
+            AnyNoise::White => Vec::new(),
+            AnyNoise::Arma(a) => a.param_names(),
+        }
+    }
+    fn params(&self) -> Vec<f64> {
+        match self {
+            AnyNoise::White => Vec::new(),
+            AnyNoise::Arma(a) => a.params(),
+        }
+    }
+    fn with_params(&self, params: &[f64]) -> Result<Self, EstimateError> {
+        match self {
+            AnyNoise::White => {
+                if params.is_empty() {
+                    Ok(AnyNoise::White)
+                } else {
+                    Err(EstimateError::WrongParamCount {
+                        expected: 0,
+                        got: params.len(),
+                    })
+                }
+            }
+            AnyNoise::Arma(a) => Ok(AnyNoise::Arma(a.with_params(params)?)),
+        }
+    }
+    fn shape(&self, f: f64, interval: f64) -> f64 {
+        match self {
+            AnyNoise::White => 1.0,
+            AnyNoise::Arma(a) => a.shape(f, interval),
+        }
+    }
+    fn is_white(&self) -> bool {
+        matches!(self, AnyNoise::White)
+    }
+}
+
+/// A solver chosen at run time.
+#[derive(Debug, Clone)]
+pub enum AnySolver {
+    /// Levenberg–Marquardt.
+    Lm(LevenbergMarquardt),
+    /// Gauss–Newton with a backtracking line search.
+    GaussNewton(GaussNewtonLineSearch),
+    /// Nelder–Mead simplex.
+    NelderMead(NelderMead),
+}
+
+impl Solver for AnySolver {
+    fn minimize<P: LeastSquares + ?Sized>(
+        &self,
+        problem: &P,
+        start: &[f64],
+    ) -> Result<SolverReport, SolverError> {
+        match self {
+            AnySolver::Lm(s) => s.minimize(problem, start),
+            AnySolver::GaussNewton(s) => s.minimize(problem, start),
+            AnySolver::NelderMead(s) => s.minimize(problem, start),
+        }
+    }
+}
