@@ -6,6 +6,7 @@ use jitterid::jitter::{
 use jitterid::signal::{LtiResponse, PiecewiseConstant, RandomBinary, Root, Zpk};
 use proptest::prelude::*;
 use rand::SeedableRng;
+use std::sync::Arc;
 
 /// The paper's eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)`.
 pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Zpk {
@@ -42,19 +43,19 @@ pub fn arb_system() -> impl Strategy<Value = Zpk> {
 }
 
 /// A jitter model from every family, with random parameters.
-pub fn arb_jitter() -> impl Strategy<Value = Box<dyn JitterModel>> {
+pub fn arb_jitter() -> impl Strategy<Value = Arc<dyn JitterModel>> {
     prop_oneof![
-        Just(Box::new(NoJitter) as Box<dyn JitterModel>),
+        Just(Arc::new(NoJitter) as Arc<dyn JitterModel>),
         (0u32..6, 0.01f64..0.8)
-            .prop_map(|(n, a)| Box::new(UniformSum::new(n, a).unwrap()) as Box<dyn JitterModel>),
-        (0.01f64..0.3).prop_map(|s| Box::new(Gaussian::new(s).unwrap()) as Box<dyn JitterModel>),
-        (0.01f64..0.1).prop_map(|b| Box::new(Laplace::new(b).unwrap()) as Box<dyn JitterModel>),
-        (0.01f64..0.5).prop_map(|d| Box::new(TwoPoint::new(d).unwrap()) as Box<dyn JitterModel>),
+            .prop_map(|(n, a)| Arc::new(UniformSum::new(n, a).unwrap()) as Arc<dyn JitterModel>),
+        (0.01f64..0.3).prop_map(|s| Arc::new(Gaussian::new(s).unwrap()) as Arc<dyn JitterModel>),
+        (0.01f64..0.1).prop_map(|b| Arc::new(Laplace::new(b).unwrap()) as Arc<dyn JitterModel>),
+        (0.01f64..0.5).prop_map(|d| Arc::new(TwoPoint::new(d).unwrap()) as Arc<dyn JitterModel>),
         (0.01f64..0.1)
-            .prop_map(|m| Box::new(ExponentialDelay::new(m).unwrap()) as Box<dyn JitterModel>),
+            .prop_map(|m| Arc::new(ExponentialDelay::new(m).unwrap()) as Arc<dyn JitterModel>),
         (-0.3f64..0.3, 0.01f64..0.4).prop_map(|(c, a)| {
-            Box::new(Shifted::new(UniformSum::new(1, a).unwrap(), c).unwrap())
-                as Box<dyn JitterModel>
+            Arc::new(Shifted::new(UniformSum::new(1, a).unwrap(), c).unwrap())
+                as Arc<dyn JitterModel>
         }),
     ]
 }

@@ -1,1 +1,20 @@
-//! placeholder
+//! The `jitterid` command line: experiment files, `simulate` / `fit` / `montecarlo` / `merge`,
+//! CSV and JSON, SVG figures and a progress bar. See `docs/experiments.md`.
+//!
+//! The binary is a thin wrapper around [`run`]; the modules are public so that tests can reach
+//! the readers directly (for example to fuzz them).
+#![warn(missing_docs)]
+
+pub mod cli;
+pub mod commands;
+pub mod csvio;
+pub mod error;
+pub mod experiment;
+pub mod fitting;
+pub mod models;
+pub mod output;
+pub mod plots;
+pub mod progress;
+pub mod svg;
+
+pub use cli::run;

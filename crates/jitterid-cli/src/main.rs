@@ -1,1 +1,5 @@
-fn main() {}
+//! The `jitterid` binary.
+
+fn main() -> std::process::ExitCode {
+    jitterid_cli::run(std::env::args_os())
+}

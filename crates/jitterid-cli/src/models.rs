@@ -3,7 +3,7 @@
 //! non-generic [`ModelStructure`](jitterid::estimate::ModelStructure) serves every experiment.
 
 use jitterid::estimate::solver::{
-    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, NelderMead, Solver, SolverError,
+    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, MultiStart, NelderMead, Solver, SolverError,
     SolverReport,
 };
 use jitterid::estimate::{ArmaNoise, EstimateError, NoiseModel};
@@ -255,6 +255,8 @@ pub enum AnySolver {
     GaussNewton(GaussNewtonLineSearch),
     /// Nelder–Mead simplex.
     NelderMead(NelderMead),
+    /// Any of these from several starts.
+    Multi(Box<MultiStart<AnySolver>>),
 }
 
 impl Solver for AnySolver {
@@ -267,6 +269,7 @@ impl Solver for AnySolver {
             AnySolver::Lm(s) => s.minimize(problem, start),
             AnySolver::GaussNewton(s) => s.minimize(problem, start),
             AnySolver::NelderMead(s) => s.minimize(problem, start),
+            AnySolver::Multi(s) => s.minimize(problem, start),
         }
     }
 }

@@ -75,26 +75,9 @@ where
     let w = criterion.weights(freqs, &model.noise);
     let taper = data.window().weights(n);
 
-    // G = Aᵀ√W·J without the taper c_k (applied in the sum below):
-    // G[k][j] = Σ_f √w_f (cos φ J[2f,j] − sin φ J[2f+1,j]), φ = 2π f kT.
-    let mut g = vec![vec![0.0; p]; n];
-    for (fi, &f) in freqs.frequencies().iter().enumerate() {
-        let sw = w[fi].sqrt();
-        let step = Complex64::from_polar(1.0, TAU * f * t);
-        let mut rot = Complex64::new(1.0, 0.0);
-        for (k, gk) in g.iter_mut().enumerate() {
-            if k % 128 == 0 {
-                // Re-anchor the rotation so rounding does not accumulate over long records.
-                rot = Complex64::from_polar(1.0, TAU * ((f * t * k as f64).fract()));
-            }
-            for (j, gkj) in gk.iter_mut().enumerate() {
-                *gkj += sw * (rot.re * jac[(2 * fi, j)] - rot.im * jac[(2 * fi + 1, j)]);
-            }
-            rot *= step;
-        }
-    }
+    let g = project_to_time(jac, freqs, &w, n, t);
     let mut meat = Mat::<f64>::zeros(p, p);
-    for (k, gk) in g.iter().enumerate() {
+    for (k, gk) in g.chunks_exact(p.max(1)).enumerate().take(n) {
         let ck = taper[k];
         let lambda = jitter_var[k] + if white { noise_var } else { 0.0 };
         for a in 0..p {
@@ -135,4 +118,52 @@ where
         .collect();
     let finite = out.iter().flatten().all(|v| v.is_finite());
     (finite.then_some(out), noise_var.sqrt())
+}
+
+/// `G = Aᵀ√W·J` without the taper `c_k` (applied by the caller), row-major `N × p`:
+/// `G[k][j] = Σ_f √w_f Re((J[2f,j] + i J[2f+1,j]) e^{i2π f kT})`.
+///
+/// On the DFT grid this is one inverse FFT per parameter, `O(p N log N)`; elsewhere a direct sum
+/// with a rotation recurrence re-anchored every 128 samples, `O(p N F)`.
+fn project_to_time(
+    jac: &Mat<f64>,
+    freqs: &jitterid_window::FrequencySet,
+    w: &[f64],
+    n: usize,
+    t: f64,
+) -> Vec<f64> {
+    let p = jac.ncols();
+    let mut g = vec![0.0; n * p];
+    if let Some(bins) = freqs.dft_indices() {
+        let fft = rustfft::FftPlanner::<f64>::new().plan_fft_inverse(n);
+        let mut z = vec![Complex64::new(0.0, 0.0); n];
+        for j in 0..p {
+            z.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
+            for (fi, &b) in bins.iter().enumerate() {
+                z[b] += w[fi].sqrt() * Complex64::new(jac[(2 * fi, j)], jac[(2 * fi + 1, j)]);
+            }
+            fft.process(&mut z);
+            for (k, v) in z.iter().enumerate() {
+                g[k * p + j] = v.re;
+            }
+        }
+        return g;
+    }
+    for (fi, &f) in freqs.frequencies().iter().enumerate() {
+        let sw = w[fi].sqrt();
+        let step = Complex64::from_polar(1.0, TAU * f * t);
+        let mut rot = Complex64::new(1.0, 0.0);
+        for k in 0..n {
+            if k % 128 == 0 {
+                // Re-anchor the rotation so rounding does not accumulate over long records.
+                rot = Complex64::from_polar(1.0, TAU * ((f * t * k as f64).fract()));
+            }
+            for j in 0..p {
+                g[k * p + j] +=
+                    sw * (rot.re * jac[(2 * fi, j)] - rot.im * jac[(2 * fi + 1, j)]);
+            }
+            rot *= step;
+        }
+    }
+    g
 }

@@ -127,3 +127,60 @@ impl NoiseModel for ArmaNoise {
         (Self::eval(&self.c, z_inv) / Self::eval(&self.d, z_inv)).norm_sqr()
     }
 }
+
+/// A noise shape plus a flat floor: `|H(f)|² + ρ`, `ρ > 0` estimated with the shape through its
+/// logarithm (the parameter is `log_floor = ln ρ`, so every parameter vector is valid).
+///
+/// Jittered samples carry their own noise, `E[s(t_k+τ)²] − m_k²`, which is independent from
+/// sample to sample and so has a flat spectrum (`conventions.md`: `Var Y(f) = Σ_k λ_k` at every
+/// `f`). The residual spectrum of a Box–Jenkins fit to jittered data is therefore
+/// `σ_e²|H(f)|² + λ̄ = σ_e² (|H(f)|² + ρ)`; without the floor the noise model absorbs it and its
+/// parameters are biased towards white noise. With it, `σ_e²` still concentrates out of the
+/// likelihood exactly.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WithFloor<N> {
+    inner: N,
+    floor: f64,
+}
+
+impl<N: NoiseModel> WithFloor<N> {
+    /// `floor > 0`, finite.
+    pub fn new(inner: N, floor: f64) -> Result<Self, EstimateError> {
+        if !(floor.is_finite() && floor > 0.0) {
+            return Err(EstimateError::Noise(format!(
+                "floor must be finite and > 0, got {floor}"
+            )));
+        }
+        Ok(Self { inner, floor })
+    }
+
+    /// The floor `ρ`.
+    pub fn floor(&self) -> f64 {
+        self.floor
+    }
+}
+
+impl<N: NoiseModel> NoiseModel for WithFloor<N> {
+    fn param_names(&self) -> Vec<String> {
+        let mut n = self.inner.param_names();
+        n.push("log_floor".into());
+        n
+    }
+    fn params(&self) -> Vec<f64> {
+        let mut p = self.inner.params();
+        p.push(self.floor.ln());
+        p
+    }
+    fn with_params(&self, params: &[f64]) -> Result<Self, EstimateError> {
+        let Some((&log_floor, inner)) = params.split_last() else {
+            return Err(EstimateError::WrongParamCount {
+                expected: self.inner.params().len() + 1,
+                got: 0,
+            });
+        };
+        Self::new(self.inner.with_params(inner)?, log_floor.exp())
+    }
+    fn shape(&self, f: f64, interval: f64) -> f64 {
+        self.inner.shape(f, interval) + self.floor
+    }
+}

@@ -153,13 +153,9 @@ impl PiecewiseCheb {
     }
 
     /// Number of segments.
+    #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.starts.len()
-    }
-
-    /// First and last covered time.
-    pub(crate) fn span(&self) -> Option<(f64, f64)> {
-        Some((*self.starts.first()?, *self.ends.last()?))
     }
 
     /// The segment containing `t`, if any.

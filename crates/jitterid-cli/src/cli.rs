@@ -1,0 +1,198 @@
+//! Command-line arguments (clap) and dispatch.
+
+use crate::commands::{self, FitOptions, MonteCarloOptions, Shard, SimulateOptions, DEFAULT_SEED};
+use crate::error::CliResult;
+use crate::experiment::Method;
+use clap::{Args, Parser, Subcommand};
+use std::ffi::OsString;
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// System identification from jittered samples: simulate, fit and Monte Carlo studies of
+/// experiments described in TOML files (see docs/experiments.md).
+#[derive(Debug, Parser)]
+#[command(name = "jitterid", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate one record of an experiment (its values are the truth) and write it as CSV.
+    Simulate(SimulateArgs),
+    /// Fit an experiment's model to a data file (the experiment's values are the start).
+    Fit(FitArgs),
+    /// Run a Monte Carlo study: simulate and fit many seeded realisations.
+    Montecarlo(MonteCarloArgs),
+    /// Merge the shard files of `montecarlo --shard i/n --json` into the unsharded result.
+    Merge(MergeArgs),
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    Method::parse(s).ok_or_else(|| format!("expected ls, bcls, bj or ml, found `{s}`"))
+}
+
+/// Arguments of `simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// The experiment file (TOML).
+    pub experiment: PathBuf,
+    /// Master seed; the record is realisation `--run` of a Monte Carlo study with this seed.
+    #[arg(long, default_value_t = DEFAULT_SEED)]
+    pub seed: u64,
+    /// Realisation index.
+    #[arg(long, default_value_t = 0)]
+    pub run: u64,
+    /// The CSV file to write (columns k, t, y and u; a random-binary input also goes to
+    /// <stem>.input.csv).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the drawn jitter `tau` and measurement noise `v`.
+    #[arg(long)]
+    pub truth: bool,
+}
+
+/// Arguments of `fit`.
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// The experiment file (TOML); its values are the starting point.
+    pub experiment: PathBuf,
+    /// The data file (CSV with a column `y`; optional `k`, `t` are checked).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// The input realisation (CSV with columns t,u) for a random-binary experiment
+    /// [default: <data stem>.input.csv].
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml.
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<Method>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write SVG figures into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Arguments of `montecarlo`.
+#[derive(Debug, Args)]
+pub struct MonteCarloArgs {
+    /// The experiment file (TOML); its values are the truth.
+    pub experiment: PathBuf,
+    /// Number of realisations.
+    #[arg(long, default_value_t = 128)]
+    pub runs: u64,
+    /// Master seed (realisation r uses a generator derived from the seed and r).
+    #[arg(long, default_value_t = DEFAULT_SEED)]
+    pub seed: u64,
+    /// Worker threads [default: one per core]; results do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write SVG figures into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// Run only shard i of n (runs R·i/n .. R·(i+1)/n); merge shard JSON files with `merge`.
+    #[arg(long, value_name = "i/n")]
+    pub shard: Option<Shard>,
+    /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml.
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<Method>,
+    /// Write the JSON to this file (atomically) instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
+/// Arguments of `merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The shard files.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the JSON to this file (atomically) instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
+fn dispatch(cli: Cli) -> CliResult<String> {
+    match cli.command {
+        Command::Simulate(a) => commands::simulate(&SimulateOptions {
+            experiment: a.experiment,
+            seed: a.seed,
+            run: a.run,
+            out: a.out,
+            truth: a.truth,
+        })
+        .map(|s| s + "\n"),
+        Command::Fit(a) => commands::fit(&FitOptions {
+            experiment: a.experiment,
+            data: a.data,
+            input: a.input,
+            method: a.method,
+            json: a.json,
+            plot: a.plot,
+        }),
+        Command::Montecarlo(a) => commands::montecarlo(&MonteCarloOptions {
+            experiment: a.experiment,
+            runs: a.runs,
+            seed: a.seed,
+            threads: a.threads,
+            json: a.json,
+            plot: a.plot,
+            shard: a.shard,
+            method: a.method,
+            out: a.out,
+        }),
+        Command::Merge(a) => commands::merge(&a.shards, a.json, a.out.as_deref()),
+    }
+}
+
+/// Runs the command line; returns the exit status (0, or 2 after a one-line error on stderr).
+pub fn run<I, T>(args: I) -> ExitCode
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+                let _ = e.print();
+                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                    ExitCode::from(2)
+                } else {
+                    ExitCode::SUCCESS
+                };
+            }
+            let text = e.render().to_string();
+            let first = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: invalid arguments");
+            let first = first.trim();
+            let first = first.strip_prefix("error: ").unwrap_or(first);
+            eprintln!("error: {first} (see jitterid --help)");
+            return ExitCode::from(2);
+        }
+    };
+    match dispatch(cli) {
+        Ok(text) => {
+            let mut out = std::io::stdout().lock();
+            let _ = out.write_all(text.as_bytes());
+            let _ = out.flush();
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("{}", commands::report(&e));
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,637 @@
+//! The subcommands: `simulate`, `fit`, `montecarlo`, `merge`.
+
+use crate::cli_err;
+use crate::csvio::{self, Column};
+use crate::error::{CliError, CliResult};
+use crate::experiment::{self, Experiment, InputSpec, Method};
+use crate::fitting::{self, Fit, Structure};
+use crate::output::{ensure_dir, write_atomic, Staged};
+use crate::plots;
+use crate::progress::Progress;
+use jitterid::estimate::montecarlo::{realization_rng, realization_seed, run as mc_run, Summary};
+use jitterid::signal::Input;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The default master seed (that of `cargo xtask reproduce`).
+pub const DEFAULT_SEED: u64 = 20_051_205;
+
+/// The side file holding the input of a simulated record: `data.csv` → `data.input.csv`.
+pub fn input_side_file(data: &Path) -> PathBuf {
+    let stem = data
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "data".into());
+    data.with_file_name(format!("{stem}.input.csv"))
+}
+
+// ---------------------------------------------------------------------------------------------
+// simulate
+
+/// Options of `simulate`.
+#[derive(Debug, Clone)]
+pub struct SimulateOptions {
+    /// The experiment file.
+    pub experiment: PathBuf,
+    /// Master seed.
+    pub seed: u64,
+    /// Realisation index (the same record as Monte Carlo run `run`).
+    pub run: u64,
+    /// The data file to write.
+    pub out: PathBuf,
+    /// Whether to write the drawn jitter and noise.
+    pub truth: bool,
+}
+
+/// `jitterid simulate`: one record of the experiment's truth. Returns the report line.
+pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
+    let exp = experiment::read(&o.experiment)?;
+    let mut rng = realization_rng(o.seed, o.run);
+    let input = fitting::realize_input(&exp, &mut rng)?;
+    let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+    let sim = fitting::simulate_record(&exp, &signal, &mut rng)?;
+    let n = exp.grid.len();
+    let k: Vec<usize> = (0..n).collect();
+    let t: Vec<f64> = exp.grid.times().collect();
+    let u: Option<Vec<f64>> = input.as_ref().map(|i| t.iter().map(|&t| i.value(t)).collect());
+    let mut cols = vec![Column::Index("k", &k), Column::Real("t", &t), Column::Real("y", &sim.y)];
+    if let Some(u) = &u {
+        cols.push(Column::Real("u", u));
+    }
+    if o.truth {
+        cols.push(Column::Real("tau", &sim.tau));
+        cols.push(Column::Real("v", &sim.v));
+    }
+    let mut staged = Staged::new();
+    staged.add(&o.out, csvio::format(&cols).as_bytes())?;
+    let mut report = format!(
+        "wrote {}: {n} samples ({})",
+        o.out.display(),
+        cols.iter()
+            .map(|c| match c {
+                Column::Index(n, _) | Column::Real(n, _) => *n,
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if let (InputSpec::RandomBinary(_), Some(Input::Piecewise(p))) = (&exp.input, &input) {
+        let side = input_side_file(&o.out);
+        let edges = p.edges();
+        let mut levels = p.levels().to_vec();
+        levels.push(0.0);
+        staged.add(&side, csvio::format(&[Column::Real("t", edges), Column::Real("u", &levels)]).as_bytes())?;
+        let _ = write!(report, "; {}: the input's {} switch times and levels", side.display(), edges.len());
+    }
+    staged.commit()?;
+    Ok(report)
+}
+
+// ---------------------------------------------------------------------------------------------
+// fit
+
+/// Options of `fit`.
+#[derive(Debug, Clone)]
+pub struct FitOptions {
+    /// The experiment file.
+    pub experiment: PathBuf,
+    /// The data file.
+    pub data: PathBuf,
+    /// The input file (for a random-binary experiment), default `<data>.input.csv`.
+    pub input: Option<PathBuf>,
+    /// Method override.
+    pub method: Option<Method>,
+    /// JSON output.
+    pub json: bool,
+    /// Plot directory.
+    pub plot: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct FitJson<'a> {
+    method: &'a str,
+    converged: bool,
+    cost: f64,
+    iterations: u64,
+    termination: &'a str,
+    noise_std: f64,
+    parameters: &'a [fitting::Param],
+}
+
+/// The samples of a data file, checked against the experiment's grid.
+fn read_data(exp: &Experiment, path: &Path) -> CliResult<csvio::Table> {
+    let table = csvio::read(path)?;
+    let y = table.column("y")?;
+    let n = exp.grid.len();
+    if y.len() != n {
+        return Err(cli_err!(
+            "{}: has {} data rows, expected {n} (the experiment's [sampling] samples)",
+            table.name,
+            y.len()
+        ));
+    }
+    if let Some(k) = table.optional("k") {
+        if let Some(i) = (0..n).find(|&i| k[i] != i as f64) {
+            return Err(cli_err!(
+                "{}:{}: column `k`: expected {i} (rows in order from 0), found {}",
+                table.name,
+                table.lines[i],
+                k[i]
+            ));
+        }
+    }
+    if let Some(t) = table.optional("t") {
+        let tol = 1e-6 * exp.grid.interval();
+        if let Some(i) = (0..n).find(|&i| (t[i] - exp.grid.time(i)).abs() > tol + 1e-12 * t[i].abs()) {
+            return Err(cli_err!(
+                "{}:{}: column `t`: expected {} (t0 + kT of the experiment's [sampling]), found {}",
+                table.name,
+                table.lines[i],
+                exp.grid.time(i),
+                t[i]
+            ));
+        }
+    }
+    Ok(table)
+}
+
+fn fmt_num(x: f64) -> String {
+    if !x.is_finite() {
+        return "–".into();
+    }
+    let a = x.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{x:.4e}")
+    } else {
+        format!("{x:.6}")
+    }
+}
+
+/// `jitterid fit`: returns the text to print.
+pub fn fit(o: &FitOptions) -> CliResult<String> {
+    let exp = experiment::read(&o.experiment)?;
+    let method = o.method.unwrap_or(exp.estimate.method);
+    fitting::check_method(&exp, method, o.method.is_some())?;
+    let table = read_data(&exp, &o.data)?;
+    let y = table.column("y")?.to_vec();
+    let input: Option<Input> = match &exp.input {
+        InputSpec::None => None,
+        InputSpec::Known(i) => Some(i.clone()),
+        InputSpec::RandomBinary(_) => {
+            let side = o.input.clone().unwrap_or_else(|| input_side_file(&o.data));
+            if !side.exists() {
+                return Err(cli_err!(
+                    "{}: cannot read: file does not exist; the experiment's input is random-binary, so fit reads the input realisation written by `jitterid simulate` (or give --input FILE with columns t,u)",
+                    side.display()
+                ));
+            }
+            let t = csvio::read(&side)?;
+            Some(Input::Piecewise(experiment::piecewise_from_table(&t, "t", "u", &exp.grid)?))
+        }
+    };
+    let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+    let record = fitting::record(&exp.grid, y.clone()).map_err(|e| cli_err!("{}: {e}", table.name))?;
+    let s = fitting::structure(&exp, signal.clone(), method)?;
+    let fit_err = |e: jitterid::estimate::EstimateError| cli_err!("{}: fit with method {} failed: {e}", exp.file, method.as_str());
+    let f: Fit = fitting::fit(&exp, &s, &record, method, 0, true).map_err(fit_err)?;
+
+    if let Some(dir) = &o.plot {
+        ensure_dir(dir)?;
+        // The naive LS fit of the system for comparison (when the system is estimated).
+        let ls = if exp.system.estimate && method != Method::Ls {
+            let mut ls_exp = exp.clone();
+            ls_exp.jitter.estimate = false;
+            ls_exp.noise.estimate = false;
+            fitting::structure(&ls_exp, signal.clone(), Method::Ls)
+                .ok()
+                .and_then(|ls_s| fitting::fit(&ls_exp, &ls_s, &record, Method::Ls, 0, false).ok())
+                .map(|f| f.fitted)
+        } else if method == Method::Ls {
+            Some(f.fitted.clone())
+        } else {
+            None
+        };
+        let main_label = if method == Method::Ls { "naive LS" } else { method.as_str() };
+        let figs = plots::fit_figures(&plots::FitPlots {
+            exp: &exp,
+            y: &y,
+            input: input.as_ref(),
+            file_model: &signal,
+            ls: if method == Method::Ls { None } else { ls.as_ref() },
+            main: (main_label, &f.fitted),
+            tau: table.optional("tau"),
+        })?;
+        let mut staged = Staged::new();
+        for (name, svg) in figs {
+            staged.add(&dir.join(name), svg.as_bytes())?;
+        }
+        staged.commit()?;
+    }
+
+    if o.json {
+        let j = FitJson {
+            method: method.as_str(),
+            converged: f.converged,
+            cost: f.cost,
+            iterations: f.iterations,
+            termination: &f.termination,
+            noise_std: f.noise_std,
+            parameters: &f.params,
+        };
+        return serde_json::to_string_pretty(&j).map(|s| s + "\n").map_err(|e| cli_err!("JSON: {e}"));
+    }
+    let mut out = String::new();
+    let _ = writeln!(out, "fit of {} with {} ({})", table.name, method.as_str(), exp.file);
+    let _ = writeln!(
+        out,
+        "{} ({}) after {} iterations, cost {:.6e}, noise std {} ({})",
+        if f.converged { "converged" } else { "NOT converged" },
+        f.termination,
+        f.iterations,
+        f.cost,
+        fmt_num(f.noise_std),
+        if exp.noise.estimate { "estimated" } else { "known" }
+    );
+    let w = f.params.iter().map(|p| p.name.len()).max().unwrap_or(9).max(9);
+    let _ = writeln!(out, "{:<w$}  {:>14}  {:>14}", "parameter", "estimate", "std error");
+    for p in &f.params {
+        let _ = writeln!(out, "{:<w$}  {:>14}  {:>14}", p.name, fmt_num(p.estimate), p.stderr.map_or("–".into(), fmt_num));
+    }
+    if let Some(dir) = &o.plot {
+        let _ = writeln!(out, "figures in {}: bode.svg (rational systems), spectrum.svg, moment.svg, jitter-pdf.svg", dir.display());
+    }
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------------------------
+// montecarlo
+
+/// A shard `i/n` of the runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// Index, `0 ≤ index < count`.
+    pub index: u64,
+    /// Number of shards.
+    pub count: u64,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        s.split_once('/')
+            .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)))
+            .filter(|&(i, n): &(u64, u64)| n > 0 && i < n)
+            .map(|(index, count)| Shard { index, count })
+            .ok_or_else(|| format!("expected i/n with 0 <= i < n, found `{s}`"))
+    }
+}
+
+/// Options of `montecarlo`.
+#[derive(Debug, Clone)]
+pub struct MonteCarloOptions {
+    /// The experiment file.
+    pub experiment: PathBuf,
+    /// Total number of realisations.
+    pub runs: u64,
+    /// Master seed.
+    pub seed: u64,
+    /// Worker threads (rayon's default if `None`).
+    pub threads: Option<usize>,
+    /// JSON output.
+    pub json: bool,
+    /// Plot directory.
+    pub plot: Option<PathBuf>,
+    /// Which shard of the runs.
+    pub shard: Option<Shard>,
+    /// Method override.
+    pub method: Option<Method>,
+    /// Write the JSON to this file (atomically) instead of stdout.
+    pub out: Option<PathBuf>,
+}
+
+/// One parameter's Monte Carlo summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamSummary {
+    /// Name.
+    pub name: String,
+    /// True value (null where unknown).
+    #[serde(rename = "true")]
+    pub truth: Option<f64>,
+    /// Mean over converged runs.
+    pub mean: Option<f64>,
+    /// Sample standard deviation.
+    pub std: Option<f64>,
+    /// Standard error of the mean.
+    pub se: Option<f64>,
+    /// Root mean square error against the truth.
+    pub rmse: Option<f64>,
+}
+
+/// One realisation, as kept in shard files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Realization {
+    /// Index.
+    pub run: u64,
+    /// Whether the fit converged.
+    pub converged: bool,
+    /// Reported estimates (null where not finite).
+    pub values: Vec<Option<f64>>,
+}
+
+/// Which part of a study a file covers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShardInfo {
+    /// Shard index.
+    pub index: u64,
+    /// Number of shards.
+    pub count: u64,
+    /// Runs of the whole study.
+    pub runs_total: u64,
+    /// First run of the shard.
+    pub first: u64,
+    /// One past the last run.
+    pub end: u64,
+}
+
+/// The JSON of `montecarlo --json` (and of `merge`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct McJson {
+    /// Method.
+    pub method: String,
+    /// Runs in this file.
+    pub runs: u64,
+    /// Runs that converged.
+    pub converged: u64,
+    /// Wall time in seconds (summed over shards after a merge).
+    pub seconds: f64,
+    /// Master seed.
+    pub seed: u64,
+    /// Experiment file.
+    pub experiment: String,
+    /// Per parameter.
+    pub parameters: Vec<ParamSummary>,
+    /// Present in shard files: which runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardInfo>,
+    /// Present in shard files: every realisation's estimates, for `jitterid merge`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub realizations: Option<Vec<Realization>>,
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// Summaries over the converged realisations, in run order.
+pub fn summarize(names: &[String], truth: &[Option<f64>], runs: &[Realization]) -> Vec<ParamSummary> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let vals: Vec<f64> = runs
+                .iter()
+                .filter(|r| r.converged)
+                .map(|r| r.values.get(i).copied().flatten().unwrap_or(f64::NAN))
+                .collect();
+            let s: Summary = vals.iter().copied().collect();
+            let t = truth.get(i).copied().flatten();
+            let rmse = t.and_then(|t| {
+                (!vals.is_empty()).then(|| (vals.iter().map(|x| (x - t).powi(2)).sum::<f64>() / vals.len() as f64).sqrt())
+            });
+            ParamSummary {
+                name: name.clone(),
+                truth: t,
+                mean: finite(s.mean).filter(|_| s.count > 0),
+                std: finite(s.std()),
+                se: finite(s.se()),
+                rmse: rmse.and_then(finite),
+            }
+        })
+        .collect()
+}
+
+struct RunOut {
+    realization: Realization,
+    fitted: Option<Structure>,
+}
+
+/// Realisations whose fitted models are kept for the figures.
+const KEEP_FITTED: u64 = 32;
+
+fn one_run(exp: &Experiment, method: Method, seed: u64, n: usize, r: u64, rng: &mut jitterid::rand::rngs::StdRng, keep: bool) -> RunOut {
+    let fail = || RunOut {
+        realization: Realization { run: r, converged: false, values: vec![None; n] },
+        fitted: None,
+    };
+    let mut go = || -> Option<Fit> {
+        let input = fitting::realize_input(exp, rng).ok()?;
+        let signal = fitting::signal_of(&exp.system.kind, input.as_ref()).ok()?;
+        let sim = fitting::simulate_record(exp, &signal, rng).ok()?;
+        let s = fitting::structure(exp, signal, method).ok()?;
+        let start = fitting::perturb(&s.params(), exp.estimate.perturb, rng);
+        let s0 = s.with_params(&start).ok()?;
+        let record = fitting::record(&exp.grid, sim.y).ok()?;
+        fitting::fit(exp, &s0, &record, method, realization_seed(seed, r) ^ 0x6d73, exp.noise.estimate).ok()
+    };
+    match go() {
+        Some(f) => RunOut {
+            realization: Realization {
+                run: r,
+                converged: f.converged,
+                values: f.params.iter().map(|p| finite(p.estimate)).collect(),
+            },
+            fitted: keep.then_some(f.fitted),
+        },
+        None => fail(),
+    }
+}
+
+fn mc_table(j: &McJson) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "Monte Carlo of {} with {}: {} runs (seed {}), {} converged, {:.2} s",
+        j.experiment, j.method, j.runs, j.seed, j.converged, j.seconds
+    );
+    if let Some(s) = &j.shard {
+        let _ = writeln!(out, "shard {}/{}: runs {}..{} of {}", s.index, s.count, s.first, s.end, s.runs_total);
+    }
+    let w = j.parameters.iter().map(|p| p.name.len()).max().unwrap_or(9).max(9);
+    let _ = writeln!(out, "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}", "parameter", "true", "mean", "std", "se", "rmse");
+    let f = |x: Option<f64>| x.map_or("–".into(), fmt_num);
+    for p in &j.parameters {
+        let _ = writeln!(out, "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}", p.name, f(p.truth), f(p.mean), f(p.std), f(p.se), f(p.rmse));
+    }
+    out
+}
+
+/// `jitterid montecarlo`: returns the text to print (empty if written to `--out`).
+pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
+    let exp = experiment::read(&o.experiment)?;
+    let method = o.method.unwrap_or(exp.estimate.method);
+    fitting::check_method(&exp, method, o.method.is_some())?;
+    if o.runs == 0 || o.runs > 100_000_000 {
+        return Err(cli_err!("--runs: expected a number of realisations in [1, 100000000], found {}", o.runs));
+    }
+    // The names and truths, from realisation 0's setup (they do not depend on the input).
+    let mut rng0 = realization_rng(o.seed, 0);
+    let input0 = fitting::realize_input(&exp, &mut rng0)?;
+    let signal0 = fitting::signal_of(&exp.system.kind, input0.as_ref())?;
+    let names = fitting::param_names(&exp, &signal0, method)?;
+    let truth = fitting::truth_values(&exp, &signal0, method)?;
+    let shard = o.shard.unwrap_or(Shard { index: 0, count: 1 });
+    let first = o.runs * shard.index / shard.count;
+    let end = o.runs * (shard.index + 1) / shard.count;
+    let n = names.len();
+    let pool = {
+        let mut b = rayon::ThreadPoolBuilder::new();
+        if let Some(k) = o.threads {
+            if k == 0 {
+                return Err(cli_err!("--threads: expected at least 1 thread, found 0"));
+            }
+            b = b.num_threads(k);
+        }
+        b.build().map_err(|e| cli_err!("--threads: cannot start the worker threads: {e}"))?
+    };
+    let progress = Progress::new(end - first);
+    let t0 = Instant::now();
+    let outs: Vec<RunOut> = pool.install(|| {
+        mc_run(o.seed, first..end, |r, rng| {
+            let out = one_run(&exp, method, o.seed, n, r, rng, o.plot.is_some() && r < first + KEEP_FITTED);
+            progress.tick();
+            out
+        })
+    });
+    progress.finish();
+    let seconds = t0.elapsed().as_secs_f64();
+    let realizations: Vec<Realization> = outs.iter().map(|o| o.realization.clone()).collect();
+    let parameters = summarize(&names, &truth, &realizations);
+    let converged = realizations.iter().filter(|r| r.converged).count() as u64;
+    let sharded = o.shard.is_some_and(|s| s.count > 1);
+    let j = McJson {
+        method: method.as_str().to_string(),
+        runs: end - first,
+        converged,
+        seconds,
+        seed: o.seed,
+        experiment: exp.file.clone(),
+        parameters,
+        shard: sharded.then_some(ShardInfo { index: shard.index, count: shard.count, runs_total: o.runs, first, end }),
+        realizations: sharded.then_some(realizations.clone()),
+    };
+    if let Some(dir) = &o.plot {
+        ensure_dir(dir)?;
+        let conv: Vec<Vec<f64>> = realizations
+            .iter()
+            .filter(|r| r.converged)
+            .map(|r| r.values.iter().map(|v| v.unwrap_or(f64::NAN)).collect())
+            .collect();
+        let fitted: Vec<&Structure> = outs
+            .iter()
+            .filter(|o| o.realization.converged)
+            .filter_map(|o| o.fitted.as_ref())
+            .collect();
+        let figs = plots::montecarlo_figures(&plots::McPlots {
+            exp: &exp,
+            method: method.as_str(),
+            names: &names,
+            truth: &truth,
+            values: conv.iter().map(Vec::as_slice).collect(),
+            true_signal: &signal0,
+            fitted,
+        });
+        let mut staged = Staged::new();
+        for (name, svg) in figs {
+            staged.add(&dir.join(name), svg.as_bytes())?;
+        }
+        staged.commit()?;
+    }
+    emit(&j, o.json, o.out.as_deref())
+}
+
+fn emit(j: &McJson, json: bool, out: Option<&Path>) -> CliResult<String> {
+    let text = serde_json::to_string_pretty(j).map_err(|e| cli_err!("JSON: {e}"))? + "\n";
+    match out {
+        Some(path) => {
+            write_atomic(path, text.as_bytes())?;
+            Ok(if json { String::new() } else { mc_table(j) })
+        }
+        None if json => Ok(text),
+        None => Ok(mc_table(j)),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// merge
+
+/// `jitterid merge`: combines shard files into the result of the unsharded study.
+pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<String> {
+    let mut parts: Vec<(String, McJson)> = Vec::new();
+    for f in files {
+        let name = f.display().to_string();
+        let text = std::fs::read_to_string(f).map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
+        let j: McJson = serde_json::from_str(&text)
+            .map_err(|e| cli_err!("{name}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}", e.line()))?;
+        parts.push((name, j));
+    }
+    let Some((first_name, first)) = parts.first() else {
+        return Err(cli_err!("merge: expected at least one shard file"));
+    };
+    let info = |name: &str, j: &McJson| -> CliResult<(ShardInfo, Vec<Realization>)> {
+        match (&j.shard, &j.realizations) {
+            (Some(s), Some(r)) => Ok((s.clone(), r.clone())),
+            _ => Err(cli_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json")),
+        }
+    };
+    let (s0, _) = info(first_name, first)?;
+    let mut all: Vec<Realization> = Vec::new();
+    let mut seconds = 0.0;
+    let mut seen = vec![false; s0.count as usize];
+    for (name, j) in &parts {
+        let (s, r) = info(name, j)?;
+        if j.experiment != first.experiment || j.method != first.method || j.seed != first.seed || s.runs_total != s0.runs_total || s.count != s0.count {
+            return Err(cli_err!(
+                "{name}: belongs to another study than {first_name} (experiment, method, seed, runs and shard count must agree)"
+            ));
+        }
+        if j.parameters.iter().map(|p| &p.name).ne(first.parameters.iter().map(|p| &p.name)) {
+            return Err(cli_err!("{name}: its parameters differ from those of {first_name}"));
+        }
+        let slot = seen
+            .get_mut(s.index as usize)
+            .ok_or_else(|| cli_err!("{name}: shard index {} out of range", s.index))?;
+        if *slot {
+            return Err(cli_err!("{name}: shard {}/{} given twice", s.index, s.count));
+        }
+        *slot = true;
+        seconds += j.seconds;
+        all.extend(r);
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return Err(cli_err!("merge: shard {missing}/{} is missing", s0.count));
+    }
+    all.sort_by_key(|r| r.run);
+    if all.iter().enumerate().any(|(i, r)| r.run != i as u64) || all.len() as u64 != s0.runs_total {
+        return Err(cli_err!("merge: the shards do not cover runs 0..{} exactly once", s0.runs_total));
+    }
+    let names: Vec<String> = first.parameters.iter().map(|p| p.name.clone()).collect();
+    let truth: Vec<Option<f64>> = first.parameters.iter().map(|p| p.truth).collect();
+    let j = McJson {
+        method: first.method.clone(),
+        runs: s0.runs_total,
+        converged: all.iter().filter(|r| r.converged).count() as u64,
+        seconds,
+        seed: first.seed,
+        experiment: first.experiment.clone(),
+        parameters: summarize(&names, &truth, &all),
+        shard: None,
+        realizations: None,
+    };
+    emit(&j, json, out)
+}
+
+/// Converts a [`CliError`] from a command into the reported line.
+pub fn report(e: &CliError) -> String {
+    format!("error: {e}")
+}

@@ -1,0 +1,399 @@
+//! From an experiment to signals, model structures and estimates.
+
+use crate::cli_err;
+use crate::error::{CliError, CliResult};
+use crate::experiment::{input_span, Experiment, InputSpec, Method, SolverKind, SystemKind};
+use crate::models::{AnyJitter, AnyNoise, AnySignal, AnySolver};
+use jitterid::estimate::solver::{GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead};
+use jitterid::estimate::{
+    estimate, profile_uniform_sum, Bcls, BoxJenkins, Criterion, Estimate, EstimateError,
+    EstimateOptions, Ls, ModelStructure, NoiseModel, Record,
+};
+use jitterid::jitter::{JitterModel, UniformSum};
+use jitterid::rand::rngs::StdRng;
+use jitterid::rand::Rng;
+use jitterid::signal::{simulate, Input, LtiResponse, SampleGrid, Signal};
+use jitterid::window::DirichletWindow;
+
+/// The model structure of the command line.
+pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
+
+/// The signal of a system kind driven by `input` (rational systems need one).
+pub fn signal_of(kind: &SystemKind, input: Option<&Input>) -> CliResult<AnySignal> {
+    let input = || input.cloned().ok_or_else(|| cli_err!("a rational system needs an input"));
+    Ok(match kind {
+        SystemKind::Zpk(z) => AnySignal::Zpk(LtiResponse::new(z.clone(), input()?)),
+        SystemKind::Tf(t) => AnySignal::Tf(LtiResponse::new(t.clone(), input()?)),
+        SystemKind::Sinusoid(s) => AnySignal::Sinusoid(*s),
+    })
+}
+
+/// The input of one realisation: a random binary input is drawn from `rng`, others are fixed.
+pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> CliResult<Option<Input>> {
+    Ok(match &exp.input {
+        InputSpec::None => None,
+        InputSpec::Known(i) => Some(i.clone()),
+        InputSpec::RandomBinary(rb) => {
+            let (a, b) = input_span(&exp.grid);
+            Some(Input::Piecewise(
+                rb.generate(a, b, rng)
+                    .map_err(|e| exp.error_at("input", "mean_dwell", e))?,
+            ))
+        }
+    })
+}
+
+/// One simulated record: `y`, and the drawn `τ` and `v`.
+pub struct Simulated {
+    /// Samples.
+    pub y: Vec<f64>,
+    /// Jitter of each sample.
+    pub tau: Vec<f64>,
+    /// Measurement noise of each sample (after the noise filter).
+    pub v: Vec<f64>,
+}
+
+/// Simulates the experiment's truth with `signal`; coloured noise is white noise filtered by
+/// the `[noise]` model with zero initial conditions.
+pub fn simulate_record(exp: &Experiment, signal: &AnySignal, rng: &mut StdRng) -> CliResult<Simulated> {
+    let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
+        .map_err(|e| exp.error_at("noise", "std", e))?;
+    let v = match &exp.noise.shape {
+        AnyNoise::White => sim.noise.clone(),
+        AnyNoise::Arma(a) => {
+            let p = a.params();
+            let nc = a.param_names().iter().filter(|n| n.starts_with('c')).count();
+            arma_filter(&p[..nc], &p[nc..], &sim.noise)
+        }
+    };
+    let y = sim
+        .y
+        .iter()
+        .zip(&sim.noise)
+        .zip(&v)
+        .map(|((y, e), v)| y - e + v)
+        .collect();
+    Ok(Simulated { y, tau: sim.tau, v })
+}
+
+/// `v = (C(q)/D(q)) e` with `C = 1 + c_1 q^{-1} + …`, `D = 1 + d_1 q^{-1} + …`, at rest before.
+pub fn arma_filter(c: &[f64], d: &[f64], e: &[f64]) -> Vec<f64> {
+    let mut v: Vec<f64> = Vec::with_capacity(e.len());
+    for k in 0..e.len() {
+        let mut x = e[k];
+        for (i, ci) in c.iter().enumerate() {
+            if k > i {
+                x += ci * e[k - i - 1];
+            }
+        }
+        for (i, di) in d.iter().enumerate() {
+            if k > i {
+                x -= di * v[k - i - 1];
+            }
+        }
+        v.push(x);
+    }
+    v
+}
+
+/// The model structure for `signal` as the experiment says (free parts, noise, method).
+pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResult<Structure> {
+    let shape_free = exp.noise.estimate && method == Method::Bj && !exp.noise.shape.is_white();
+    let s = ModelStructure::bj(signal, exp.jitter.model.clone(), exp.noise.shape.clone())
+        .with_estimated(exp.system.estimate, exp.jitter.estimate, shape_free);
+    if exp.noise.estimate {
+        Ok(s)
+    } else {
+        s.with_noise_std(exp.noise.std)
+            .map_err(|e| exp.error_at("noise", "std", e))
+    }
+}
+
+/// Checks that the experiment can be fitted with `method`.
+pub fn check_method(exp: &Experiment, method: Method, from_command_line: bool) -> CliResult<()> {
+    let blame = |msg: String| -> CliError {
+        if from_command_line {
+            cli_err!("--method {}: {msg}", method.as_str())
+        } else {
+            exp.error_at("estimate", "method", msg)
+        }
+    };
+    if method == Method::Ml {
+        return Err(blame(
+            "maximum likelihood is not available in this build of jitterid; use \"bcls\" (or \"ls\", \"bj\")".into(),
+        ));
+    }
+    if method == Method::Ls && exp.jitter.estimate {
+        return Err(blame(
+            "naive least squares ignores the jitter and cannot estimate it; use \"bcls\" or set [jitter] estimate = false".into(),
+        ));
+    }
+    if !exp.system.estimate && !exp.jitter.estimate && !exp.noise.estimate {
+        return Err(exp.error_at(
+            "system",
+            "estimate",
+            "nothing to estimate: set estimate = true in [system], [jitter] or [noise]",
+        ));
+    }
+    if !exp.system.estimate && !exp.jitter.estimate {
+        return Err(exp.error_at(
+            "system",
+            "estimate",
+            "only the noise level is marked for estimation; it is estimated together with the system or the jitter, so set estimate = true in [system] or [jitter]",
+        ));
+    }
+    if method == Method::Ls && !exp.system.estimate {
+        return Err(blame(
+            "naive least squares has nothing to estimate when the system is known".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The solver of the experiment; `seed` seeds multistart perturbations.
+pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
+    let e = &exp.estimate;
+    let base = match e.solver {
+        SolverKind::Lm => {
+            let mut s = LevenbergMarquardt::default();
+            if let Some(n) = e.max_iterations {
+                s = s.with_max_iters(n);
+            }
+            AnySolver::Lm(s)
+        }
+        SolverKind::GaussNewton => {
+            let mut s = GaussNewtonLineSearch::default();
+            if let Some(n) = e.max_iterations {
+                s.max_iters = n;
+            }
+            AnySolver::GaussNewton(s)
+        }
+        SolverKind::NelderMead => {
+            let mut s = NelderMead::default();
+            if let Some(n) = e.max_iterations {
+                s.max_iters = n;
+            }
+            AnySolver::NelderMead(s)
+        }
+    };
+    if e.multistart > 0 {
+        AnySolver::Multi(Box::new(MultiStart::new(
+            base,
+            e.multistart,
+            e.multistart_radius,
+            seed,
+        )))
+    } else {
+        base
+    }
+}
+
+/// One reported parameter of a fit.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Param {
+    /// Its name.
+    pub name: String,
+    /// The estimate.
+    pub estimate: f64,
+    /// Its standard error, where defined.
+    pub stderr: Option<f64>,
+}
+
+/// The outcome of one fit.
+#[derive(Debug, Clone)]
+pub struct Fit {
+    /// Method used.
+    pub method: Method,
+    /// Whether the solver converged.
+    pub converged: bool,
+    /// Final cost.
+    pub cost: f64,
+    /// Iterations.
+    pub iterations: u64,
+    /// Why the solver stopped.
+    pub termination: String,
+    /// Noise standard deviation used for the covariance (known or estimated).
+    pub noise_std: f64,
+    /// Reported parameters, in the model's order.
+    pub params: Vec<Param>,
+    /// The fitted structure.
+    pub fitted: Structure,
+}
+
+/// Names of the reported parameters, in order, for an experiment fitted with `method`.
+pub fn param_names(exp: &Experiment, signal: &AnySignal, method: Method) -> CliResult<Vec<String>> {
+    let s = structure(exp, signal.clone(), method)?;
+    Ok(report_names(exp, &s))
+}
+
+fn profiled(exp: &Experiment) -> bool {
+    exp.jitter.estimate && exp.jitter.n_range.is_some() && matches!(exp.jitter.model, AnyJitter::UniformSum(_))
+}
+
+fn report_names(exp: &Experiment, s: &Structure) -> Vec<String> {
+    let mut names = Vec::new();
+    let (ns, _, _) = s.blocks();
+    let all = s.param_names();
+    names.extend(all[..ns].iter().cloned());
+    if s.estimate_jitter {
+        if profiled(exp) {
+            names.extend(["jitter.n".into(), "jitter.a".into(), "jitter.sigma".into()]);
+        } else {
+            names.extend(s.jitter.param_names().iter().map(|n| format!("jitter.{n}")));
+        }
+    }
+    if s.estimate_noise {
+        names.extend(s.noise.param_names().iter().map(|n| format!("noise.{n}")));
+    }
+    if exp.noise.estimate {
+        names.push("noise.std".into());
+    }
+    names
+}
+
+/// True values of the reported parameters (`None` where the fitted family differs from the
+/// true one).
+pub fn truth_values(exp: &Experiment, signal_truth: &AnySignal, method: Method) -> CliResult<Vec<Option<f64>>> {
+    let s = structure(exp, signal_truth.clone(), method)?;
+    let names = report_names(exp, &s);
+    let mut out = Vec::with_capacity(names.len());
+    if s.estimate_signal {
+        out.extend(signal_truth.params().into_iter().map(Some));
+    }
+    if s.estimate_jitter {
+        let t = &exp.jitter.truth;
+        if profiled(exp) {
+            match (t, exp.jitter.family_differs) {
+                (AnyJitter::UniformSum(u), false) => {
+                    out.extend([Some(f64::from(u.n())), Some(u.a())]);
+                }
+                _ => out.extend([None, None]),
+            }
+            out.push(Some(t.std_dev()));
+        } else if exp.jitter.family_differs {
+            out.extend(
+                s.jitter
+                    .param_names()
+                    .iter()
+                    .map(|n| (*n == "sigma").then(|| t.std_dev())),
+            );
+        } else {
+            out.extend(t.params().into_iter().map(Some));
+        }
+    }
+    if s.estimate_noise {
+        out.extend(exp.noise.shape.params().into_iter().map(Some));
+    }
+    if exp.noise.estimate {
+        out.push(Some(exp.noise.std));
+    }
+    debug_assert_eq!(out.len(), names.len());
+    Ok(out)
+}
+
+fn options(exp: &Experiment, seed: u64, covariance: bool) -> EstimateOptions<AnySolver, DirichletWindow> {
+    EstimateOptions {
+        frequencies: exp.estimate.frequencies.clone(),
+        window: DirichletWindow,
+        solver: solver(exp, seed),
+        covariance,
+    }
+}
+
+fn run_criterion<C: Criterion>(
+    exp: &Experiment,
+    s: &Structure,
+    record: &Record,
+    criterion: &C,
+    opts: &EstimateOptions<AnySolver, DirichletWindow>,
+) -> Result<(Estimate, Structure, Option<u32>), EstimateError> {
+    if profiled(exp) {
+        if let (AnyJitter::UniformSum(u), Some((lo, hi))) = (&s.jitter, exp.jitter.n_range) {
+            let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
+                signal: s.signal.clone(),
+                jitter: *u,
+                noise: s.noise.clone(),
+                estimate_signal: s.estimate_signal,
+                estimate_jitter: s.estimate_jitter,
+                estimate_noise: s.estimate_noise,
+                noise_std: s.noise_std,
+            };
+            let p = profile_uniform_sum(&us, record, criterion, opts, lo..=hi)?;
+            let mut base = s.clone();
+            base.jitter = AnyJitter::UniformSum(u.with_n(p.n)?);
+            let fitted = base.with_params(&p.estimate.params)?;
+            return Ok((p.estimate, fitted, Some(p.n)));
+        }
+    }
+    let e = estimate(s, record, criterion, opts)?;
+    let fitted = s.with_params(&e.params)?;
+    Ok((e, fitted, None))
+}
+
+/// Fits structure `s` (started at its parameters) to `record` with `method`.
+pub fn fit(
+    exp: &Experiment,
+    s: &Structure,
+    record: &Record,
+    method: Method,
+    seed: u64,
+    covariance: bool,
+) -> Result<Fit, EstimateError> {
+    let opts = options(exp, seed, covariance);
+    let (e, fitted, n) = match method {
+        Method::Ls => run_criterion(exp, s, record, &Ls, &opts)?,
+        Method::Bcls | Method::Ml => run_criterion(exp, s, record, &Bcls, &opts)?,
+        Method::Bj => run_criterion(exp, s, record, &BoxJenkins, &opts)?,
+    };
+    let names = report_names(exp, s);
+    let se = |i: usize| e.std_errors.as_ref().and_then(|v| v.get(i).copied()).filter(|x| x.is_finite());
+    let (ns, nj, nn) = s.blocks();
+    let mut params = Vec::with_capacity(names.len());
+    let mut push = |estimate: f64, stderr: Option<f64>| {
+        let name = names.get(params.len()).cloned().unwrap_or_default();
+        params.push(Param { name, estimate, stderr });
+    };
+    for i in 0..ns {
+        push(e.params[i], se(i));
+    }
+    if let Some(n) = n {
+        let a = e.params.get(ns).copied().unwrap_or(f64::NAN);
+        let k = (3.0 * (f64::from(n) + 1.0)).sqrt();
+        push(f64::from(n), None);
+        push(a, se(ns));
+        push(a / k, se(ns).map(|s| s / k));
+    } else {
+        for i in ns..ns + nj {
+            push(e.params[i], se(i));
+        }
+    }
+    for i in ns + nj..ns + nj + nn {
+        push(e.params[i], se(i));
+    }
+    if exp.noise.estimate {
+        push(e.noise_std, None);
+    }
+    Ok(Fit {
+        method,
+        converged: e.converged,
+        cost: e.cost,
+        iterations: e.iterations,
+        termination: e.termination.to_string(),
+        noise_std: e.noise_std,
+        params,
+        fitted,
+    })
+}
+
+/// `θ ∘ (1 + U(−r, r))`, componentwise, drawn from `rng`.
+pub fn perturb(theta: &[f64], r: f64, rng: &mut StdRng) -> Vec<f64> {
+    theta
+        .iter()
+        .map(|x| x * (1.0 + rng.random_range(-r..=r)))
+        .collect()
+}
+
+/// A record from samples on the experiment's grid.
+pub fn record(grid: &SampleGrid, y: Vec<f64>) -> Result<Record, EstimateError> {
+    Record::new(*grid, y)
+}

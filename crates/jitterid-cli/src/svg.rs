@@ -1,0 +1,542 @@
+//! A small hand-written SVG plotter: panels with linear or logarithmic axes, lines, markers,
+//! bars, vertical rules and a legend.
+
+use std::fmt::Write as _;
+
+/// Palette: true/file model, naive LS, BCLS/ML, data, extra.
+pub const BLACK: &str = "#222222";
+/// Naive LS.
+pub const RED: &str = "#d62728";
+/// BCLS.
+pub const BLUE: &str = "#1f77b4";
+/// Data.
+pub const GREY: &str = "#8c8c8c";
+/// Extra.
+pub const GREEN: &str = "#2ca02c";
+/// Extra.
+pub const ORANGE: &str = "#ff7f0e";
+
+/// How a series is drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Style {
+    /// A polyline; `dash` is an SVG dash array.
+    Line {
+        /// Stroke width.
+        width: f64,
+        /// Dash pattern.
+        dash: Option<&'static str>,
+    },
+    /// Circles.
+    Markers {
+        /// Radius.
+        radius: f64,
+    },
+    /// Bars from 0 to `y`, centred at `x`, of width `width` (data units).
+    Bars {
+        /// Width.
+        width: f64,
+    },
+    /// Vertical rules at each `x` across the whole panel.
+    VRule {
+        /// Dash pattern.
+        dash: Option<&'static str>,
+    },
+    /// Stems from 0 to `y` with a dot at the top (point masses).
+    Stems,
+}
+
+/// One data series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend label (empty: not in the legend).
+    pub label: String,
+    /// Colour.
+    pub color: &'static str,
+    /// Opacity in `[0, 1]`.
+    pub opacity: f64,
+    /// Drawing style.
+    pub style: Style,
+    /// Points `(x, y)`; non-finite points are skipped (a line breaks there).
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Series {
+    /// A solid line.
+    pub fn line(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Self {
+        Self { label: label.into(), color, opacity: 1.0, style: Style::Line { width: 1.8, dash: None }, points }
+    }
+    /// A dashed line.
+    pub fn dashed(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Self {
+        Self { label: label.into(), color, opacity: 1.0, style: Style::Line { width: 1.8, dash: Some("6 4") }, points }
+    }
+    /// Markers.
+    pub fn markers(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Self {
+        Self { label: label.into(), color, opacity: 0.75, style: Style::Markers { radius: 2.2 }, points }
+    }
+    /// Sets the opacity.
+    pub fn with_opacity(mut self, o: f64) -> Self {
+        self.opacity = o;
+        self
+    }
+    /// Sets the line width.
+    pub fn with_width(mut self, w: f64) -> Self {
+        if let Style::Line { width, .. } = &mut self.style {
+            *width = w;
+        }
+        self
+    }
+}
+
+/// One panel.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Panel {
+    /// Title above the panel.
+    pub title: String,
+    /// x-axis label.
+    pub xlabel: String,
+    /// y-axis label.
+    pub ylabel: String,
+    /// Logarithmic x axis.
+    pub xlog: bool,
+    /// Logarithmic y axis.
+    pub ylog: bool,
+    /// Forced y range.
+    pub yrange: Option<(f64, f64)>,
+    /// Whether y = 0 must be inside the range (bars, densities).
+    pub y_from_zero: bool,
+    /// The series, drawn in order.
+    pub series: Vec<Series>,
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// A compact label for a tick value.
+fn fmt_tick(v: f64, step: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if !(1e-3..1e5).contains(&a) {
+        let s = format!("{v:.1e}");
+        return s.replace(".0e", "e");
+    }
+    let decimals = if step >= 1.0 { 0 } else { (-step.log10().floor()) as usize };
+    format!("{v:.decimals$}")
+}
+
+/// Nice linear ticks covering `[lo, hi]`.
+fn linear_ticks(lo: f64, hi: f64) -> (f64, f64, Vec<f64>, f64) {
+    let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
+    let raw = span / 5.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 2.5, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| span / s <= 6.0)
+        .unwrap_or(10.0 * mag);
+    let a = (lo / step).floor() * step;
+    let b = (hi / step).ceil() * step;
+    let mut ticks = Vec::new();
+    let mut i = 0;
+    loop {
+        let t = a + i as f64 * step;
+        if t > b + step * 1e-9 || i > 100 {
+            break;
+        }
+        ticks.push(if t.abs() < step * 1e-9 { 0.0 } else { t });
+        i += 1;
+    }
+    (a, b, ticks, step)
+}
+
+/// Data range of the finite values, widened when degenerate.
+fn range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for v in values {
+        if v.is_finite() && (!log || v > 0.0) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if lo > hi {
+        return None;
+    }
+    if log {
+        if hi / lo < 1.5 {
+            return Some((lo / 1.5, hi * 1.5));
+        }
+        return Some((lo, hi));
+    }
+    if hi - lo <= 1e-12 * hi.abs().max(lo.abs()).max(1e-300) {
+        let d = if hi == 0.0 { 1.0 } else { 0.1 * hi.abs() };
+        return Some((lo - d, hi + d));
+    }
+    Some((lo, hi))
+}
+
+struct Axis {
+    lo: f64,
+    hi: f64,
+    log: bool,
+    ticks: Vec<(f64, String)>,
+}
+
+impl Axis {
+    fn new(lo: f64, hi: f64, log: bool) -> Self {
+        if log {
+            // A tight range with ticks at 1, 2, 5 × 10^k (only decades when there are many).
+            let (a, b) = (lo.log10(), hi.log10());
+            let pad = 0.03 * (b - a).max(0.1);
+            let (a, b) = (a - pad, b + pad);
+            let decades = b - a;
+            let mantissas: &[f64] = if decades > 4.0 { &[1.0] } else if decades > 1.5 { &[1.0, 3.0] } else { &[1.0, 2.0, 5.0] };
+            let mut ticks = Vec::new();
+            let mut e = a.floor() as i32;
+            while f64::from(e) <= b.ceil() && ticks.len() < 40 {
+                for m in mantissas {
+                    let v = m * 10f64.powi(e);
+                    let l = v.log10();
+                    if l >= a && l <= b {
+                        ticks.push((v, fmt_tick(v, v)));
+                    }
+                }
+                e += 1;
+            }
+            Axis { lo: 10f64.powf(a), hi: 10f64.powf(b), log, ticks }
+        } else {
+            let (a, b, t, step) = linear_ticks(lo, hi);
+            Axis { lo: a, hi: b, log, ticks: t.into_iter().map(|v| (v, fmt_tick(v, step))).collect() }
+        }
+    }
+
+    /// Position in `[0, 1]`.
+    fn frac(&self, v: f64) -> f64 {
+        if self.log {
+            (v.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10())
+        } else {
+            (v - self.lo) / (self.hi - self.lo)
+        }
+    }
+}
+
+const PANEL_W: f64 = 520.0;
+const PANEL_H: f64 = 300.0;
+const LEFT: f64 = 70.0;
+const RIGHT: f64 = 20.0;
+const TOP: f64 = 36.0;
+const BOTTOM: f64 = 48.0;
+
+fn truncate(s: &str, max: usize) -> String {
+    if s.chars().count() <= max {
+        s.to_string()
+    } else {
+        let mut t: String = s.chars().take(max.saturating_sub(1)).collect();
+        t.push('…');
+        t
+    }
+}
+
+/// Renders panels in a grid of `cols` columns under a figure title and a subtitle.
+pub fn figure(title: &str, subtitle: &str, panels: &[Panel], cols: usize) -> String {
+    let cols = cols.max(1).min(panels.len().max(1));
+    let rows = panels.len().div_ceil(cols).max(1);
+    let cell_w = PANEL_W + LEFT + RIGHT;
+    let cell_h = PANEL_H + TOP + BOTTOM;
+    let width = cell_w * cols as f64;
+    let head = 48.0;
+    let height = cell_h * rows as f64 + head;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" font-family="DejaVu Sans, Helvetica, Arial, sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="21" text-anchor="middle" font-size="15" font-weight="bold">{}</text>"#,
+        width / 2.0,
+        esc(&truncate(title, (width / 9.0) as usize))
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="{}" y="39" text-anchor="middle" font-size="11" fill="#555">{}</text>"##,
+        width / 2.0,
+        esc(&truncate(subtitle, (width / 6.6) as usize))
+    );
+    for (i, p) in panels.iter().enumerate() {
+        let ox = (i % cols) as f64 * cell_w + LEFT;
+        let oy = (i / cols) as f64 * cell_h + TOP + head;
+        panel(&mut s, p, ox, oy, i);
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
+    let (w, h) = (PANEL_W, PANEL_H);
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle" font-size="13">{}</text>"#,
+        ox + w / 2.0,
+        oy - 10.0,
+        esc(&p.title)
+    );
+    let xs = p
+        .series
+        .iter()
+        .flat_map(|se| se.points.iter().map(|q| q.0).collect::<Vec<_>>());
+    let ys = p
+        .series
+        .iter()
+        .filter(|se| !matches!(se.style, Style::VRule { .. }))
+        .flat_map(|se| se.points.iter().map(|q| q.1).collect::<Vec<_>>());
+    let xr = range(xs, p.xlog);
+    let yr = match p.yrange {
+        Some(r) => Some(r),
+        None => range(ys, p.ylog).map(|(a, b)| {
+            if p.y_from_zero && !p.ylog {
+                (a.min(0.0), b.max(0.0))
+            } else {
+                (a, b)
+            }
+        }),
+    };
+    let _ = writeln!(
+        s,
+        r##"<rect x="{ox}" y="{oy}" width="{w}" height="{h}" fill="#ffffff" stroke="#444" stroke-width="1"/>"##
+    );
+    let (Some((x0, x1)), Some((y0, y1))) = (xr, yr) else {
+        let _ = writeln!(
+            s,
+            r##"<text x="{}" y="{}" text-anchor="middle" fill="#888">no finite data</text>"##,
+            ox + w / 2.0,
+            oy + h / 2.0
+        );
+        return;
+    };
+    let xa = Axis::new(x0, x1, p.xlog);
+    let ya = Axis::new(y0, y1, p.ylog);
+    let px = |x: f64| ox + xa.frac(x) * w;
+    let py = |y: f64| oy + h - ya.frac(y) * h;
+    // Grid and ticks.
+    for (v, label) in &xa.ticks {
+        let x = px(*v);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{x:.1}" y1="{oy}" x2="{x:.1}" y2="{}" stroke="#e6e6e6"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
+            oy + h,
+            oy + h + 16.0,
+            esc(label)
+        );
+    }
+    for (v, label) in &ya.ticks {
+        let y = py(*v);
+        let _ = writeln!(
+            s,
+            r##"<line x1="{ox}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#e6e6e6"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
+            ox + w,
+            ox - 6.0,
+            y + 4.0,
+            esc(label)
+        );
+    }
+    let _ = writeln!(
+        s,
+        r#"<text x="{}" y="{}" text-anchor="middle">{}</text>"#,
+        ox + w / 2.0,
+        oy + h + 36.0,
+        esc(&p.xlabel)
+    );
+    let _ = writeln!(
+        s,
+        r#"<text transform="translate({},{}) rotate(-90)" text-anchor="middle">{}</text>"#,
+        ox - 52.0,
+        oy + h / 2.0,
+        esc(&p.ylabel)
+    );
+    let _ = writeln!(
+        s,
+        r#"<clipPath id="clip{id}"><rect x="{ox}" y="{oy}" width="{w}" height="{h}"/></clipPath><g clip-path="url(#clip{id})">"#
+    );
+    let ok = |x: f64, y: f64| x.is_finite() && y.is_finite() && (!p.xlog || x > 0.0) && (!p.ylog || y > 0.0);
+    for se in &p.series {
+        let op = se.opacity;
+        match &se.style {
+            Style::Line { width, dash } => {
+                let dash = dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default();
+                let mut run: Vec<String> = Vec::new();
+                let flush = |run: &mut Vec<String>, s: &mut String| {
+                    if run.len() >= 2 {
+                        let _ = writeln!(
+                            s,
+                            r#"<polyline fill="none" stroke="{}" stroke-opacity="{op}" stroke-width="{width}"{dash} stroke-linejoin="round" points="{}"/>"#,
+                            se.color,
+                            run.join(" ")
+                        );
+                    }
+                    run.clear();
+                };
+                for &(x, y) in &se.points {
+                    if ok(x, y) {
+                        run.push(format!("{:.1},{:.1}", px(x), py(y).clamp(oy - 2.0 * h, oy + 3.0 * h)));
+                    } else {
+                        flush(&mut run, s);
+                    }
+                }
+                flush(&mut run, s);
+            }
+            Style::Markers { radius } => {
+                for &(x, y) in &se.points {
+                    if ok(x, y) {
+                        let _ = writeln!(
+                            s,
+                            r#"<circle cx="{:.1}" cy="{:.1}" r="{radius}" fill="{}" fill-opacity="{op}"/>"#,
+                            px(x),
+                            py(y),
+                            se.color
+                        );
+                    }
+                }
+            }
+            Style::Bars { width } => {
+                let base = if p.ylog { ya.lo } else { 0.0 };
+                for &(x, y) in &se.points {
+                    if ok(x, y) && ok(x - width / 2.0, y) {
+                        let (xa_, xb) = (px(x - width / 2.0), px(x + width / 2.0));
+                        let (ya_, yb) = (py(y), py(base));
+                        let _ = writeln!(
+                            s,
+                            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{}" fill-opacity="{op}" stroke="white" stroke-width="0.5"/>"#,
+                            xa_.min(xb),
+                            ya_.min(yb),
+                            (xb - xa_).abs(),
+                            (yb - ya_).abs(),
+                            se.color
+                        );
+                    }
+                }
+            }
+            Style::VRule { dash } => {
+                let dash = dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default();
+                for &(x, _) in &se.points {
+                    if x.is_finite() && (!p.xlog || x > 0.0) {
+                        let _ = writeln!(
+                            s,
+                            r#"<line x1="{0:.1}" y1="{oy}" x2="{0:.1}" y2="{1}" stroke="{2}" stroke-opacity="{op}" stroke-width="2"{dash}/>"#,
+                            px(x),
+                            oy + h,
+                            se.color
+                        );
+                    }
+                }
+            }
+            Style::Stems => {
+                let base = if p.ylog { ya.lo } else { 0.0 };
+                for &(x, y) in &se.points {
+                    if ok(x, y) {
+                        let _ = writeln!(
+                            s,
+                            r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-opacity="{op}" stroke-width="2"/><circle cx="{0:.1}" cy="{1:.1}" r="3.5" fill="{3}" fill-opacity="{op}"/>"#,
+                            px(x),
+                            py(y),
+                            py(base),
+                            se.color
+                        );
+                    }
+                }
+            }
+        }
+    }
+    s.push_str("</g>\n");
+    // Legend.
+    let entries: Vec<&Series> = p.series.iter().filter(|se| !se.label.is_empty()).collect();
+    if !entries.is_empty() {
+        let lw = entries.iter().map(|e| e.label.chars().count()).max().unwrap_or(0) as f64 * 6.8 + 40.0;
+        let lh = entries.len() as f64 * 16.0 + 8.0;
+        let lx = ox + w - lw - 8.0;
+        let ly = oy + 8.0;
+        let _ = writeln!(
+            s,
+            r##"<rect x="{lx:.1}" y="{ly:.1}" width="{lw:.1}" height="{lh:.1}" fill="white" fill-opacity="0.85" stroke="#bbb"/>"##
+        );
+        for (i, e) in entries.iter().enumerate() {
+            let y = ly + 14.0 + i as f64 * 16.0;
+            let sym = match &e.style {
+                Style::Markers { .. } => format!(r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#, lx + 16.0, y - 4.0, e.color),
+                Style::Bars { .. } => format!(r#"<rect x="{:.1}" y="{:.1}" width="14" height="9" fill="{}" fill-opacity="{}"/>"#, lx + 9.0, y - 9.0, e.color, e.opacity),
+                Style::Line { dash, .. } | Style::VRule { dash } => format!(
+                    r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"{}/>"#,
+                    lx + 6.0,
+                    y - 4.0,
+                    lx + 26.0,
+                    y - 4.0,
+                    e.color,
+                    dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default()
+                ),
+                Style::Stems => format!(r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-width="2"/>"#, lx + 16.0, y - 10.0, y, e.color),
+            };
+            let _ = writeln!(
+                s,
+                r#"{sym}<text x="{:.1}" y="{y:.1}">{}</text>"#,
+                lx + 32.0,
+                esc(&e.label)
+            );
+        }
+    }
+}
+
+/// A histogram of `values` with about `√n` bins (at most 30): bar centres, counts, bin width.
+pub fn histogram(values: &[f64]) -> (Vec<(f64, f64)>, f64) {
+    let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return (Vec::new(), 1.0);
+    }
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let bins = ((v.len() as f64).sqrt().ceil() as usize).clamp(1, 30);
+    let width = if hi > lo { (hi - lo) / bins as f64 } else { (lo.abs() * 0.01).max(1e-6) };
+    let mut counts = vec![0usize; bins];
+    for x in &v {
+        let i = if hi > lo { (((x - lo) / width) as usize).min(bins - 1) } else { 0 };
+        counts[i] += 1;
+    }
+    let base = if hi > lo { lo } else { lo - width / 2.0 };
+    (
+        counts
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| (base + (i as f64 + 0.5) * width, c as f64))
+            .collect(),
+        width,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn figure_is_wellformed_even_without_data() {
+        let p = Panel {
+            title: "t <&>".into(),
+            series: vec![Series::line("a", BLUE, vec![(f64::NAN, 1.0)])],
+            ..Default::default()
+        };
+        let s = figure("x", "y", &[p], 1);
+        assert!(s.starts_with("<svg") && s.ends_with("</svg>\n"));
+        assert!(s.contains("no finite data") && s.contains("t &lt;&amp;&gt;"));
+    }
+
+    #[test]
+    fn ticks_are_nice() {
+        let (_, _, t, step) = linear_ticks(0.013, 0.48);
+        assert_eq!(step, 0.1);
+        assert!(t.len() >= 5 && t.len() <= 7);
+        let (h, w) = histogram(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(h.len(), 2);
+        assert!((w - 1.5).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,278 @@
+//! The likelihood criteria as one trait, and the data they are evaluated on.
+
+use super::cheb::PiecewiseCheb;
+use super::exact::{signal_table, ExactMl, JitterPrep, SampleModel, Scratch, SignalEval};
+use super::MlError;
+use crate::data::Record;
+use crate::noise::NoiseModel;
+use crate::structure::ModelStructure;
+use jitterid_jitter::JitterModel;
+use jitterid_signal::Signal;
+use rayon::prelude::*;
+use std::fmt;
+
+/// A likelihood criterion at one parameter value: the negative log-likelihood (or
+/// quasi-log-likelihood), with its gradient in the signal's parameters and in `σ_v` when
+/// requested. Gradients in the jitter's and the noise shape's parameters are central
+/// differences of the value, taken by [`LikelihoodObjective`](super::LikelihoodObjective).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluation {
+    /// `−log L` (including all constants: a proper negative log-density of the record).
+    pub nll: f64,
+    /// `∂(−log L)/∂θ_signal`, when requested.
+    pub signal_gradient: Option<Vec<f64>>,
+    /// `∂(−log L)/∂σ_v`, when requested.
+    pub noise_std_gradient: Option<f64>,
+}
+
+/// What an evaluation should compute besides the value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct GradientRequest {
+    /// The gradient in the signal's parameters.
+    pub signal: bool,
+    /// The derivative in `σ_v`.
+    pub noise_std: bool,
+}
+
+/// A record prepared for a likelihood criterion: the samples and, when the signal is fixed,
+/// a table of it built once.
+#[derive(Debug, Clone)]
+pub struct LikelihoodData {
+    pub(crate) record: Record,
+    pub(crate) table: Option<PiecewiseCheb>,
+}
+
+impl LikelihoodData {
+    /// The record.
+    pub fn record(&self) -> &Record {
+        &self.record
+    }
+}
+
+/// A maximum-likelihood criterion: [`QuasiMl`](super::QuasiMl) (Gaussian, second moment) or
+/// [`ExactMl`] (the exact per-sample likelihood).
+pub trait LikelihoodCriterion: fmt::Debug + Send + Sync {
+    /// Short name (`"quasi-ml"`, `"exact-ml"`).
+    fn name(&self) -> &'static str;
+
+    /// Whether coloured (Box–Jenkins) measurement noise is supported.
+    fn supports_coloured_noise(&self) -> bool;
+
+    /// Prepares `record` for evaluations at parameters of `structure`.
+    fn prepare<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
+        &self,
+        structure: &ModelStructure<S, J, N>,
+        record: &Record,
+    ) -> LikelihoodData {
+        let _ = structure;
+        LikelihoodData {
+            record: record.clone(),
+            table: None,
+        }
+    }
+
+    /// The criterion at `model` with measurement-noise level `noise_std`.
+    ///
+    /// # Errors
+    ///
+    /// Typed errors where the criterion is not defined (see [`MlError`]): the objective
+    /// turns them into an infinite cost during a search, [`ml_estimate`](super::ml_estimate)
+    /// reports them at the start.
+    fn evaluate<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
+        &self,
+        data: &LikelihoodData,
+        model: &ModelStructure<S, J, N>,
+        noise_std: f64,
+        gradient: GradientRequest,
+    ) -> Result<Evaluation, MlError>;
+}
+
+/// Checks that the jitter's reach fits in the record.
+pub(crate) fn check_reach<J: JitterModel + ?Sized>(
+    jitter: &J,
+    record: &Record,
+) -> Result<(), MlError> {
+    let (lo, hi) = jitter.reach();
+    let duration = record.grid().duration();
+    if !(lo.is_finite() && hi.is_finite()) || hi - lo > duration {
+        return Err(MlError::ReachExceedsRecord { lo, hi, duration });
+    }
+    Ok(())
+}
+
+impl LikelihoodCriterion for ExactMl {
+    fn name(&self) -> &'static str {
+        "exact-ml"
+    }
+
+    fn supports_coloured_noise(&self) -> bool {
+        false
+    }
+
+    fn prepare<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
+        &self,
+        structure: &ModelStructure<S, J, N>,
+        record: &Record,
+    ) -> LikelihoodData {
+        let table = (!structure.estimate_signal).then(|| {
+            signal_table(
+                &structure.signal,
+                record.grid(),
+                structure.jitter.reach(),
+                false,
+            )
+        });
+        LikelihoodData {
+            record: record.clone(),
+            table,
+        }
+    }
+
+    fn evaluate<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
+        &self,
+        data: &LikelihoodData,
+        model: &ModelStructure<S, J, N>,
+        noise_std: f64,
+        gradient: GradientRequest,
+    ) -> Result<Evaluation, MlError> {
+        let per = self.per_sample(data, model, noise_std, gradient.signal, gradient.noise_std)?;
+        let ns = model.signal.num_params();
+        let mut nll = 0.0;
+        let mut gs = vec![0.0; if gradient.signal { ns } else { 0 }];
+        let mut gsig = 0.0;
+        for (lp, g) in &per {
+            nll -= lp;
+            if let Some(g) = g {
+                for (a, b) in gs.iter_mut().zip(g) {
+                    *a -= b;
+                }
+                gsig -= g[g.len() - 1];
+            }
+        }
+        Ok(Evaluation {
+            nll,
+            signal_gradient: gradient.signal.then_some(gs),
+            noise_std_gradient: gradient.noise_std.then_some(gsig),
+        })
+    }
+}
+
+impl ExactMl {
+    /// `log p(y_k)` of every sample, with (when asked) the per-sample gradient
+    /// `[∂/∂θ_signal…, ∂/∂σ_v]`.
+    pub(crate) fn per_sample<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
+        &self,
+        data: &LikelihoodData,
+        model: &ModelStructure<S, J, N>,
+        noise_std: f64,
+        signal_grad: bool,
+        sigma_grad: bool,
+    ) -> Result<Vec<(f64, Option<Vec<f64>>)>, MlError> {
+        self.validate()?;
+        if !model.noise.is_white() {
+            return Err(MlError::ColouredNoise {
+                criterion: "exact-ml",
+            });
+        }
+        let sigma = model.noise_std.unwrap_or(noise_std);
+        if !(sigma.is_finite() && sigma > 0.0) {
+            return Err(MlError::NoNoise { value: sigma });
+        }
+        let record = &data.record;
+        check_reach(&model.jitter, record)?;
+        let grid = record.grid();
+        let rate = model.signal.rate();
+        let prep = JitterPrep::new(&model.jitter, rate);
+        let own;
+        let ns = model.signal.num_params();
+        let (table, channels) = match (&data.table, signal_grad) {
+            (Some(t), false) => (t, 0),
+            _ => {
+                own = signal_table(&model.signal, grid, model.jitter.reach(), signal_grad);
+                (&own, if signal_grad { ns } else { 0 })
+            }
+        };
+        let breaks = {
+            let mut b = model.signal.breakpoints();
+            b.sort_by(f64::total_cmp);
+            b
+        };
+        let sm = SampleModel {
+            opts: *self,
+            signal: SignalEval {
+                signal: &model.signal,
+                table,
+                grad_channels: channels,
+            },
+            jitter: &prep,
+            breaks: &breaks,
+            sigma,
+        };
+        let want = signal_grad || sigma_grad;
+        let glen = channels + 1;
+        let one = |scratch: &mut Scratch, k: usize| {
+            let y = record.y()[k];
+            if want {
+                let mut g = vec![0.0; glen];
+                let lp = sm.log_p(grid.time(k), y, Some(&mut g), scratch);
+                (lp, Some(g))
+            } else {
+                (sm.log_p(grid.time(k), y, None, scratch), None)
+            }
+        };
+        let n = grid.len();
+        let out: Vec<(f64, Option<Vec<f64>>)> = if self.parallel && n >= 64 {
+            (0..n)
+                .into_par_iter()
+                .with_min_len(16)
+                .map_init(Scratch::default, one)
+                .collect()
+        } else {
+            let mut scratch = Scratch::default();
+            (0..n).map(|k| one(&mut scratch, k)).collect()
+        };
+        if let Some((index, (lp, _))) = out.iter().enumerate().find(|(_, (lp, _))| !lp.is_finite())
+        {
+            return Err(MlError::LikelihoodUnderflow {
+                index,
+                y: record.y()[index],
+                log_p: *lp,
+            });
+        }
+        if let Some((index, v)) = out.iter().enumerate().find_map(|(k, (_, g))| {
+            g.as_ref()
+                .and_then(|g| g.iter().find(|v| !v.is_finite()).map(|v| (k, *v)))
+        }) {
+            return Err(MlError::NonFinite {
+                what: "likelihood gradient of sample",
+                index,
+                value: v,
+            });
+        }
+        Ok(out)
+    }
+
+    /// `log p(y_k)` of every sample of `record` under `structure` with measurement-noise
+    /// level `noise_std` (used when the structure does not fix it).
+    ///
+    /// # Errors
+    ///
+    /// Coloured noise, `σ_v = 0`, a reach wider than the record, a sample whose likelihood
+    /// underflows (see [`MlError`]).
+    pub fn log_likelihoods<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
+        &self,
+        structure: &ModelStructure<S, J, N>,
+        record: &Record,
+        noise_std: f64,
+    ) -> Result<Vec<f64>, MlError> {
+        let data = LikelihoodData {
+            record: record.clone(),
+            table: None,
+        };
+        Ok(self
+            .per_sample(&data, structure, noise_std, false, false)?
+            .into_iter()
+            .map(|(lp, _)| lp)
+            .collect())
+    }
+}

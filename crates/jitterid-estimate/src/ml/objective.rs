@@ -1,0 +1,237 @@
+//! General (cost + gradient) objectives: the likelihood criteria in the likelihood's parameter
+//! vector, and their constrained form in unconstrained coordinates.
+
+use super::criterion::{GradientRequest, LikelihoodCriterion, LikelihoodData};
+use super::moments::fd_step;
+use super::param::{split, Layout};
+use super::MlError;
+use crate::noise::NoiseModel;
+use crate::solver::{SolverError, Transform};
+use crate::structure::ModelStructure;
+use jitterid_jitter::JitterModel;
+use jitterid_signal::Signal;
+
+/// A smooth objective `f(θ)` to minimise, with its gradient. `f` is `+∞` where `θ` is
+/// infeasible; minimisers treat that as a rejected trial point.
+pub trait Objective: Send + Sync {
+    /// Number of parameters.
+    fn num_params(&self) -> usize;
+
+    /// `f(θ)`, or `+∞` where `θ` is infeasible.
+    fn cost(&self, theta: &[f64]) -> f64;
+
+    /// `(f(θ), ∇f(θ))`. The default takes central differences of [`cost`](Self::cost)
+    /// (one-sided next to an infeasible point).
+    fn cost_gradient(&self, theta: &[f64]) -> (f64, Vec<f64>) {
+        let f = self.cost(theta);
+        let g = (0..theta.len())
+            .map(|j| fd_partial(|p| self.cost(p), theta, j, f))
+            .collect();
+        (f, g)
+    }
+}
+
+/// Central difference of `f` in coordinate `j` (one-sided where a side is infinite, NaN if
+/// both are).
+pub(crate) fn fd_partial(f: impl Fn(&[f64]) -> f64, theta: &[f64], j: usize, f0: f64) -> f64 {
+    let h = fd_step(theta[j]);
+    let mut p = theta.to_vec();
+    p[j] = theta[j] + h;
+    let fp = f(&p);
+    p[j] = theta[j] - h;
+    let fm = f(&p);
+    match (fp.is_finite(), fm.is_finite()) {
+        (true, true) => (fp - fm) / (2.0 * h),
+        (true, false) if f0.is_finite() => (fp - f0) / h,
+        (false, true) if f0.is_finite() => (f0 - fm) / h,
+        _ => f64::NAN,
+    }
+}
+
+/// A likelihood criterion on a record as an [`Objective`] in the likelihood's parameter
+/// vector ([`likelihood_param_names`](super::likelihood_param_names)): the structure's free
+/// parameters, then `σ_v` when it is estimated.
+///
+/// Gradients: analytic in the signal's parameters and `σ_v`, central differences in the
+/// jitter's and the noise shape's.
+#[derive(Debug)]
+pub struct LikelihoodObjective<'a, S, J, N, C> {
+    structure: &'a ModelStructure<S, J, N>,
+    criterion: &'a C,
+    data: LikelihoodData,
+    layout: Layout,
+}
+
+impl<'a, S, J, N, C> LikelihoodObjective<'a, S, J, N, C>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: LikelihoodCriterion,
+{
+    /// Prepares `record` for `criterion` at parameters of `structure`.
+    pub fn new(
+        structure: &'a ModelStructure<S, J, N>,
+        criterion: &'a C,
+        record: &crate::Record,
+    ) -> Self {
+        LikelihoodObjective {
+            structure,
+            criterion,
+            data: criterion.prepare(structure, record),
+            layout: Layout::of(structure),
+        }
+    }
+
+    /// The criterion's value at `theta`, with the reason when it is not defined.
+    ///
+    /// # Errors
+    ///
+    /// An invalid parameter vector or any error of the criterion (see [`MlError`]).
+    pub fn evaluate(&self, theta: &[f64]) -> Result<f64, MlError> {
+        let (model, sigma) = split(self.structure, theta)?;
+        Ok(self
+            .criterion
+            .evaluate(&self.data, &model, sigma, GradientRequest::default())?
+            .nll)
+    }
+
+    /// The prepared data.
+    pub fn data(&self) -> &LikelihoodData {
+        &self.data
+    }
+}
+
+impl<S, J, N, C> Objective for LikelihoodObjective<'_, S, J, N, C>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: LikelihoodCriterion,
+{
+    fn num_params(&self) -> usize {
+        self.layout.len()
+    }
+
+    fn cost(&self, theta: &[f64]) -> f64 {
+        match self.evaluate(theta) {
+            Ok(v) if v.is_finite() => v,
+            _ => f64::INFINITY,
+        }
+    }
+
+    fn cost_gradient(&self, theta: &[f64]) -> (f64, Vec<f64>) {
+        let nan = || (f64::INFINITY, vec![f64::NAN; theta.len()]);
+        let Ok((model, sigma)) = split(self.structure, theta) else {
+            return nan();
+        };
+        let l = self.layout;
+        let request = GradientRequest {
+            signal: l.ns > 0,
+            noise_std: l.sigma,
+        };
+        let Ok(ev) = self.criterion.evaluate(&self.data, &model, sigma, request) else {
+            return nan();
+        };
+        if !ev.nll.is_finite() {
+            return nan();
+        }
+        let mut g = vec![0.0; l.len()];
+        if let Some(gs) = &ev.signal_gradient {
+            g[..l.ns].copy_from_slice(gs);
+        }
+        for j in l.jitter_range().chain(l.noise_range()) {
+            g[j] = fd_partial(|p| self.cost(p), theta, j, ev.nll);
+        }
+        if let (Some(i), Some(d)) = (l.sigma_index(), ev.noise_std_gradient) {
+            g[i] = d;
+        }
+        (ev.nll, g)
+    }
+}
+
+/// An objective in unconstrained coordinates `φ`, `θ_j = T_j(φ_j)` (see [`Transform`]).
+#[derive(Debug)]
+pub struct TransformedObjective<'a, O: ?Sized> {
+    inner: &'a O,
+    transforms: Vec<Transform>,
+}
+
+impl<'a, O: Objective + ?Sized> TransformedObjective<'a, O> {
+    /// Wraps `inner` with one transform per parameter.
+    ///
+    /// # Errors
+    ///
+    /// A wrong number of transforms, or invalid bounds.
+    pub fn new(inner: &'a O, transforms: Vec<Transform>) -> Result<Self, SolverError> {
+        if transforms.len() != inner.num_params() {
+            return Err(SolverError::WrongTransformCount {
+                expected: inner.num_params(),
+                got: transforms.len(),
+            });
+        }
+        for (index, t) in transforms.iter().enumerate() {
+            if let Transform::Bounded { lo, hi } = *t {
+                if !t.is_valid() {
+                    return Err(SolverError::InvalidBounds { index, lo, hi });
+                }
+            }
+        }
+        Ok(TransformedObjective { inner, transforms })
+    }
+
+    /// `θ(φ)`.
+    pub fn to_external(&self, phi: &[f64]) -> Vec<f64> {
+        phi.iter()
+            .zip(&self.transforms)
+            .map(|(&p, t)| t.to_external(p))
+            .collect()
+    }
+
+    /// `φ(θ)`.
+    ///
+    /// # Errors
+    ///
+    /// [`SolverError::OutsideConstraint`] for the first parameter that violates its
+    /// constraint.
+    pub fn to_internal(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
+        theta
+            .iter()
+            .zip(&self.transforms)
+            .enumerate()
+            .map(|(index, (&value, &t))| {
+                t.to_internal(value).ok_or(SolverError::OutsideConstraint {
+                    index,
+                    value,
+                    constraint: t,
+                })
+            })
+            .collect()
+    }
+}
+
+impl<O: Objective + ?Sized> Objective for TransformedObjective<'_, O> {
+    fn num_params(&self) -> usize {
+        self.inner.num_params()
+    }
+
+    fn cost(&self, phi: &[f64]) -> f64 {
+        let theta = self.to_external(phi);
+        if theta.iter().any(|v| !v.is_finite()) {
+            return f64::INFINITY;
+        }
+        self.inner.cost(&theta)
+    }
+
+    fn cost_gradient(&self, phi: &[f64]) -> (f64, Vec<f64>) {
+        let theta = self.to_external(phi);
+        if theta.iter().any(|v| !v.is_finite()) {
+            return (f64::INFINITY, vec![f64::NAN; phi.len()]);
+        }
+        let (f, mut g) = self.inner.cost_gradient(&theta);
+        for ((gj, &p), t) in g.iter_mut().zip(phi).zip(&self.transforms) {
+            *gj *= t.derivative(p);
+        }
+        (f, g)
+    }
+}

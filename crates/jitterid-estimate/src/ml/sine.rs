@@ -1,0 +1,260 @@
+//! A jittered sine record (the ADC-testing use): `y_k = A sin(2πf0(t_k + τ_k) + φ) + v_k`.
+//!
+//! * [`sine_least_squares`]: the classical start, a least-squares sine fit at the periodogram's
+//!   peak, which sees only the baseband (aliased) frequency and the damped amplitude
+//!   `A|γ(f0)|`.
+//! * [`attenuation_sigma`]: the classical jitter estimate from that damping for Gaussian
+//!   jitter, `σ = √(−2 ln(Â/A))/(2πf0)`, given the true amplitude `A`.
+//! * [`fit_sine`]: maximum likelihood of `A, f0, φ`, the jitter and `σ_v` from a start at a
+//!   chosen alias of the baseband frequency, with either likelihood criterion.
+//!
+//! # Aliases
+//!
+//! On the grid `t_k = kT`, tones at `f0` and `f0 + j/T` have the same samples, and their first
+//! moments differ only by the damping `γ(f0)`, which the amplitude absorbs. The second moment
+//! separates them when the jitter is known: the variance `λ_k` of a tone at `f0` grows like
+//! `(2πf0σA)² cos²θ_k`, so a higher alias predicts more scatter. When the jitter's scale is
+//! estimated too, nothing separates them for a scale family: `2πf0τ` is the only way `f0` and
+//! `τ` enter `s(t_k + τ)` on the grid, so `(f0 + j/T, σ f0/(f0 + j/T))` gives exactly the same
+//! distribution of every sample (all moments). Only prior knowledge of the jitter, or a second
+//! tone sharing it, tells the aliases apart.
+
+use super::criterion::LikelihoodCriterion;
+use super::fit::{ml_estimate, MlEstimate, MlOptions};
+use super::objective::Objective;
+use super::optim::Brent;
+use super::MlError;
+use crate::data::Record;
+use crate::structure::ModelStructure;
+use jitterid_jitter::JitterModel;
+use jitterid_signal::{Signal, Sinusoid};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+
+/// Fewest samples [`sine_least_squares`] accepts.
+pub const SINE_MIN_SAMPLES: usize = 8;
+
+/// A least-squares sine fit ignoring the jitter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SineLs {
+    /// Amplitude `Â` (the damped `A|γ(f0)|` when the tone is jittered).
+    pub amplitude: f64,
+    /// Baseband frequency in `[0, 1/(2T)]` (Hz).
+    pub frequency: f64,
+    /// Phase (rad).
+    pub phase: f64,
+    /// Root mean square of the residuals.
+    pub residual_rms: f64,
+}
+
+/// `(Â, φ̂, rss)` of the linear least-squares fit `y ≈ a sin(2πft) + b cos(2πft)` on the grid.
+fn linear_fit(record: &Record, f: f64) -> Option<(f64, f64, f64)> {
+    let grid = record.grid();
+    let (mut ss, mut cc, mut sc, mut ys, mut yc) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (k, &y) in record.y().iter().enumerate() {
+        let (s, c) = (TAU * ((f * grid.time(k)).fract())).sin_cos();
+        ss += s * s;
+        cc += c * c;
+        sc += s * c;
+        ys += y * s;
+        yc += y * c;
+    }
+    let det = ss * cc - sc * sc;
+    if !(det > 1e-9 * (ss * cc).max(1e-300)) {
+        return None;
+    }
+    let a = (ys * cc - yc * sc) / det;
+    let b = (yc * ss - ys * sc) / det;
+    let yy: f64 = record.y().iter().map(|y| y * y).sum();
+    let rss = (yy - a * ys - b * yc).max(0.0);
+    // a sin θ + b cos θ = A sin(θ + φ): a = A cos φ, b = A sin φ.
+    Some((a.hypot(b), b.atan2(a), rss))
+}
+
+struct Rss<'a>(&'a Record);
+
+impl Objective for Rss<'_> {
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn cost(&self, theta: &[f64]) -> f64 {
+        linear_fit(self.0, theta[0]).map_or(f64::INFINITY, |r| r.2)
+    }
+}
+
+/// The least-squares sine fit at the periodogram's peak in `(0, 1/(2T))`, refined by Brent's
+/// method on the residual sum of squares.
+///
+/// # Errors
+///
+/// [`MlError::SineRecordTooShort`] with fewer than [`SINE_MIN_SAMPLES`] samples or fewer than
+/// two cycles of the baseband tone in the record (its frequency is then not resolved from
+/// the record's length).
+pub fn sine_least_squares(record: &Record) -> Result<SineLs, MlError> {
+    let grid = record.grid();
+    let n = grid.len();
+    let t = grid.interval();
+    let too_short = |cycles: f64| MlError::SineRecordTooShort {
+        samples: n,
+        cycles,
+        min_samples: SINE_MIN_SAMPLES,
+    };
+    if n < SINE_MIN_SAMPLES {
+        return Err(too_short(0.0));
+    }
+    // Zero-padded periodogram on (0, 1/(2T)).
+    let pad = 8;
+    let m = pad * n / 2;
+    let freqs: Vec<f64> = (1..m).map(|j| j as f64 / (pad as f64 * n as f64 * t)).collect();
+    let spectrum = jitterid_window::dtft(grid, record.y(), None, &freqs)
+        .map_err(|e| MlError::from(crate::EstimateError::from(e)))?;
+    let (peak, _) = spectrum
+        .iter()
+        .enumerate()
+        .fold((0, -1.0), |(bi, bv), (i, z)| {
+            let v = z.norm_sqr();
+            if v > bv {
+                (i, v)
+            } else {
+                (bi, bv)
+            }
+        });
+    let f_peak = freqs[peak];
+    let cycles = f_peak * grid.duration();
+    if cycles < 2.0 {
+        return Err(too_short(cycles));
+    }
+    let df = 1.0 / (pad as f64 * n as f64 * t);
+    let brent = Brent {
+        bracket_step: 0.25 * df,
+        tolerance: 1e-9 * df,
+        max_iters: 200,
+    };
+    let report = brent
+        .minimize(&Rss(record), &[f_peak])
+        .map_err(MlError::from)?;
+    let mut f = report.params[0];
+    if !(f > 0.0 && f < 0.5 / t) || (f - f_peak).abs() > 2.0 * df {
+        f = f_peak;
+    }
+    let (a, phi, rss) = linear_fit(record, f).ok_or_else(|| too_short(cycles))?;
+    Ok(SineLs {
+        amplitude: a,
+        frequency: f,
+        phase: phi,
+        residual_rms: (rss / n as f64).sqrt(),
+    })
+}
+
+/// The classical amplitude-attenuation estimate of a Gaussian jitter's standard deviation,
+/// `σ = √(−2 ln(Â/A))/(2πf0)`, from the fitted (damped) amplitude `Â` and the true
+/// amplitude `A`; `None` when `Â ≥ A` (no attenuation seen) or an argument is not positive.
+pub fn attenuation_sigma(fitted_amplitude: f64, true_amplitude: f64, frequency: f64) -> Option<f64> {
+    let r = fitted_amplitude.abs() / true_amplitude.abs();
+    if !(r > 0.0 && r < 1.0 && frequency > 0.0) {
+        return None;
+    }
+    Some((-2.0 * r.ln()).sqrt() / (TAU * frequency))
+}
+
+/// The start `(A, φ)` at alias `frequency` of the least-squares fit `ls` of a record with
+/// interval `interval`, for a jitter of characteristic function `γ` (the amplitude is
+/// undamped by `|γ(f)|`).
+///
+/// # Errors
+///
+/// [`MlError::InvalidArgument`] if `frequency` is not an alias of `ls.frequency` (within
+/// `1e-6/T`) or not positive.
+pub fn alias_start<J: JitterModel + ?Sized>(
+    ls: &SineLs,
+    frequency: f64,
+    interval: f64,
+    jitter: &J,
+) -> Result<(f64, f64), MlError> {
+    let bad = MlError::InvalidArgument {
+        name: "alias frequency",
+        value: frequency,
+        reason: "must be > 0 and an alias f_b + j/T or j/T − f_b of the baseband frequency",
+    };
+    if !(frequency > 0.0) {
+        return Err(bad);
+    }
+    let x = frequency * interval;
+    let xb = ls.frequency * interval;
+    let near_int = |v: f64| (v - v.round()).abs() < 1e-6;
+    let phase = if near_int(x - xb) {
+        ls.phase
+    } else if near_int(x + xb) {
+        // sin(−2πf_b t + φ') = sin(2πf_b t + φ) with φ' = π − φ.
+        PI - ls.phase
+    } else {
+        return Err(bad);
+    };
+    let damping = jitter.cf(frequency).norm().max(1e-3);
+    Ok((ls.amplitude / damping, phase))
+}
+
+/// A maximum-likelihood sine fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SineFit {
+    /// Amplitude `Â`.
+    pub amplitude: f64,
+    /// Frequency `f̂0` (Hz).
+    pub frequency: f64,
+    /// Phase `φ̂` (rad).
+    pub phase: f64,
+    /// The jitter's parameters at the estimate (estimated or known).
+    pub jitter_params: Vec<f64>,
+    /// The jitter's standard deviation at the estimate.
+    pub jitter_std: f64,
+    /// `σ̂_v` (estimated or known).
+    pub noise_std: f64,
+    /// The full estimate (names, covariance, termination).
+    pub estimate: MlEstimate,
+}
+
+/// Fits `A, f0, φ`, the jitter's parameters (if `estimate_jitter`) and `σ_v` (unless
+/// `noise_std` is given) by maximum likelihood, starting at alias `frequency` of the
+/// least-squares fit `ls` with jitter `jitter` (known, or the start).
+///
+/// # Errors
+///
+/// Those of [`alias_start`] and [`ml_estimate`].
+#[allow(clippy::too_many_arguments)]
+pub fn fit_sine<J, C>(
+    record: &Record,
+    ls: &SineLs,
+    frequency: f64,
+    jitter: J,
+    estimate_jitter: bool,
+    noise_std: Option<f64>,
+    criterion: &C,
+    options: &MlOptions,
+) -> Result<SineFit, MlError>
+where
+    J: JitterModel + Clone,
+    C: LikelihoodCriterion,
+{
+    let (a, phi) = alias_start(ls, frequency, record.grid().interval(), &jitter)?;
+    let signal = Sinusoid::new(a, frequency, phi)?;
+    let mut structure = ModelStructure::oe(signal, jitter).with_estimated(true, estimate_jitter, false);
+    if let Some(s) = noise_std {
+        structure = structure.with_noise_std(s)?;
+    }
+    let mut opts = options.clone();
+    if opts.noise_std_start.is_none() && noise_std.is_none() {
+        opts.noise_std_start = Some((0.5 * ls.residual_rms).max(1e-6 * ls.amplitude.abs()));
+    }
+    let estimate = ml_estimate(&structure, record, criterion, &opts)?;
+    let (model, sigma) = super::param::split(&structure, &estimate.params)?;
+    let p = model.signal.params();
+    Ok(SineFit {
+        amplitude: p[0],
+        frequency: p[1],
+        phase: p[2],
+        jitter_params: model.jitter.params(),
+        jitter_std: model.jitter.std_dev(),
+        noise_std: sigma,
+        estimate,
+    })
+}
