@@ -465,3 +465,4 @@ fn table1(o: &Options) -> Result<(), String> {
         &md,
     )
 }
+

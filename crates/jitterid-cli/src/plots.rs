@@ -380,3 +380,17 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
     out.push(("moment.svg".to_string(), moment_figure(&format!("{title} (realisation 0)"), grid, p.true_signal, &exp.jitter.truth, "true", None)));
     out
 }
+#[cfg(test)]
+mod tmp_tests {
+    use jitterid::jitter::{JitterModel, UniformSum};
+    #[test]
+    fn tmp_pdf() {
+        for n in [0u32, 2, 6, 8, 9] {
+            let j = UniformSum::new(n, 1.6).unwrap();
+            let m = (-100..=100).map(|i| j.pdf(i as f64 * 0.02)).fold(0.0f64, f64::max);
+            let at0 = j.pdf(0.0);
+            let near = j.pdf(1e-9);
+            eprintln!("n={n} max={m} at0={at0} near={near} pieces={:?}", j.pieces().len());
+        }
+    }
+}
