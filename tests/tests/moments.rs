@@ -6,15 +6,15 @@ use jitterid::window::{
     dirichlet, first_moment, first_moment_integral, transform, DirichletWindow, FrequencySet,
     IntegralOptions, Window,
 };
-use jitterid_tests::{arb_jitter, arb_response, binary, eq17};
+use jitterid_tests::{arb_jitter, arb_response, arb_smooth_jitter, arb_strict_system, binary, eq17};
 use proptest::prelude::*;
 use rand::SeedableRng;
 
 /// Route (a)'s accuracy target for these tests, relative to `max |μ_Y|`.
-const REL_TOL: f64 = 1e-9;
+const REL_TOL: f64 = 1e-8;
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(2005), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 16, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(2005), ..ProptestConfig::default() })]
 
     /// With `γ ≡ 1`, `μ_Y` is the DTFT of `s(t_k)`, and the rectangular window's kernel is the
     /// Dirichlet kernel.
@@ -38,15 +38,23 @@ proptest! {
     }
 
     /// Route (a), the literal eq. (14b) integral, equals route (b), the time-domain identity,
-    /// within route (a)'s own error bound.
+    /// within route (a)'s own error bound. Route (a) needs `|S_c γ|` integrable with a tail it
+    /// can bound: strictly proper systems (no jumps in `s`) and jitter with a density (`γ`
+    /// decaying); elsewhere it answers `NotConverged`, a typed error tested in the window crate.
     #[test]
-    fn frequency_integral_equals_time_domain_route(s in arb_response(30.0), jitter in arb_jitter()) {
+    fn frequency_integral_equals_time_domain_route(
+        g in arb_strict_system(), seed in any::<u64>(), dwell in 0.5f64..10.0, jitter in arb_smooth_jitter()
+    ) {
+        let s = LtiResponse::new(g, binary(seed, dwell, -2.0, 30.0));
         let grid = SampleGrid::new(0.25, 1.0, 24).unwrap();
         let freqs = FrequencySet::list(&grid, vec![0.0, 0.1, 0.23, 0.41, 0.5, 0.77]).unwrap();
         let b = first_moment(&s, jitter.as_ref(), &grid, &DirichletWindow, &freqs);
         let opts = IntegralOptions { rel_tol: REL_TOL, ..IntegralOptions::default() };
         let a = first_moment_integral(&s, jitter.as_ref(), &grid, &DirichletWindow, &freqs, &opts).unwrap();
         let scale = b.iter().map(|v| v.norm()).fold(1e-300, f64::max);
+        let worst = a.values.iter().zip(&b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max);
+        let allowed = a.error_bounds.iter().fold(0.0f64, |m, b| m.max(*b)) + 1e-12 * scale;
+        eprintln!("route (a) − (b): observed {:.2e}, allowed {:.2e} (relative to max |μ_Y|)", worst / scale, allowed / scale);
         for ((x, y), bound) in a.values.iter().zip(&b).zip(&a.error_bounds) {
             // The bound is route (a)'s; route (b) is exact to ~1e-15·scale.
             prop_assert!((x - y).norm() <= bound + 1e-12 * scale,

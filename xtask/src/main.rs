@@ -5,12 +5,17 @@ mod paper;
 mod reproduce;
 mod reproduce_ml;
 mod reproduce_starts;
+mod scale;
 
 use std::process::ExitCode;
 
 const USAGE: &str = "usage:
   cargo xtask demo
       simulate the paper's Table 2 setup and print μ_Y by both routes
+  cargo xtask scale [N ...]
+      BCLS evaluation and fit time against the record length (default 200 … 10^6)
+  cargo xtask speedup
+      the Table 2 study on 1 and 2 threads: wall time and identical results
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
       cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, all";
 
@@ -79,6 +84,15 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("demo") => demo::run(),
+        Some("scale") => {
+            let sizes: Result<Vec<usize>, _> = args[1..].iter().map(|a| a.parse::<usize>()).collect();
+            match sizes {
+                Ok(s) if !s.is_empty() => scale::run(&s),
+                Ok(_) => scale::run(&[200, 2_000, 20_000, 200_000, 1_000_000]),
+                Err(_) => Err("scale takes record lengths, e.g. `cargo xtask scale 200 2000`".into()),
+            }
+        }
+        Some("speedup") => scale::speedup(),
         Some("reproduce") => parse(&args[1..]).and_then(|(case, o)| reproduce::run(&case, &o)),
         _ => Err(USAGE.to_string()),
     };

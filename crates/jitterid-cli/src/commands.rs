@@ -15,6 +15,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// Largest number of Monte Carlo realisations.
+pub const MAX_RUNS: u64 = 10_000_000;
+
 /// The default master seed (that of `cargo xtask reproduce`).
 pub const DEFAULT_SEED: u64 = 20_051_205;
 
@@ -193,7 +196,7 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
     let record = fitting::record(&exp.grid, y.clone()).map_err(|e| cli_err!("{}: {e}", table.name))?;
     let s = fitting::structure(&exp, signal.clone(), method)?;
-    let fit_err = |e: jitterid::estimate::EstimateError| cli_err!("{}: fit with method {} failed: {e}", exp.file, method.as_str());
+    let fit_err = |e: String| cli_err!("{}: fit with method {} failed: {e}", exp.file, method.as_str());
     let f: Fit = fitting::fit(&exp, &s, &record, method, 0, true).map_err(fit_err)?;
 
     if let Some(dir) = &o.plot {
@@ -471,8 +474,8 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
     let exp = experiment::read(&o.experiment)?;
     let method = o.method.unwrap_or(exp.estimate.method);
     fitting::check_method(&exp, method, o.method.is_some())?;
-    if o.runs == 0 || o.runs > 100_000_000 {
-        return Err(cli_err!("--runs: expected a number of realisations in [1, 100000000], found {}", o.runs));
+    if o.runs == 0 || o.runs > MAX_RUNS {
+        return Err(cli_err!("--runs: expected a number of realisations in [1, {MAX_RUNS}], found {}", o.runs));
     }
     // The names and truths, from realisation 0's setup (they do not depend on the input).
     let mut rng0 = realization_rng(o.seed, 0);
@@ -487,8 +490,8 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
     let pool = {
         let mut b = rayon::ThreadPoolBuilder::new();
         if let Some(k) = o.threads {
-            if k == 0 {
-                return Err(cli_err!("--threads: expected at least 1 thread, found 0"));
+            if !(1..=1024).contains(&k) {
+                return Err(cli_err!("--threads: expected 1 to 1024 threads, found {k}"));
             }
             b = b.num_threads(k);
         }
@@ -570,6 +573,7 @@ pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<Str
     let mut parts: Vec<(String, McJson)> = Vec::new();
     for f in files {
         let name = f.display().to_string();
+        csvio::check_regular_file(f, &name)?;
         let text = std::fs::read_to_string(f).map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
         let j: McJson = serde_json::from_str(&text)
             .map_err(|e| cli_err!("{name}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}", e.line()))?;
@@ -585,6 +589,9 @@ pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<Str
         }
     };
     let (s0, _) = info(first_name, first)?;
+    if s0.count > 1_000_000 || s0.runs_total > MAX_RUNS {
+        return Err(cli_err!("{first_name}: shard count {} or run total {} out of range", s0.count, s0.runs_total));
+    }
     let mut all: Vec<Realization> = Vec::new();
     let mut seconds = 0.0;
     let mut seen = vec![false; s0.count as usize];

@@ -163,6 +163,7 @@ pub fn parse(name: &str, text: &str) -> CliResult<Table> {
 /// Reads and parses a CSV file.
 pub fn read(path: &Path) -> CliResult<Table> {
     let name = path.display().to_string();
+    check_regular_file(path, &name)?;
     let bytes = std::fs::read(path).map_err(|e| CliError::new(format!("{name}: cannot read: {}", io_reason(&e))))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         cli_err!(
@@ -171,6 +172,22 @@ pub fn read(path: &Path) -> CliResult<Table> {
         )
     })?;
     parse(&name, &text)
+}
+
+/// Largest input file accepted (1 GiB).
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Fails unless `path` is a regular file of at most [`MAX_FILE_BYTES`] (so that a device or a
+/// pipe given by mistake cannot block or exhaust memory).
+pub fn check_regular_file(path: &Path, name: &str) -> CliResult<()> {
+    let meta = std::fs::metadata(path).map_err(|e| cli_err!("{name}: cannot read: {}", io_reason(&e)))?;
+    if !meta.is_file() {
+        return Err(cli_err!("{name}: not a regular file"));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(cli_err!("{name}: larger than {MAX_FILE_BYTES} bytes"));
+    }
+    Ok(())
 }
 
 /// A short reason for an I/O error (`file does not exist`, …).

@@ -559,6 +559,7 @@ fn describe(v: &toml::Value) -> String {
 /// Reads and validates an experiment file.
 pub fn read(path: &Path) -> CliResult<Experiment> {
     let file = path.display().to_string();
+    csvio::check_regular_file(path, &file)?;
     let bytes = std::fs::read(path)
         .map_err(|e| cli_err!("{file}: cannot read: {}", csvio::io_reason(&e)))?;
     let text = String::from_utf8(bytes).map_err(|e| {

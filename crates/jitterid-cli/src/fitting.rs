@@ -98,7 +98,9 @@ pub fn arma_filter(c: &[f64], d: &[f64], e: &[f64]) -> Vec<f64> {
 
 /// The model structure for `signal` as the experiment says (free parts, noise, method).
 pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResult<Structure> {
-    let shape_free = exp.noise.estimate && method == Method::Bj && !exp.noise.shape.is_white();
+    let shape_free = exp.noise.estimate
+        && matches!(method, Method::Bj | Method::Ml)
+        && !exp.noise.shape.is_white();
     let s = ModelStructure::bj(signal, exp.jitter.model.clone(), exp.noise.shape.clone())
         .with_estimated(exp.system.estimate, exp.jitter.estimate, shape_free);
     if exp.noise.estimate {
@@ -118,9 +120,9 @@ pub fn check_method(exp: &Experiment, method: Method, from_command_line: bool) -
             exp.error_at("estimate", "method", msg)
         }
     };
-    if method == Method::Ml {
+    if method == Method::Ml && !cfg!(feature = "ml") {
         return Err(blame(
-            "maximum likelihood is not available in this build of jitterid; use \"bcls\" (or \"ls\", \"bj\")".into(),
+            "maximum likelihood is not available in this build of jitterid (built without the `ml` feature); use \"bcls\" (or \"ls\", \"bj\")".into(),
         ));
     }
     if method == Method::Ls && exp.jitter.estimate {
@@ -330,7 +332,22 @@ fn run_criterion<C: Criterion>(
     Ok((e, fitted, None))
 }
 
-/// Fits structure `s` (started at its parameters) to `record` with `method`.
+/// The raw outcome of one estimator, before the parameters are arranged for the report.
+struct Raw {
+    /// The structure's free parameters, then `σ_v` when a likelihood estimated it.
+    params: Vec<f64>,
+    std_errors: Option<Vec<f64>>,
+    cost: f64,
+    iterations: u64,
+    termination: String,
+    converged: bool,
+    noise_std: f64,
+    fitted: Structure,
+    n: Option<u32>,
+}
+
+/// Fits structure `s` (started at its parameters) to `record` with `method`; the error is a
+/// message.
 pub fn fit(
     exp: &Experiment,
     s: &Structure,
@@ -338,12 +355,27 @@ pub fn fit(
     method: Method,
     seed: u64,
     covariance: bool,
-) -> Result<Fit, EstimateError> {
+) -> Result<Fit, String> {
     let opts = options(exp, seed, covariance);
-    let (e, fitted, n) = match method {
-        Method::Ls => run_criterion(exp, s, record, &Ls, &opts)?,
-        Method::Bcls | Method::Ml => run_criterion(exp, s, record, &Bcls, &opts)?,
-        Method::Bj => run_criterion(exp, s, record, &BoxJenkins, &opts)?,
+    let raw = |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
+        let (e, fitted, n) = r.map_err(|e| e.to_string())?;
+        Ok(Raw {
+            params: e.params,
+            std_errors: e.std_errors,
+            cost: e.cost,
+            iterations: e.iterations,
+            termination: e.termination.to_string(),
+            converged: e.converged,
+            noise_std: e.noise_std,
+            fitted,
+            n,
+        })
+    };
+    let e = match method {
+        Method::Ls => raw(run_criterion(exp, s, record, &Ls, &opts))?,
+        Method::Bcls => raw(run_criterion(exp, s, record, &Bcls, &opts))?,
+        Method::Bj => raw(run_criterion(exp, s, record, &BoxJenkins, &opts))?,
+        Method::Ml => fit_ml(exp, s, record, covariance)?,
     };
     let names = report_names(exp, s);
     let se = |i: usize| e.std_errors.as_ref().and_then(|v| v.get(i).copied()).filter(|x| x.is_finite());
@@ -353,35 +385,106 @@ pub fn fit(
         let name = names.get(params.len()).cloned().unwrap_or_default();
         params.push(Param { name, estimate, stderr });
     };
+    let at = |i: usize| e.params.get(i).copied().unwrap_or(f64::NAN);
     for i in 0..ns {
-        push(e.params[i], se(i));
+        push(at(i), se(i));
     }
-    if let Some(n) = n {
-        let a = e.params.get(ns).copied().unwrap_or(f64::NAN);
+    if let Some(n) = e.n {
+        let a = at(ns);
         let k = (3.0 * (f64::from(n) + 1.0)).sqrt();
         push(f64::from(n), None);
         push(a, se(ns));
         push(a / k, se(ns).map(|s| s / k));
     } else {
         for i in ns..ns + nj {
-            push(e.params[i], se(i));
+            push(at(i), se(i));
         }
     }
     for i in ns + nj..ns + nj + nn {
-        push(e.params[i], se(i));
+        push(at(i), se(i));
     }
     if exp.noise.estimate {
-        push(e.noise_std, None);
+        // A likelihood estimates σ_v jointly (the last parameter); the least-squares criteria
+        // estimate it from the residuals afterwards (no standard error).
+        let joint = e.params.len() > ns + nj + nn;
+        push(e.noise_std, if joint { se(ns + nj + nn) } else { None });
     }
     Ok(Fit {
         method,
         converged: e.converged,
         cost: e.cost,
         iterations: e.iterations,
-        termination: e.termination.to_string(),
+        termination: e.termination,
         noise_std: e.noise_std,
         params,
+        fitted: e.fitted,
+    })
+}
+
+#[cfg(not(feature = "ml"))]
+fn fit_ml(_: &Experiment, _: &Structure, _: &Record, _: bool) -> Result<Raw, String> {
+    Err("maximum likelihood is not available in this build of jitterid".into())
+}
+
+/// Maximum likelihood: the exact likelihood for white noise, the Gaussian (quasi) likelihood
+/// of the first two moments for an ARMA noise model.
+#[cfg(feature = "ml")]
+fn fit_ml(exp: &Experiment, s: &Structure, record: &Record, covariance: bool) -> Result<Raw, String> {
+    use jitterid::estimate::ml::{
+        ml_estimate, ml_profile_uniform_sum, ExactMl, LikelihoodCriterion, MlEstimate, MlOptions,
+        QuasiMl,
+    };
+    fn go<C: LikelihoodCriterion>(
+        exp: &Experiment,
+        s: &Structure,
+        record: &Record,
+        c: &C,
+        opts: &MlOptions,
+    ) -> Result<(MlEstimate, Option<u32>, Structure), String> {
+        let e = |e: jitterid::estimate::ml::MlError| e.to_string();
+        if profiled(exp) {
+            if let (AnyJitter::UniformSum(u), Some((lo, hi))) = (&s.jitter, exp.jitter.n_range) {
+                let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
+                    signal: s.signal.clone(),
+                    jitter: *u,
+                    noise: s.noise.clone(),
+                    estimate_signal: s.estimate_signal,
+                    estimate_jitter: s.estimate_jitter,
+                    estimate_noise: s.estimate_noise,
+                    noise_std: s.noise_std,
+                };
+                let p = ml_profile_uniform_sum(&us, record, c, opts, lo..=hi).map_err(e)?;
+                let mut base = s.clone();
+                base.jitter = AnyJitter::UniformSum(u.with_n(p.n).map_err(|x| x.to_string())?);
+                return Ok((p.estimate, Some(p.n), base));
+            }
+        }
+        Ok((ml_estimate(s, record, c, opts).map_err(e)?, None, s.clone()))
+    }
+    let opts = MlOptions {
+        covariance,
+        ..MlOptions::default()
+    };
+    let (e, n, base) = if s.noise.is_white() {
+        go(exp, s, record, &ExactMl::default(), &opts)?
+    } else {
+        go(exp, s, record, &QuasiMl, &opts)?
+    };
+    let k = base.num_params();
+    let mut fitted = base
+        .with_params(e.params.get(..k).unwrap_or(&e.params))
+        .map_err(|x| x.to_string())?;
+    fitted.noise_std = Some(e.noise_std);
+    Ok(Raw {
+        params: e.params,
+        std_errors: e.std_errors,
+        cost: e.neg_log_likelihood,
+        iterations: e.iterations,
+        termination: e.termination.to_string(),
+        converged: e.converged,
+        noise_std: e.noise_std,
         fitted,
+        n,
     })
 }
 

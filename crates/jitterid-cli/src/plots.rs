@@ -275,9 +275,19 @@ fn jitter_figure(title: &str, truth: &AnyJitter, estimates: &[(&str, &AnyJitter)
     figure(
         "Jitter density",
         title,
-        &[Panel { title: "p(τ)".into(), xlabel: "τ (s)".into(), ylabel: "density (1/s)".into(), y_from_zero: true, series, ..Default::default() }],
+        &[Panel { title: "p(τ)".into(), xlabel: "τ (s)".into(), ylabel: "density (1/s)".into(), y_from_zero: true, yrange: pdf_yrange(truth, &taus), series, ..Default::default() }],
         1,
     )
+}
+
+/// A y range for densities that an estimate collapsing to a spike cannot squash: up to 2.5
+/// times the peak of the reference density (automatic if it has no density part).
+fn pdf_yrange(reference: &AnyJitter, taus: &[f64]) -> Option<(f64, f64)> {
+    if reference.pieces().is_empty() {
+        return None;
+    }
+    let peak = taus.iter().map(|&t| reference.pdf(t)).fold(0.0, f64::max);
+    (peak.is_finite() && peak > 0.0).then_some((0.0, 2.5 * peak))
 }
 
 /// Everything `montecarlo --plot` draws from.
@@ -372,25 +382,11 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
             figure(
                 &format!("Jitter density, true and estimated ({} runs shown)", est.len()),
                 &title,
-                &[Panel { title: "p(τ)".into(), xlabel: "τ (s)".into(), ylabel: "density (1/s)".into(), y_from_zero: true, series, ..Default::default() }],
+                &[Panel { title: "p(τ)".into(), xlabel: "τ (s)".into(), ylabel: "density (1/s)".into(), y_from_zero: true, yrange: pdf_yrange(&exp.jitter.truth, &taus), series, ..Default::default() }],
                 1,
             ),
         ));
     }
     out.push(("moment.svg".to_string(), moment_figure(&format!("{title} (realisation 0)"), grid, p.true_signal, &exp.jitter.truth, "true", None)));
     out
-}
-#[cfg(test)]
-mod tmp_tests {
-    use jitterid::jitter::{JitterModel, UniformSum};
-    #[test]
-    fn tmp_pdf() {
-        for n in [0u32, 2, 6, 8, 9] {
-            let j = UniformSum::new(n, 1.6).unwrap();
-            let m = (-100..=100).map(|i| j.pdf(i as f64 * 0.02)).fold(0.0f64, f64::max);
-            let at0 = j.pdf(0.0);
-            let near = j.pdf(1e-9);
-            eprintln!("n={n} max={m} at0={at0} near={near} pieces={:?}", j.pieces().len());
-        }
-    }
 }

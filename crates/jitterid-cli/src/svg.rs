@@ -122,7 +122,12 @@ fn fmt_tick(v: f64, step: f64) -> String {
         let s = format!("{v:.1e}");
         return s.replace(".0e", "e");
     }
-    let decimals = if step >= 1.0 { 0 } else { (-step.log10().floor()) as usize };
+    let decimals = (0..8)
+        .find(|&d| {
+            let x = step * 10f64.powi(d);
+            (x - x.round()).abs() < 1e-6 * x.abs().max(1.0)
+        })
+        .unwrap_or(8) as usize;
     format!("{v:.decimals$}")
 }
 
@@ -284,21 +289,35 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
         oy - 10.0,
         esc(&p.title)
     );
-    let xs = p
-        .series
-        .iter()
-        .flat_map(|se| se.points.iter().map(|q| q.0).collect::<Vec<_>>());
+    let xs = p.series.iter().flat_map(|se| {
+        let half = match se.style {
+            Style::Bars { width } => width / 2.0,
+            _ => 0.0,
+        };
+        se.points
+            .iter()
+            .flat_map(|q| [q.0 - half, q.0 + half])
+            .collect::<Vec<_>>()
+    });
     let ys = p
         .series
         .iter()
         .filter(|se| !matches!(se.style, Style::VRule { .. }))
         .flat_map(|se| se.points.iter().map(|q| q.1).collect::<Vec<_>>());
-    let xr = range(xs, p.xlog);
+    let xr = range(xs, p.xlog).map(|(a, b)| {
+        if p.xlog {
+            (a, b)
+        } else {
+            let pad = 0.02 * (b - a);
+            (a - pad, b + pad)
+        }
+    });
     let yr = match p.yrange {
         Some(r) => Some(r),
         None => range(ys, p.ylog).map(|(a, b)| {
             if p.y_from_zero && !p.ylog {
-                (a.min(0.0), b.max(0.0))
+                let (a, b) = (a.min(0.0), b.max(0.0));
+                (a, b + 0.08 * (b - a))
             } else {
                 (a, b)
             }
@@ -496,6 +515,17 @@ pub fn histogram(values: &[f64]) -> (Vec<(f64, f64)>, f64) {
     }
     let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if v.iter().all(|x| x.fract() == 0.0) && hi - lo <= 40.0 {
+        // Whole numbers (the profiled n): one bar per value.
+        let mut counts = vec![0usize; (hi - lo) as usize + 1];
+        for x in &v {
+            counts[(x - lo) as usize] += 1;
+        }
+        return (
+            counts.iter().enumerate().map(|(i, &c)| (lo + i as f64, c as f64)).collect(),
+            0.9,
+        );
+    }
     let bins = ((v.len() as f64).sqrt().ceil() as usize).clamp(1, 30);
     let width = if hi > lo { (hi - lo) / bins as f64 } else { (lo.abs() * 0.01).max(1e-6) };
     let mut counts = vec![0usize; bins];
@@ -535,8 +565,10 @@ mod tests {
         let (_, _, t, step) = linear_ticks(0.013, 0.48);
         assert_eq!(step, 0.1);
         assert!(t.len() >= 5 && t.len() <= 7);
-        let (h, w) = histogram(&[1.0, 2.0, 3.0, 4.0]);
+        let (h, w) = histogram(&[1.5, 2.5, 3.5, 4.5]);
         assert_eq!(h.len(), 2);
         assert!((w - 1.5).abs() < 1e-12);
+        let (h, _) = histogram(&[0.0, 0.0, 3.0]);
+        assert_eq!(h, vec![(0.0, 2.0), (1.0, 0.0), (2.0, 0.0), (3.0, 1.0)]);
     }
 }

@@ -24,6 +24,10 @@ pub struct LtiResponse<M> {
     model: M,
     input: Input,
     steps: Vec<(f64, f64)>,
+    /// Right after step `j`: the input level `Σ_{l≤j} Δu_l` and, per representative pole,
+    /// `X_ij = Σ_{l≤j} Δu_l e^{p_i (t_j − t_l)}`, so that `s(t)` costs `O(log J + poles)`.
+    #[serde(skip)]
+    prefix: Vec<(f64, Vec<Complex64>)>,
 }
 
 impl<M: RationalModel> LtiResponse<M> {
@@ -34,11 +38,39 @@ impl<M: RationalModel> LtiResponse<M> {
             Input::Piecewise(p) => p.steps(),
             Input::Tones(_) => Vec::new(),
         };
-        Self {
+        let mut out = Self {
             model,
             input,
             steps,
-        }
+            prefix: Vec::new(),
+        };
+        out.prefix = out.prefix_states();
+        out
+    }
+
+    fn prefix_states(&self) -> Vec<(f64, Vec<Complex64>)> {
+        let poles: Vec<Complex64> = self
+            .representatives()
+            .iter()
+            .map(|&(i, _)| self.modal().poles[i])
+            .collect();
+        let mut level = 0.0;
+        let mut x = vec![Complex64::new(0.0, 0.0); poles.len()];
+        let mut prev = f64::NEG_INFINITY;
+        self.steps
+            .iter()
+            .map(|&(tj, du)| {
+                for (xi, p) in x.iter_mut().zip(&poles) {
+                    if prev.is_finite() {
+                        *xi *= (p * (tj - prev)).exp();
+                    }
+                    *xi += du;
+                }
+                level += du;
+                prev = tj;
+                (level, x.clone())
+            })
+            .collect()
     }
 
     /// The model `G`.
@@ -338,11 +370,14 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        Ok(Self {
+        let mut out = Self {
             model: self.model.with_params(params)?,
             input: self.input.clone(),
             steps: self.steps.clone(),
-        })
+            prefix: Vec::new(),
+        };
+        out.prefix = out.prefix_states();
+        Ok(out)
     }
 
     fn value(&self, t: f64) -> f64 {
@@ -355,7 +390,23 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                     (g * Complex64::from_polar(c.amplitude, TAU * c.frequency * t + c.phase)).im
                 })
                 .sum(),
+            Input::Piecewise(_) if self.prefix.len() == self.steps.len() => {
+                let j = self.steps.partition_point(|s| s.0 <= t);
+                if j == 0 {
+                    return 0.0;
+                }
+                let m = self.modal();
+                let (level, x) = &self.prefix[j - 1];
+                let dt = t - self.steps[j - 1].0;
+                let mut s = m.dc_gain * level;
+                for (&(i, w), xi) in self.representatives().iter().zip(x) {
+                    let (p, r) = (m.poles[i], m.residues[i]);
+                    s += w * (r / p * xi * (p * dt).exp()).re;
+                }
+                s
+            }
             Input::Piecewise(_) => {
+                // A deserialised value has no prefix states: sum over the steps.
                 let m = self.modal();
                 let reps = self.representatives();
                 let mut s = 0.0;
