@@ -58,8 +58,14 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
     let n = exp.grid.len();
     let k: Vec<usize> = (0..n).collect();
     let t: Vec<f64> = exp.grid.times().collect();
-    let u: Option<Vec<f64>> = input.as_ref().map(|i| t.iter().map(|&t| i.value(t)).collect());
-    let mut cols = vec![Column::Index("k", &k), Column::Real("t", &t), Column::Real("y", &sim.y)];
+    let u: Option<Vec<f64>> = input
+        .as_ref()
+        .map(|i| t.iter().map(|&t| i.value(t)).collect());
+    let mut cols = vec![
+        Column::Index("k", &k),
+        Column::Real("t", &t),
+        Column::Real("y", &sim.y),
+    ];
     if let Some(u) = &u {
         cols.push(Column::Real("u", u));
     }
@@ -84,8 +90,16 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
         let edges = p.edges();
         let mut levels = p.levels().to_vec();
         levels.push(0.0);
-        staged.add(&side, csvio::format(&[Column::Real("t", edges), Column::Real("u", &levels)]).as_bytes())?;
-        let _ = write!(report, "; {}: the input's {} switch times and levels", side.display(), edges.len());
+        staged.add(
+            &side,
+            csvio::format(&[Column::Real("t", edges), Column::Real("u", &levels)]).as_bytes(),
+        )?;
+        let _ = write!(
+            report,
+            "; {}: the input's {} switch times and levels",
+            side.display(),
+            edges.len()
+        );
     }
     staged.commit()?;
     Ok(report)
@@ -146,7 +160,9 @@ fn read_data(exp: &Experiment, path: &Path) -> CliResult<csvio::Table> {
     }
     if let Some(t) = table.optional("t") {
         let tol = 1e-6 * exp.grid.interval();
-        if let Some(i) = (0..n).find(|&i| (t[i] - exp.grid.time(i)).abs() > tol + 1e-12 * t[i].abs()) {
+        if let Some(i) =
+            (0..n).find(|&i| (t[i] - exp.grid.time(i)).abs() > tol + 1e-12 * t[i].abs())
+        {
             return Err(cli_err!(
                 "{}:{}: column `t`: expected {} (t0 + kT of the experiment's [sampling]), found {}",
                 table.name,
@@ -190,13 +206,22 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
                 ));
             }
             let t = csvio::read(&side)?;
-            Some(Input::Piecewise(experiment::piecewise_from_table(&t, "t", "u", &exp.grid)?))
+            Some(Input::Piecewise(experiment::piecewise_from_table(
+                &t, "t", "u", &exp.grid,
+            )?))
         }
     };
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
-    let record = fitting::record(&exp.grid, y.clone()).map_err(|e| cli_err!("{}: {e}", table.name))?;
+    let record =
+        fitting::record(&exp.grid, y.clone()).map_err(|e| cli_err!("{}: {e}", table.name))?;
     let s = fitting::structure(&exp, signal.clone(), method)?;
-    let fit_err = |e: String| cli_err!("{}: fit with method {} failed: {e}", exp.file, method.as_str());
+    let fit_err = |e: String| {
+        cli_err!(
+            "{}: fit with method {} failed: {e}",
+            exp.file,
+            method.as_str()
+        )
+    };
     let f: Fit = fitting::fit(&exp, &s, &record, method, 0, true).map_err(fit_err)?;
 
     if let Some(dir) = &o.plot {
@@ -215,13 +240,21 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
         } else {
             None
         };
-        let main_label = if method == Method::Ls { "naive LS" } else { method.as_str() };
+        let main_label = if method == Method::Ls {
+            "naive LS"
+        } else {
+            method.as_str()
+        };
         let figs = plots::fit_figures(&plots::FitPlots {
             exp: &exp,
             y: &y,
             input: input.as_ref(),
             file_model: &signal,
-            ls: if method == Method::Ls { None } else { ls.as_ref() },
+            ls: if method == Method::Ls {
+                None
+            } else {
+                ls.as_ref()
+            },
             main: (main_label, &f.fitted),
             tau: table.optional("tau"),
         })?;
@@ -242,27 +275,63 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
             noise_std: f.noise_std,
             parameters: &f.params,
         };
-        return serde_json::to_string_pretty(&j).map(|s| s + "\n").map_err(|e| cli_err!("JSON: {e}"));
+        return serde_json::to_string_pretty(&j)
+            .map(|s| s + "\n")
+            .map_err(|e| cli_err!("JSON: {e}"));
     }
     let mut out = String::new();
-    let _ = writeln!(out, "fit of {} with {} ({})", table.name, method.as_str(), exp.file);
+    let _ = writeln!(
+        out,
+        "fit of {} with {} ({})",
+        table.name,
+        method.as_str(),
+        exp.file
+    );
     let _ = writeln!(
         out,
         "{} ({}) after {} iterations, cost {:.6e}, noise std {} ({})",
-        if f.converged { "converged" } else { "NOT converged" },
+        if f.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
         f.termination,
         f.iterations,
         f.cost,
         fmt_num(f.noise_std),
-        if exp.noise.estimate { "estimated" } else { "known" }
+        if exp.noise.estimate {
+            "estimated"
+        } else {
+            "known"
+        }
     );
-    let w = f.params.iter().map(|p| p.name.len()).max().unwrap_or(9).max(9);
-    let _ = writeln!(out, "{:<w$}  {:>14}  {:>14}", "parameter", "estimate", "std error");
+    let w = f
+        .params
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(9)
+        .max(9);
+    let _ = writeln!(
+        out,
+        "{:<w$}  {:>14}  {:>14}",
+        "parameter", "estimate", "std error"
+    );
     for p in &f.params {
-        let _ = writeln!(out, "{:<w$}  {:>14}  {:>14}", p.name, fmt_num(p.estimate), p.stderr.map_or("–".into(), fmt_num));
+        let _ = writeln!(
+            out,
+            "{:<w$}  {:>14}  {:>14}",
+            p.name,
+            fmt_num(p.estimate),
+            p.stderr.map_or("–".into(), fmt_num)
+        );
     }
     if let Some(dir) = &o.plot {
-        let _ = writeln!(out, "figures in {}: bode.svg (rational systems), spectrum.svg, moment.svg, jitter-pdf.svg", dir.display());
+        let _ = writeln!(
+            out,
+            "figures in {}: bode.svg (rational systems), spectrum.svg, moment.svg, jitter-pdf.svg",
+            dir.display()
+        );
     }
     Ok(out)
 }
@@ -387,7 +456,11 @@ fn finite(x: f64) -> Option<f64> {
 }
 
 /// Summaries over the converged realisations, in run order.
-pub fn summarize(names: &[String], truth: &[Option<f64>], runs: &[Realization]) -> Vec<ParamSummary> {
+pub fn summarize(
+    names: &[String],
+    truth: &[Option<f64>],
+    runs: &[Realization],
+) -> Vec<ParamSummary> {
     names
         .iter()
         .enumerate()
@@ -400,7 +473,9 @@ pub fn summarize(names: &[String], truth: &[Option<f64>], runs: &[Realization]) 
             let s: Summary = vals.iter().copied().collect();
             let t = truth.get(i).copied().flatten();
             let rmse = t.and_then(|t| {
-                (!vals.is_empty()).then(|| (vals.iter().map(|x| (x - t).powi(2)).sum::<f64>() / vals.len() as f64).sqrt())
+                (!vals.is_empty()).then(|| {
+                    (vals.iter().map(|x| (x - t).powi(2)).sum::<f64>() / vals.len() as f64).sqrt()
+                })
             });
             ParamSummary {
                 name: name.clone(),
@@ -422,9 +497,21 @@ struct RunOut {
 /// Realisations whose fitted models are kept for the figures.
 const KEEP_FITTED: u64 = 32;
 
-fn one_run(exp: &Experiment, method: Method, seed: u64, n: usize, r: u64, rng: &mut jitterid::rand::rngs::StdRng, keep: bool) -> RunOut {
+fn one_run(
+    exp: &Experiment,
+    method: Method,
+    seed: u64,
+    n: usize,
+    r: u64,
+    rng: &mut jitterid::rand::rngs::StdRng,
+    keep: bool,
+) -> RunOut {
     let fail = || RunOut {
-        realization: Realization { run: r, converged: false, values: vec![None; n] },
+        realization: Realization {
+            run: r,
+            converged: false,
+            values: vec![None; n],
+        },
         fitted: None,
     };
     let mut go = || -> Option<Fit> {
@@ -435,7 +522,15 @@ fn one_run(exp: &Experiment, method: Method, seed: u64, n: usize, r: u64, rng: &
         let start = fitting::perturb(&s.params(), exp.estimate.perturb, rng);
         let s0 = s.with_params(&start).ok()?;
         let record = fitting::record(&exp.grid, sim.y).ok()?;
-        fitting::fit(exp, &s0, &record, method, realization_seed(seed, r) ^ 0x6d73, exp.noise.estimate).ok()
+        fitting::fit(
+            exp,
+            &s0,
+            &record,
+            method,
+            realization_seed(seed, r) ^ 0x6d73,
+            exp.noise.estimate,
+        )
+        .ok()
     };
     match go() {
         Some(f) => RunOut {
@@ -458,13 +553,36 @@ fn mc_table(j: &McJson) -> String {
         j.experiment, j.method, j.runs, j.seed, j.converged, j.seconds
     );
     if let Some(s) = &j.shard {
-        let _ = writeln!(out, "shard {}/{}: runs {}..{} of {}", s.index, s.count, s.first, s.end, s.runs_total);
+        let _ = writeln!(
+            out,
+            "shard {}/{}: runs {}..{} of {}",
+            s.index, s.count, s.first, s.end, s.runs_total
+        );
     }
-    let w = j.parameters.iter().map(|p| p.name.len()).max().unwrap_or(9).max(9);
-    let _ = writeln!(out, "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}", "parameter", "true", "mean", "std", "se", "rmse");
+    let w = j
+        .parameters
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(9)
+        .max(9);
+    let _ = writeln!(
+        out,
+        "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}",
+        "parameter", "true", "mean", "std", "se", "rmse"
+    );
     let f = |x: Option<f64>| x.map_or("–".into(), fmt_num);
     for p in &j.parameters {
-        let _ = writeln!(out, "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}", p.name, f(p.truth), f(p.mean), f(p.std), f(p.se), f(p.rmse));
+        let _ = writeln!(
+            out,
+            "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}",
+            p.name,
+            f(p.truth),
+            f(p.mean),
+            f(p.std),
+            f(p.se),
+            f(p.rmse)
+        );
     }
     out
 }
@@ -475,7 +593,10 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
     let method = o.method.unwrap_or(exp.estimate.method);
     fitting::check_method(&exp, method, o.method.is_some())?;
     if o.runs == 0 || o.runs > MAX_RUNS {
-        return Err(cli_err!("--runs: expected a number of realisations in [1, {MAX_RUNS}], found {}", o.runs));
+        return Err(cli_err!(
+            "--runs: expected a number of realisations in [1, {MAX_RUNS}], found {}",
+            o.runs
+        ));
     }
     // The names and truths, from realisation 0's setup (they do not depend on the input).
     let mut rng0 = realization_rng(o.seed, 0);
@@ -495,13 +616,22 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
             }
             b = b.num_threads(k);
         }
-        b.build().map_err(|e| cli_err!("--threads: cannot start the worker threads: {e}"))?
+        b.build()
+            .map_err(|e| cli_err!("--threads: cannot start the worker threads: {e}"))?
     };
     let progress = Progress::new(end - first);
     let t0 = Instant::now();
     let outs: Vec<RunOut> = pool.install(|| {
         mc_run(o.seed, first..end, |r, rng| {
-            let out = one_run(&exp, method, o.seed, n, r, rng, o.plot.is_some() && r < first + KEEP_FITTED);
+            let out = one_run(
+                &exp,
+                method,
+                o.seed,
+                n,
+                r,
+                rng,
+                o.plot.is_some() && r < first + KEEP_FITTED,
+            );
             progress.tick();
             out
         })
@@ -520,7 +650,13 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
         seed: o.seed,
         experiment: exp.file.clone(),
         parameters,
-        shard: sharded.then_some(ShardInfo { index: shard.index, count: shard.count, runs_total: o.runs, first, end }),
+        shard: sharded.then_some(ShardInfo {
+            index: shard.index,
+            count: shard.count,
+            runs_total: o.runs,
+            first,
+            end,
+        }),
         realizations: sharded.then_some(realizations.clone()),
     };
     if let Some(dir) = &o.plot {
@@ -574,9 +710,14 @@ pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<Str
     for f in files {
         let name = f.display().to_string();
         csvio::check_regular_file(f, &name)?;
-        let text = std::fs::read_to_string(f).map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
-        let j: McJson = serde_json::from_str(&text)
-            .map_err(|e| cli_err!("{name}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}", e.line()))?;
+        let text = std::fs::read_to_string(f)
+            .map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
+        let j: McJson = serde_json::from_str(&text).map_err(|e| {
+            cli_err!(
+                "{name}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}",
+                e.line()
+            )
+        })?;
         parts.push((name, j));
     }
     let Some((first_name, first)) = parts.first() else {
@@ -590,26 +731,45 @@ pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<Str
     };
     let (s0, _) = info(first_name, first)?;
     if s0.count > 1_000_000 || s0.runs_total > MAX_RUNS {
-        return Err(cli_err!("{first_name}: shard count {} or run total {} out of range", s0.count, s0.runs_total));
+        return Err(cli_err!(
+            "{first_name}: shard count {} or run total {} out of range",
+            s0.count,
+            s0.runs_total
+        ));
     }
     let mut all: Vec<Realization> = Vec::new();
     let mut seconds = 0.0;
     let mut seen = vec![false; s0.count as usize];
     for (name, j) in &parts {
         let (s, r) = info(name, j)?;
-        if j.experiment != first.experiment || j.method != first.method || j.seed != first.seed || s.runs_total != s0.runs_total || s.count != s0.count {
+        if j.experiment != first.experiment
+            || j.method != first.method
+            || j.seed != first.seed
+            || s.runs_total != s0.runs_total
+            || s.count != s0.count
+        {
             return Err(cli_err!(
                 "{name}: belongs to another study than {first_name} (experiment, method, seed, runs and shard count must agree)"
             ));
         }
-        if j.parameters.iter().map(|p| &p.name).ne(first.parameters.iter().map(|p| &p.name)) {
-            return Err(cli_err!("{name}: its parameters differ from those of {first_name}"));
+        if j.parameters
+            .iter()
+            .map(|p| &p.name)
+            .ne(first.parameters.iter().map(|p| &p.name))
+        {
+            return Err(cli_err!(
+                "{name}: its parameters differ from those of {first_name}"
+            ));
         }
         let slot = seen
             .get_mut(s.index as usize)
             .ok_or_else(|| cli_err!("{name}: shard index {} out of range", s.index))?;
         if *slot {
-            return Err(cli_err!("{name}: shard {}/{} given twice", s.index, s.count));
+            return Err(cli_err!(
+                "{name}: shard {}/{} given twice",
+                s.index,
+                s.count
+            ));
         }
         *slot = true;
         seconds += j.seconds;
@@ -620,7 +780,10 @@ pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<Str
     }
     all.sort_by_key(|r| r.run);
     if all.iter().enumerate().any(|(i, r)| r.run != i as u64) || all.len() as u64 != s0.runs_total {
-        return Err(cli_err!("merge: the shards do not cover runs 0..{} exactly once", s0.runs_total));
+        return Err(cli_err!(
+            "merge: the shards do not cover runs 0..{} exactly once",
+            s0.runs_total
+        ));
     }
     let names: Vec<String> = first.parameters.iter().map(|p| p.name.clone()).collect();
     let truth: Vec<Option<f64>> = first.parameters.iter().map(|p| p.truth).collect();

@@ -164,7 +164,8 @@ pub fn parse(name: &str, text: &str) -> CliResult<Table> {
 pub fn read(path: &Path) -> CliResult<Table> {
     let name = path.display().to_string();
     check_regular_file(path, &name)?;
-    let bytes = std::fs::read(path).map_err(|e| CliError::new(format!("{name}: cannot read: {}", io_reason(&e))))?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| CliError::new(format!("{name}: cannot read: {}", io_reason(&e))))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         cli_err!(
             "{name}: not UTF-8 text (invalid byte at offset {}); expected a CSV file",
@@ -180,7 +181,8 @@ pub const MAX_FILE_BYTES: u64 = 1 << 30;
 /// Fails unless `path` is a regular file of at most [`MAX_FILE_BYTES`] (so that a device or a
 /// pipe given by mistake cannot block or exhaust memory).
 pub fn check_regular_file(path: &Path, name: &str) -> CliResult<()> {
-    let meta = std::fs::metadata(path).map_err(|e| cli_err!("{name}: cannot read: {}", io_reason(&e)))?;
+    let meta =
+        std::fs::metadata(path).map_err(|e| cli_err!("{name}: cannot read: {}", io_reason(&e)))?;
     if !meta.is_file() {
         return Err(cli_err!("{name}: not a regular file"));
     }
@@ -271,7 +273,14 @@ mod tests {
         assert!(e.message().contains("empty"), "{e}");
         let e = parse("d.csv", "k,,y\n").unwrap_err();
         assert!(e.message().starts_with("d.csv:1: header"), "{e}");
-        let e = parse("d.csv", "k,y\n0,1\n").unwrap().column("t").unwrap_err();
-        assert!(e.message().starts_with("d.csv:1: header: expected a column named `t`"), "{e}");
+        let e = parse("d.csv", "k,y\n0,1\n")
+            .unwrap()
+            .column("t")
+            .unwrap_err();
+        assert!(
+            e.message()
+                .starts_with("d.csv:1: header: expected a column named `t`"),
+            "{e}"
+        );
     }
 }

@@ -12,8 +12,8 @@ use jitterid::jitter::{
     ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
 };
 use jitterid::signal::{
-    Input, Multisine, PiecewiseConstant, RandomBinary, Root, SampleGrid, Sinusoid,
-    TransferFunction, Tone, Zpk,
+    Input, Multisine, PiecewiseConstant, RandomBinary, Root, SampleGrid, Sinusoid, Tone,
+    TransferFunction, Zpk,
 };
 use serde::Deserialize;
 use std::ops::Range;
@@ -308,7 +308,9 @@ struct RawExperiment {
     estimate: Option<RawEstimate>,
 }
 
-const SECTIONS: &[&str] = &["title", "sampling", "input", "system", "jitter", "noise", "estimate"];
+const SECTIONS: &[&str] = &[
+    "title", "sampling", "input", "system", "jitter", "noise", "estimate",
+];
 
 fn keys_of(section: &str) -> &'static [&'static str] {
     match section {
@@ -328,7 +330,11 @@ fn keys_of(section: &str) -> &'static [&'static str] {
 /// 1-based line of a byte offset.
 fn line_of(text: &str, offset: usize) -> usize {
     let end = offset.min(text.len());
-    text.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count() + 1
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
 }
 
 /// The section header in force at `line` (the last `[name]` at or before it).
@@ -394,7 +400,9 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> CliError {
             .collect::<Vec<_>>()
             .join(", ");
         msg = match suggestion(&name, known) {
-            Some(s) => format!("unknown key `{name}` (did you mean `{s}`?); expected one of {list}"),
+            Some(s) => {
+                format!("unknown key `{name}` (did you mean `{s}`?); expected one of {list}")
+            }
             None => format!("unknown key `{name}`; expected one of {list}"),
         };
         key = None;
@@ -405,7 +413,10 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> CliError {
     }
     msg = msg
         .replace("expected struct table ", "expected the table ")
-        .replace("expected struct experiment file", "expected a table of sections");
+        .replace(
+            "expected struct experiment file",
+            "expected a table of sections",
+        );
     let section = section.map(|s| format!("[{s}] ")).unwrap_or_default();
     let key = key.map(|k| format!("{k}: ")).unwrap_or_default();
     match line {
@@ -426,7 +437,13 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn err(&self, section: &str, key: &str, span: &Range<usize>, msg: impl std::fmt::Display) -> CliError {
+    fn err(
+        &self,
+        section: &str,
+        key: &str,
+        span: &Range<usize>,
+        msg: impl std::fmt::Display,
+    ) -> CliError {
         cli_err!(
             "{}:{}: [{section}] {key}: {msg}",
             self.file,
@@ -450,7 +467,8 @@ impl Ctx<'_> {
 
     fn record(&mut self, section: &'static str, present: Vec<(&'static str, Range<usize>)>) {
         for (k, span) in present {
-            self.key_lines.push((section, k, line_of(self.text, span.start)));
+            self.key_lines
+                .push((section, k, line_of(self.text, span.start)));
         }
     }
 
@@ -495,7 +513,12 @@ impl Ctx<'_> {
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(self.err(section, key, &v.span(), format!("expected a finite number, found {x}")))
+            Err(self.err(
+                section,
+                key,
+                &v.span(),
+                format!("expected a finite number, found {x}"),
+            ))
         }
     }
 
@@ -504,7 +527,12 @@ impl Ctx<'_> {
         if x > 0.0 {
             Ok(x)
         } else {
-            Err(self.err(section, key, &v.span(), format!("expected a number > 0, found {x}")))
+            Err(self.err(
+                section,
+                key,
+                &v.span(),
+                format!("expected a number > 0, found {x}"),
+            ))
         }
     }
 
@@ -685,27 +713,46 @@ pub fn parse(file: &str, text: &str, dir: &Path) -> CliResult<Experiment> {
 
 fn parse_sampling(cx: &Ctx, r: &RawSampling) -> CliResult<SampleGrid> {
     const S: &str = "sampling";
-    let interval = cx.required(S, "interval", &r.interval, "expected the sampling interval T in seconds")?;
+    let interval = cx.required(
+        S,
+        "interval",
+        &r.interval,
+        "expected the sampling interval T in seconds",
+    )?;
     let interval = cx.positive(S, "interval", interval)?;
     let samples = cx.required(S, "samples", &r.samples, "expected the number of samples N")?;
     let n = *samples.get_ref();
     if !(1..=MAX_SAMPLES).contains(&n) {
-        return Err(cx.err(S, "samples", &samples.span(), format!("expected a whole number in [1, {MAX_SAMPLES}], found {n}")));
+        return Err(cx.err(
+            S,
+            "samples",
+            &samples.span(),
+            format!("expected a whole number in [1, {MAX_SAMPLES}], found {n}"),
+        ));
     }
     let start = cx.opt_finite(S, "start", &r.start, 0.0)?;
     let end = start + n as f64 * interval;
     if !end.is_finite() || (end - start) <= 0.0 || interval <= end.abs().max(start.abs()) * 1e-12 {
         let span = r.interval.as_ref().map(|s| s.span()).unwrap_or(0..0);
-        return Err(cx.err(S, "interval", &span, "too small for the record's times to be told apart in double precision"));
+        return Err(cx.err(
+            S,
+            "interval",
+            &span,
+            "too small for the record's times to be told apart in double precision",
+        ));
     }
-    SampleGrid::new(start, interval, n as usize)
-        .map_err(|e| cx.err_section(S, "interval", e))
+    SampleGrid::new(start, interval, n as usize).map_err(|e| cx.err_section(S, "interval", e))
 }
 
 fn parse_input(cx: &Ctx, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
     const S: &str = "input";
     let present = r.present();
-    let kind = cx.required(S, "kind", &r.kind, "expected kind = \"random-binary\", \"sine\", \"multisine\", \"piecewise\" or \"csv\"")?;
+    let kind = cx.required(
+        S,
+        "kind",
+        &r.kind,
+        "expected kind = \"random-binary\", \"sine\", \"multisine\", \"piecewise\" or \"csv\"",
+    )?;
     let kspan = kind.span();
     let kind = kind.get_ref().as_str();
     match kind {
@@ -799,14 +846,19 @@ pub fn input_span(grid: &SampleGrid) -> (f64, f64) {
 /// A piecewise-constant input from switch times and levels: `u = values[j]` from `times[j]` to
 /// the next time; with one more time than values the last time ends the input (zero after it),
 /// otherwise the last level holds until `t0 + 2NT` (well after the record).
-pub fn piecewise(times: &[f64], values: &[f64], grid: &SampleGrid) -> Result<PiecewiseConstant, String> {
+pub fn piecewise(
+    times: &[f64],
+    values: &[f64],
+    grid: &SampleGrid,
+) -> Result<PiecewiseConstant, String> {
     if values.is_empty() {
         return Err("expected at least one switch time and level".into());
     }
     let mut edges = times.to_vec();
     if times.len() == values.len() {
         let last = times[times.len() - 1];
-        let hold = (grid.start() + 2.0 * grid.duration() + grid.interval()).max(last + grid.interval());
+        let hold =
+            (grid.start() + 2.0 * grid.duration() + grid.interval()).max(last + grid.interval());
         edges.push(hold);
     } else if times.len() != values.len() + 1 {
         return Err(format!(
@@ -869,7 +921,9 @@ fn parse_roots(cx: &Ctx, key: &str, v: &Spanned<Vec<toml::Value>>) -> CliResult<
         };
         let root = match e {
             toml::Value::Array(a) if a.len() == 2 => match (number(&a[0]), number(&a[1])) {
-                (Some(re), Some(im)) if re.is_finite() && im.is_finite() && im > 0.0 => Root::Pair { re, im },
+                (Some(re), Some(im)) if re.is_finite() && im.is_finite() && im > 0.0 => {
+                    Root::Pair { re, im }
+                }
                 (Some(re), Some(im)) => return Err(bad(format!("[{re}, {im}]"))),
                 _ => return Err(bad(describe(e))),
             },
@@ -887,45 +941,115 @@ fn parse_roots(cx: &Ctx, key: &str, v: &Spanned<Vec<toml::Value>>) -> CliResult<
 fn parse_system(cx: &Ctx, r: &RawSystem) -> CliResult<SystemSpec> {
     const S: &str = "system";
     let present = r.present();
-    let kind = cx.required(S, "kind", &r.kind, "expected kind = \"zpk\", \"tf\" or \"sinusoid\"")?;
+    let kind = cx.required(
+        S,
+        "kind",
+        &r.kind,
+        "expected kind = \"zpk\", \"tf\" or \"sinusoid\"",
+    )?;
     let kspan = kind.span();
     let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
     let kind = match kind.get_ref().as_str() {
         "zpk" => {
-            cx.only(S, &present, "kind", &["kind", "gain", "zeros", "poles", "estimate"], "zpk")?;
-            let g = cx.required(S, "gain", &r.gain, "kind = \"zpk\" needs gain, poles and optionally zeros")?;
+            cx.only(
+                S,
+                &present,
+                "kind",
+                &["kind", "gain", "zeros", "poles", "estimate"],
+                "zpk",
+            )?;
+            let g = cx.required(
+                S,
+                "gain",
+                &r.gain,
+                "kind = \"zpk\" needs gain, poles and optionally zeros",
+            )?;
             let gain = cx.finite(S, "gain", g)?;
-            let p = cx.required(S, "poles", &r.poles, "kind = \"zpk\" needs gain, poles and optionally zeros")?;
+            let p = cx.required(
+                S,
+                "poles",
+                &r.poles,
+                "kind = \"zpk\" needs gain, poles and optionally zeros",
+            )?;
             let poles = parse_roots(cx, "poles", p)?;
             let zeros = match &r.zeros {
                 Some(z) => parse_roots(cx, "zeros", z)?,
                 None => Vec::new(),
             };
-            SystemKind::Zpk(Zpk::new(gain, zeros, poles).map_err(|e| cx.err(S, "poles", &p.span(), e))?)
+            SystemKind::Zpk(
+                Zpk::new(gain, zeros, poles).map_err(|e| cx.err(S, "poles", &p.span(), e))?,
+            )
         }
         "tf" => {
-            cx.only(S, &present, "kind", &["kind", "num", "den", "estimate"], "tf")?;
-            let n = cx.required(S, "num", &r.num, "kind = \"tf\" needs num and den (highest power first)")?;
-            let d = cx.required(S, "den", &r.den, "kind = \"tf\" needs num and den (highest power first)")?;
+            cx.only(
+                S,
+                &present,
+                "kind",
+                &["kind", "num", "den", "estimate"],
+                "tf",
+            )?;
+            let n = cx.required(
+                S,
+                "num",
+                &r.num,
+                "kind = \"tf\" needs num and den (highest power first)",
+            )?;
+            let d = cx.required(
+                S,
+                "den",
+                &r.den,
+                "kind = \"tf\" needs num and den (highest power first)",
+            )?;
             let num = cx.finite_list(S, "num", n)?;
             let den = cx.finite_list(S, "den", d)?;
-            SystemKind::Tf(TransferFunction::new(&num, &den).map_err(|e| cx.err(S, "den", &d.span(), e))?)
+            SystemKind::Tf(
+                TransferFunction::new(&num, &den).map_err(|e| cx.err(S, "den", &d.span(), e))?,
+            )
         }
         "sinusoid" => {
-            cx.only(S, &present, "kind", &["kind", "amplitude", "frequency", "phase", "estimate"], "sinusoid")?;
-            let a = cx.required(S, "amplitude", &r.amplitude, "kind = \"sinusoid\" needs amplitude, frequency and optionally phase")?;
-            let f = cx.required(S, "frequency", &r.frequency, "kind = \"sinusoid\" needs amplitude, frequency and optionally phase")?;
+            cx.only(
+                S,
+                &present,
+                "kind",
+                &["kind", "amplitude", "frequency", "phase", "estimate"],
+                "sinusoid",
+            )?;
+            let a = cx.required(
+                S,
+                "amplitude",
+                &r.amplitude,
+                "kind = \"sinusoid\" needs amplitude, frequency and optionally phase",
+            )?;
+            let f = cx.required(
+                S,
+                "frequency",
+                &r.frequency,
+                "kind = \"sinusoid\" needs amplitude, frequency and optionally phase",
+            )?;
             let amplitude = cx.finite(S, "amplitude", a)?;
             let frequency = cx.finite(S, "frequency", f)?;
             let phase = cx.opt_finite(S, "phase", &r.phase, 0.0)?;
-            SystemKind::Sinusoid(Sinusoid::new(amplitude, frequency, phase).map_err(|e| cx.err(S, "frequency", &f.span(), e))?)
+            SystemKind::Sinusoid(
+                Sinusoid::new(amplitude, frequency, phase)
+                    .map_err(|e| cx.err(S, "frequency", &f.span(), e))?,
+            )
         }
-        other => return Err(cx.err(S, "kind", &kspan, format!("unknown system kind \"{other}\"; expected \"zpk\", \"tf\" or \"sinusoid\""))),
+        other => {
+            return Err(cx.err(
+                S,
+                "kind",
+                &kspan,
+                format!(
+                    "unknown system kind \"{other}\"; expected \"zpk\", \"tf\" or \"sinusoid\""
+                ),
+            ))
+        }
     };
     Ok(SystemSpec { kind, estimate })
 }
 
-const FAMILIES: &str = "\"none\", \"uniform-sum\", \"gaussian\", \"laplace\", \"two-point\" or \"exponential\"";
+const FAMILIES: &str =
+    "\"none\", \"uniform-sum\", \"gaussian\", \"laplace\", \"two-point\" or \"exponential\"";
 
 /// The keys that carry a family's parameters.
 fn family_keys(family: &str) -> Option<&'static [&'static str]> {
@@ -950,7 +1074,9 @@ fn family_with_std(family: &str, sigma: f64, n: u32) -> Result<AnyJitter, String
     }
     let e = |e: jitterid::jitter::JitterError| e.to_string();
     Ok(match family {
-        "uniform-sum" => AnyJitter::UniformSum(UniformSum::new(n, sigma * (3.0 * (f64::from(n) + 1.0)).sqrt()).map_err(e)?),
+        "uniform-sum" => AnyJitter::UniformSum(
+            UniformSum::new(n, sigma * (3.0 * (f64::from(n) + 1.0)).sqrt()).map_err(e)?,
+        ),
         "gaussian" => AnyJitter::Gaussian(Gaussian::new(sigma).map_err(e)?),
         "laplace" => AnyJitter::Laplace(Laplace::new(sigma / 2f64.sqrt()).map_err(e)?),
         "two-point" => AnyJitter::TwoPoint(TwoPoint::new(sigma).map_err(e)?),
@@ -962,10 +1088,20 @@ fn family_with_std(family: &str, sigma: f64, n: u32) -> Result<AnyJitter, String
 fn parse_jitter(cx: &Ctx, r: &RawJitter) -> CliResult<JitterSpec> {
     const S: &str = "jitter";
     let present = r.present();
-    let fam = cx.required(S, "family", &r.family, &format!("expected family = {FAMILIES}"))?;
+    let fam = cx.required(
+        S,
+        "family",
+        &r.family,
+        &format!("expected family = {FAMILIES}"),
+    )?;
     let family = fam.get_ref().as_str();
     let Some(own) = family_keys(family) else {
-        return Err(cx.err(S, "family", &fam.span(), format!("unknown jitter family \"{family}\"; expected {FAMILIES}")));
+        return Err(cx.err(
+            S,
+            "family",
+            &fam.span(),
+            format!("unknown jitter family \"{family}\"; expected {FAMILIES}"),
+        ));
     };
     let mut allowed = vec!["family", "estimate", "offset", "fit_family", "n_range"];
     allowed.extend_from_slice(own);
@@ -983,7 +1119,17 @@ fn parse_jitter(cx: &Ctx, r: &RawJitter) -> CliResult<JitterSpec> {
                 u32::try_from(n)
                     .ok()
                     .filter(|n| *n <= UniformSum::MAX_N)
-                    .ok_or_else(|| cx.err(S, "n", &v.span(), format!("expected a whole number in [0, {}], found {n}", UniformSum::MAX_N)))
+                    .ok_or_else(|| {
+                        cx.err(
+                            S,
+                            "n",
+                            &v.span(),
+                            format!(
+                                "expected a whole number in [0, {}], found {n}",
+                                UniformSum::MAX_N
+                            ),
+                        )
+                    })
             }
         }
     };
@@ -995,10 +1141,18 @@ fn parse_jitter(cx: &Ctx, r: &RawJitter) -> CliResult<JitterSpec> {
             let a = positive("a", &r.a)?;
             AnyJitter::UniformSum(UniformSum::new(n, a).map_err(|e| jerr("a", e))?)
         }
-        "gaussian" => AnyJitter::Gaussian(Gaussian::new(positive("sigma", &r.sigma)?).map_err(|e| jerr("sigma", e))?),
-        "laplace" => AnyJitter::Laplace(Laplace::new(positive("scale", &r.scale)?).map_err(|e| jerr("scale", e))?),
-        "two-point" => AnyJitter::TwoPoint(TwoPoint::new(positive("d", &r.d)?).map_err(|e| jerr("d", e))?),
-        "exponential" => AnyJitter::Exponential(ExponentialDelay::new(positive("mean", &r.mean)?).map_err(|e| jerr("mean", e))?),
+        "gaussian" => AnyJitter::Gaussian(
+            Gaussian::new(positive("sigma", &r.sigma)?).map_err(|e| jerr("sigma", e))?,
+        ),
+        "laplace" => AnyJitter::Laplace(
+            Laplace::new(positive("scale", &r.scale)?).map_err(|e| jerr("scale", e))?,
+        ),
+        "two-point" => {
+            AnyJitter::TwoPoint(TwoPoint::new(positive("d", &r.d)?).map_err(|e| jerr("d", e))?)
+        }
+        "exponential" => AnyJitter::Exponential(
+            ExponentialDelay::new(positive("mean", &r.mean)?).map_err(|e| jerr("mean", e))?,
+        ),
         _ => unreachable_family(),
     };
     let offset = match &r.offset {
@@ -1007,7 +1161,9 @@ fn parse_jitter(cx: &Ctx, r: &RawJitter) -> CliResult<JitterSpec> {
     };
     let shift = |j: AnyJitter| -> CliResult<AnyJitter> {
         match offset {
-            Some(c) => Ok(AnyJitter::Shifted(Box::new(Shifted::new(j, c).map_err(|e| jerr("offset", e))?))),
+            Some(c) => Ok(AnyJitter::Shifted(Box::new(
+                Shifted::new(j, c).map_err(|e| jerr("offset", e))?,
+            ))),
             None => Ok(j),
         }
     };
@@ -1017,31 +1173,48 @@ fn parse_jitter(cx: &Ctx, r: &RawJitter) -> CliResult<JitterSpec> {
         Some(ff) if ff.get_ref() != family => {
             let name = ff.get_ref().as_str();
             if family_keys(name).is_none() {
-                return Err(cx.err(S, "fit_family", &ff.span(), format!("unknown jitter family \"{name}\"; expected {FAMILIES}")));
+                return Err(cx.err(
+                    S,
+                    "fit_family",
+                    &ff.span(),
+                    format!("unknown jitter family \"{name}\"; expected {FAMILIES}"),
+                ));
             }
             let n = match &base {
                 AnyJitter::UniformSum(u) => u.n(),
                 _ => 0,
             };
-            let j = family_with_std(name, base.std_dev(), n).map_err(|m| cx.err(S, "fit_family", &ff.span(), m))?;
+            let j = family_with_std(name, base.std_dev(), n)
+                .map_err(|m| cx.err(S, "fit_family", &ff.span(), m))?;
             (shift(j)?, true, name.to_string())
         }
         _ => (truth.clone(), false, family.to_string()),
     };
     if estimate && model.num_params() == 0 {
         let span = r.estimate.as_ref().map(|e| e.span()).unwrap_or(0..0);
-        return Err(cx.err(S, "estimate", &span, format!("family \"{model_family}\" has no parameter to estimate; set estimate = false")));
+        return Err(cx.err(
+            S,
+            "estimate",
+            &span,
+            format!("family \"{model_family}\" has no parameter to estimate; set estimate = false"),
+        ));
     }
     let profiled = estimate && model_family == "uniform-sum" && offset.is_none();
     let n_range = match (&r.n_range, profiled) {
         (Some(v), true) => {
             let l = v.get_ref();
-            let ok = l.len() == 2
-                && l[0] >= 0
-                && l[0] <= l[1]
-                && l[1] <= i64::from(UniformSum::MAX_N);
+            let ok =
+                l.len() == 2 && l[0] >= 0 && l[0] <= l[1] && l[1] <= i64::from(UniformSum::MAX_N);
             if !ok {
-                return Err(cx.err(S, "n_range", &v.span(), format!("expected [min, max] with 0 <= min <= max <= {}, found {l:?}", UniformSum::MAX_N)));
+                return Err(cx.err(
+                    S,
+                    "n_range",
+                    &v.span(),
+                    format!(
+                        "expected [min, max] with 0 <= min <= max <= {}, found {l:?}",
+                        UniformSum::MAX_N
+                    ),
+                ));
             }
             Some((l[0] as u32, l[1] as u32))
         }
@@ -1072,7 +1245,12 @@ fn parse_noise(cx: &Ctx, r: &RawNoise) -> CliResult<NoiseSpec> {
         Some(v) => {
             let x = cx.finite(S, "std", v)?;
             if x < 0.0 {
-                return Err(cx.err(S, "std", &v.span(), format!("expected a standard deviation >= 0, found {x}")));
+                return Err(cx.err(
+                    S,
+                    "std",
+                    &v.span(),
+                    format!("expected a standard deviation >= 0, found {x}"),
+                ));
             }
             x
         }
@@ -1101,10 +1279,19 @@ fn parse_noise(cx: &Ctx, r: &RawNoise) -> CliResult<NoiseSpec> {
         }
         other => {
             let span = r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
-            return Err(cx.err(S, "model", &span, format!("unknown noise model \"{other}\"; expected \"white\" or \"arma\"")));
+            return Err(cx.err(
+                S,
+                "model",
+                &span,
+                format!("unknown noise model \"{other}\"; expected \"white\" or \"arma\""),
+            ));
         }
     };
-    Ok(NoiseSpec { std, shape, estimate })
+    Ok(NoiseSpec {
+        std,
+        shape,
+        estimate,
+    })
 }
 
 fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<EstimateSpec> {
@@ -1112,7 +1299,15 @@ fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<Est
     let method = match &r.method {
         None => Method::Bcls,
         Some(m) => Method::parse(m.get_ref()).ok_or_else(|| {
-            cx.err(S, "method", &m.span(), format!("unknown method \"{}\"; expected \"ls\", \"bcls\", \"bj\" or \"ml\"", m.get_ref()))
+            cx.err(
+                S,
+                "method",
+                &m.span(),
+                format!(
+                    "unknown method \"{}\"; expected \"ls\", \"bcls\", \"bj\" or \"ml\"",
+                    m.get_ref()
+                ),
+            )
         })?,
     };
     let frequencies = match &r.frequencies {
@@ -1133,7 +1328,12 @@ fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<Est
         Some(v) => {
             let n = *v.get_ref();
             if !(0..=1000).contains(&n) {
-                return Err(cx.err(S, "multistart", &v.span(), format!("expected a whole number of extra starts in [0, 1000], found {n}")));
+                return Err(cx.err(
+                    S,
+                    "multistart",
+                    &v.span(),
+                    format!("expected a whole number of extra starts in [0, 1000], found {n}"),
+                ));
             }
             n as usize
         }
@@ -1146,7 +1346,12 @@ fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<Est
                 if (0.0..=10.0).contains(&x) {
                     Ok(x)
                 } else {
-                    Err(cx.err(S, key, &v.span(), format!("expected a relative size in [0, 10], found {x}")))
+                    Err(cx.err(
+                        S,
+                        key,
+                        &v.span(),
+                        format!("expected a relative size in [0, 10], found {x}"),
+                    ))
                 }
             }
         }
@@ -1158,7 +1363,12 @@ fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<Est
         Some(v) => {
             let n = *v.get_ref();
             if !(1..=1_000_000).contains(&n) {
-                return Err(cx.err(S, "max_iterations", &v.span(), format!("expected a whole number in [1, 1000000], found {n}")));
+                return Err(cx.err(
+                    S,
+                    "max_iterations",
+                    &v.span(),
+                    format!("expected a whole number in [1, 1000000], found {n}"),
+                ));
             }
             Some(n as u64)
         }
@@ -1174,7 +1384,11 @@ fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<Est
     })
 }
 
-fn parse_frequencies(cx: &Ctx, v: &Spanned<toml::Value>, grid: &SampleGrid) -> CliResult<Frequencies> {
+fn parse_frequencies(
+    cx: &Ctx,
+    v: &Spanned<toml::Value>,
+    grid: &SampleGrid,
+) -> CliResult<Frequencies> {
     const S: &str = "estimate";
     const K: &str = "frequencies";
     let expected = "expected \"dft\", { min = …, max = … } (Hz) or a list of frequencies in Hz";
@@ -1183,17 +1397,37 @@ fn parse_frequencies(cx: &Ctx, v: &Spanned<toml::Value>, grid: &SampleGrid) -> C
         toml::Value::String(s) if s == "dft" => Frequencies::Dft,
         toml::Value::Table(t) => {
             if let Some(k) = t.keys().find(|k| *k != "min" && *k != "max") {
-                return Err(cx.err(S, K, &v.span(), format!("unknown key `{k}` in the band; expected min and max")));
+                return Err(cx.err(
+                    S,
+                    K,
+                    &v.span(),
+                    format!("unknown key `{k}` in the band; expected min and max"),
+                ));
             }
             let get = |k: &str| -> CliResult<f64> {
-                let x = t.get(k).ok_or_else(|| cx.err(S, K, &v.span(), format!("the band needs `{k}`; {expected}")))?;
-                number(x)
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| cx.err(S, K, &v.span(), format!("band `{k}`: expected a finite number of Hz, found {}", describe(x))))
+                let x = t.get(k).ok_or_else(|| {
+                    cx.err(S, K, &v.span(), format!("the band needs `{k}`; {expected}"))
+                })?;
+                number(x).filter(|x| x.is_finite()).ok_or_else(|| {
+                    cx.err(
+                        S,
+                        K,
+                        &v.span(),
+                        format!(
+                            "band `{k}`: expected a finite number of Hz, found {}",
+                            describe(x)
+                        ),
+                    )
+                })
             };
             let (min, max) = (get("min")?, get("max")?);
             if !(min >= 0.0 && min <= max) {
-                return Err(cx.err(S, K, &v.span(), format!("expected 0 <= min <= max, found min = {min}, max = {max}")));
+                return Err(cx.err(
+                    S,
+                    K,
+                    &v.span(),
+                    format!("expected 0 <= min <= max, found min = {min}, max = {max}"),
+                ));
             }
             jitterid::window::FrequencySet::band(grid, min, max)
                 .map_err(|e| cx.err(S, K, &v.span(), e))?;
@@ -1216,7 +1450,14 @@ fn parse_frequencies(cx: &Ctx, v: &Spanned<toml::Value>, grid: &SampleGrid) -> C
                 .map_err(|e| cx.err(S, K, &v.span(), e))?;
             Frequencies::List(out)
         }
-        other => return Err(cx.err(S, K, &v.span(), format!("{expected}, found {}", describe(other)))),
+        other => {
+            return Err(cx.err(
+                S,
+                K,
+                &v.span(),
+                format!("{expected}, found {}", describe(other)),
+            ))
+        }
     };
     Ok(f)
 }

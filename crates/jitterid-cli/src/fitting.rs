@@ -4,7 +4,9 @@ use crate::cli_err;
 use crate::error::{CliError, CliResult};
 use crate::experiment::{input_span, Experiment, InputSpec, Method, SolverKind, SystemKind};
 use crate::models::{AnyJitter, AnyNoise, AnySignal, AnySolver};
-use jitterid::estimate::solver::{GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead};
+use jitterid::estimate::solver::{
+    GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
+};
 use jitterid::estimate::{
     estimate, profile_uniform_sum, Bcls, BoxJenkins, Criterion, Estimate, EstimateError,
     EstimateOptions, Ls, ModelStructure, NoiseModel, Record,
@@ -20,7 +22,11 @@ pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
 
 /// The signal of a system kind driven by `input` (rational systems need one).
 pub fn signal_of(kind: &SystemKind, input: Option<&Input>) -> CliResult<AnySignal> {
-    let input = || input.cloned().ok_or_else(|| cli_err!("a rational system needs an input"));
+    let input = || {
+        input
+            .cloned()
+            .ok_or_else(|| cli_err!("a rational system needs an input"))
+    };
     Ok(match kind {
         SystemKind::Zpk(z) => AnySignal::Zpk(LtiResponse::new(z.clone(), input()?)),
         SystemKind::Tf(t) => AnySignal::Tf(LtiResponse::new(t.clone(), input()?)),
@@ -55,14 +61,22 @@ pub struct Simulated {
 
 /// Simulates the experiment's truth with `signal`; coloured noise is white noise filtered by
 /// the `[noise]` model with zero initial conditions.
-pub fn simulate_record(exp: &Experiment, signal: &AnySignal, rng: &mut StdRng) -> CliResult<Simulated> {
+pub fn simulate_record(
+    exp: &Experiment,
+    signal: &AnySignal,
+    rng: &mut StdRng,
+) -> CliResult<Simulated> {
     let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
         .map_err(|e| exp.error_at("noise", "std", e))?;
     let v = match &exp.noise.shape {
         AnyNoise::White => sim.noise.clone(),
         AnyNoise::Arma(a) => {
             let p = a.params();
-            let nc = a.param_names().iter().filter(|n| n.starts_with('c')).count();
+            let nc = a
+                .param_names()
+                .iter()
+                .filter(|n| n.starts_with('c'))
+                .count();
             arma_filter(&p[..nc], &p[nc..], &sim.noise)
         }
     };
@@ -229,7 +243,9 @@ pub fn param_names(exp: &Experiment, signal: &AnySignal, method: Method) -> CliR
 }
 
 fn profiled(exp: &Experiment) -> bool {
-    exp.jitter.estimate && exp.jitter.n_range.is_some() && matches!(exp.jitter.model, AnyJitter::UniformSum(_))
+    exp.jitter.estimate
+        && exp.jitter.n_range.is_some()
+        && matches!(exp.jitter.model, AnyJitter::UniformSum(_))
 }
 
 fn report_names(exp: &Experiment, s: &Structure) -> Vec<String> {
@@ -255,7 +271,11 @@ fn report_names(exp: &Experiment, s: &Structure) -> Vec<String> {
 
 /// True values of the reported parameters (`None` where the fitted family differs from the
 /// true one).
-pub fn truth_values(exp: &Experiment, signal_truth: &AnySignal, method: Method) -> CliResult<Vec<Option<f64>>> {
+pub fn truth_values(
+    exp: &Experiment,
+    signal_truth: &AnySignal,
+    method: Method,
+) -> CliResult<Vec<Option<f64>>> {
     let s = structure(exp, signal_truth.clone(), method)?;
     let names = report_names(exp, &s);
     let mut out = Vec::with_capacity(names.len());
@@ -293,7 +313,11 @@ pub fn truth_values(exp: &Experiment, signal_truth: &AnySignal, method: Method) 
     Ok(out)
 }
 
-fn options(exp: &Experiment, seed: u64, covariance: bool) -> EstimateOptions<AnySolver, DirichletWindow> {
+fn options(
+    exp: &Experiment,
+    seed: u64,
+    covariance: bool,
+) -> EstimateOptions<AnySolver, DirichletWindow> {
     EstimateOptions {
         frequencies: exp.estimate.frequencies.clone(),
         window: DirichletWindow,
@@ -357,20 +381,21 @@ pub fn fit(
     covariance: bool,
 ) -> Result<Fit, String> {
     let opts = options(exp, seed, covariance);
-    let raw = |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
-        let (e, fitted, n) = r.map_err(|e| e.to_string())?;
-        Ok(Raw {
-            params: e.params,
-            std_errors: e.std_errors,
-            cost: e.cost,
-            iterations: e.iterations,
-            termination: e.termination.to_string(),
-            converged: e.converged,
-            noise_std: e.noise_std,
-            fitted,
-            n,
-        })
-    };
+    let raw =
+        |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
+            let (e, fitted, n) = r.map_err(|e| e.to_string())?;
+            Ok(Raw {
+                params: e.params,
+                std_errors: e.std_errors,
+                cost: e.cost,
+                iterations: e.iterations,
+                termination: e.termination.to_string(),
+                converged: e.converged,
+                noise_std: e.noise_std,
+                fitted,
+                n,
+            })
+        };
     let e = match method {
         Method::Ls => raw(run_criterion(exp, s, record, &Ls, &opts))?,
         Method::Bcls => raw(run_criterion(exp, s, record, &Bcls, &opts))?,
@@ -378,12 +403,21 @@ pub fn fit(
         Method::Ml => fit_ml(exp, s, record, covariance)?,
     };
     let names = report_names(exp, s);
-    let se = |i: usize| e.std_errors.as_ref().and_then(|v| v.get(i).copied()).filter(|x| x.is_finite());
+    let se = |i: usize| {
+        e.std_errors
+            .as_ref()
+            .and_then(|v| v.get(i).copied())
+            .filter(|x| x.is_finite())
+    };
     let (ns, nj, nn) = s.blocks();
     let mut params = Vec::with_capacity(names.len());
     let mut push = |estimate: f64, stderr: Option<f64>| {
         let name = names.get(params.len()).cloned().unwrap_or_default();
-        params.push(Param { name, estimate, stderr });
+        params.push(Param {
+            name,
+            estimate,
+            stderr,
+        });
     };
     let at = |i: usize| e.params.get(i).copied().unwrap_or(f64::NAN);
     for i in 0..ns {
@@ -429,7 +463,12 @@ fn fit_ml(_: &Experiment, _: &Structure, _: &Record, _: bool) -> Result<Raw, Str
 /// Maximum likelihood: the exact likelihood for white noise, the Gaussian (quasi) likelihood
 /// of the first two moments for an ARMA noise model.
 #[cfg(feature = "ml")]
-fn fit_ml(exp: &Experiment, s: &Structure, record: &Record, covariance: bool) -> Result<Raw, String> {
+fn fit_ml(
+    exp: &Experiment,
+    s: &Structure,
+    record: &Record,
+    covariance: bool,
+) -> Result<Raw, String> {
     use jitterid::estimate::ml::{
         ml_estimate, ml_profile_uniform_sum, ExactMl, LikelihoodCriterion, MlEstimate, MlOptions,
         QuasiMl,

@@ -3,13 +3,13 @@
 //! non-generic [`ModelStructure`](jitterid::estimate::ModelStructure) serves every experiment.
 
 use jitterid::estimate::solver::{
-    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, MultiStart, NelderMead, Solver, SolverError,
-    SolverReport,
+    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, MultiStart, NelderMead, Solver,
+    SolverError, SolverReport,
 };
 use jitterid::estimate::{ArmaNoise, EstimateError, NoiseModel};
 use jitterid::jitter::{
-    Atom, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter,
-    QuadratureRule, Shifted, TwoPoint, UniformSum,
+    Atom, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter, QuadratureRule,
+    Shifted, TwoPoint, UniformSum,
 };
 use jitterid::num_complex::Complex64;
 use jitterid::rand::RngCore;

@@ -63,7 +63,10 @@ impl Staged {
             }
             Err(e) => {
                 let _ = std::fs::remove_file(&tmp);
-                Err(CliError::new(format!("{}: cannot write: {e}", path.display())))
+                Err(CliError::new(format!(
+                    "{}: cannot write: {e}",
+                    path.display()
+                )))
             }
         }
     }
@@ -76,7 +79,10 @@ impl Staged {
                 for (t, _) in &files[i..] {
                     let _ = std::fs::remove_file(t);
                 }
-                return Err(CliError::new(format!("{}: cannot write: {e}", path.display())));
+                return Err(CliError::new(format!(
+                    "{}: cannot write: {e}",
+                    path.display()
+                )));
             }
         }
         Ok(())

@@ -10,7 +10,6 @@ use jitterid::num_complex::Complex64;
 use jitterid::signal::{Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 
-
 /// `|X(f)|` of a sequence on the grid at the DFT frequencies (zero excluded).
 fn spectrum(grid: &SampleGrid, x: &[f64]) -> Vec<(f64, Complex64)> {
     let set = FrequencySet::dft(grid);
@@ -27,7 +26,11 @@ fn spectrum(grid: &SampleGrid, x: &[f64]) -> Vec<(f64, Complex64)> {
 }
 
 /// `μ_Y(f)` of a signal under a jitter (the DTFT of `m_k`).
-fn moment(grid: &SampleGrid, signal: &AnySignal, jitter: &dyn JitterModel) -> Vec<(f64, Complex64)> {
+fn moment(
+    grid: &SampleGrid,
+    signal: &AnySignal,
+    jitter: &dyn JitterModel,
+) -> Vec<(f64, Complex64)> {
     spectrum(grid, &signal.expected_values(grid, jitter))
 }
 
@@ -45,7 +48,11 @@ fn log_band(grid: &SampleGrid) -> Vec<f64> {
         .collect()
 }
 
-fn bode_points(signal: &AnySignal, fs: &[f64]) -> Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)> {
+/// Points of a curve.
+type Curve = Vec<(f64, f64)>;
+
+/// Magnitude and unwrapped phase (degrees) of `G(i2πf)`.
+fn bode_points(signal: &AnySignal, fs: &[f64]) -> Option<(Curve, Curve)> {
     let mut mag = Vec::with_capacity(fs.len());
     let mut phase = Vec::with_capacity(fs.len());
     let mut prev: Option<f64> = None;
@@ -92,19 +99,35 @@ fn tau_axis(jitters: &[&AnyJitter], extra: &[f64]) -> Vec<f64> {
     let pad = 0.05 * (hi - lo);
     let (lo, hi) = (lo - pad, hi + pad);
     let m = 400;
-    (0..=m).map(|i| lo + (hi - lo) * i as f64 / m as f64).collect()
+    (0..=m)
+        .map(|i| lo + (hi - lo) * i as f64 / m as f64)
+        .collect()
 }
 
-fn pdf_series(label: &str, color: &'static str, j: &AnyJitter, taus: &[f64], dashed: bool) -> Vec<Series> {
+fn pdf_series(
+    label: &str,
+    color: &'static str,
+    j: &AnyJitter,
+    taus: &[f64],
+    dashed: bool,
+) -> Vec<Series> {
     let mut out = Vec::new();
     if !j.pieces().is_empty() {
         let pts = taus.iter().map(|&t| (t, j.pdf(t))).collect();
-        out.push(if dashed { Series::dashed(label, color, pts) } else { Series::line(label, color, pts) });
+        out.push(if dashed {
+            Series::dashed(label, color, pts)
+        } else {
+            Series::line(label, color, pts)
+        });
     }
     let atoms = j.atoms();
     if !atoms.is_empty() {
         out.push(Series {
-            label: if out.is_empty() { format!("{label} (point masses)") } else { String::new() },
+            label: if out.is_empty() {
+                format!("{label} (point masses)")
+            } else {
+                String::new()
+            },
             color,
             opacity: 0.9,
             style: Style::Stems,
@@ -156,7 +179,14 @@ pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
                 .filter(|(_, (_, u))| u.norm() > 1e-3 * umax)
                 .map(|((f, y), (_, u))| (*f, y / u))
                 .collect();
-            mag.push(Series::markers("data Y/U", GREY, etfe.iter().map(|(f, z)| (*f, z.norm())).collect()).with_opacity(0.45));
+            mag.push(
+                Series::markers(
+                    "data Y/U",
+                    GREY,
+                    etfe.iter().map(|(f, z)| (*f, z.norm())).collect(),
+                )
+                .with_opacity(0.45),
+            );
         }
         let mut add = |label: &str, color: &'static str, dashed: bool, s: &AnySignal| {
             if let Some((m, ph_)) = bode_points(s, &fs) {
@@ -182,8 +212,23 @@ pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
                 "Bode diagram",
                 &title,
                 &[
-                    Panel { title: "magnitude |G(i2πf)|".into(), xlabel: "frequency (Hz)".into(), ylabel: "|G|".into(), xlog: true, ylog: true, series: mag, ..Default::default() },
-                    Panel { title: "phase".into(), xlabel: "frequency (Hz)".into(), ylabel: "phase (degrees)".into(), xlog: true, series: ph, ..Default::default() },
+                    Panel {
+                        title: "magnitude |G(i2πf)|".into(),
+                        xlabel: "frequency (Hz)".into(),
+                        ylabel: "|G|".into(),
+                        xlog: true,
+                        ylog: true,
+                        series: mag,
+                        ..Default::default()
+                    },
+                    Panel {
+                        title: "phase".into(),
+                        xlabel: "frequency (Hz)".into(),
+                        ylabel: "phase (degrees)".into(),
+                        xlog: true,
+                        series: ph,
+                        ..Default::default()
+                    },
                 ],
                 1,
             ),
@@ -192,35 +237,89 @@ pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
 
     // The data's |Y(f)| against the models' first moments.
     let mut sp = vec![Series::markers("data |Y(f)|", GREY, abs_points(&data))];
-    sp.push(Series::line("experiment file, μ_Y", BLACK, abs_points(&moment(grid, p.file_model, &exp.jitter.truth))));
+    sp.push(Series::line(
+        "experiment file, μ_Y",
+        BLACK,
+        abs_points(&moment(grid, p.file_model, &exp.jitter.truth)),
+    ));
     if let Some(ls) = p.ls {
-        sp.push(Series::dashed("naive LS, μ_Y without jitter", RED, abs_points(&moment(grid, &ls.signal, &NoJitter))));
+        sp.push(Series::dashed(
+            "naive LS, μ_Y without jitter",
+            RED,
+            abs_points(&moment(grid, &ls.signal, &NoJitter)),
+        ));
     }
-    sp.push(Series::line(&format!("{main_label}, μ_Y"), BLUE, abs_points(&moment(grid, &main.signal, &main.jitter))).with_width(1.4));
+    sp.push(
+        Series::line(
+            &format!("{main_label}, μ_Y"),
+            BLUE,
+            abs_points(&moment(grid, &main.signal, &main.jitter)),
+        )
+        .with_width(1.4),
+    );
     out.push((
         "spectrum.svg".to_string(),
         figure(
             "Data |Y(f)| and model first moments |μ_Y(f)|",
             &title,
-            &[Panel { title: "|Y(f)| and |μ_Y(f)| on the DFT grid".into(), xlabel: "frequency (Hz)".into(), ylabel: "magnitude".into(), ylog: true, series: sp, ..Default::default() }],
+            &[Panel {
+                title: "|Y(f)| and |μ_Y(f)| on the DFT grid".into(),
+                xlabel: "frequency (Hz)".into(),
+                ylabel: "magnitude".into(),
+                ylog: true,
+                series: sp,
+                ..Default::default()
+            }],
             1,
         ),
     ));
 
-    out.push(("moment.svg".to_string(), moment_figure(&title, grid, &main.signal, &main.jitter, main_label, Some(&exp.jitter.truth))));
-    let est: Vec<(&str, &AnyJitter)> = if main.estimate_jitter { vec![(main_label, &main.jitter)] } else { Vec::new() };
-    out.push(("jitter-pdf.svg".to_string(), jitter_figure(&title, &exp.jitter.truth, &est, p.tau)));
+    out.push((
+        "moment.svg".to_string(),
+        moment_figure(
+            &title,
+            grid,
+            &main.signal,
+            &main.jitter,
+            main_label,
+            Some(&exp.jitter.truth),
+        ),
+    ));
+    let est: Vec<(&str, &AnyJitter)> = if main.estimate_jitter {
+        vec![(main_label, &main.jitter)]
+    } else {
+        Vec::new()
+    };
+    out.push((
+        "jitter-pdf.svg".to_string(),
+        jitter_figure(&title, &exp.jitter.truth, &est, p.tau),
+    ));
     Ok(out)
 }
 
 /// `|μ_Y(f)|` with and without the jitter's damping, and `|γ(f)|`.
-fn moment_figure(title: &str, grid: &SampleGrid, signal: &AnySignal, jitter: &AnyJitter, label: &str, reference: Option<&AnyJitter>) -> String {
+fn moment_figure(
+    title: &str,
+    grid: &SampleGrid,
+    signal: &AnySignal,
+    jitter: &AnyJitter,
+    label: &str,
+    reference: Option<&AnyJitter>,
+) -> String {
     let damped = moment(grid, signal, jitter);
     let undamped = moment(grid, signal, &NoJitter);
     let fs: Vec<f64> = damped.iter().map(|x| x.0).collect();
-    let mut gam = vec![Series::line(&format!("|γ(f)|, {label}"), BLUE, fs.iter().map(|&f| (f, jitter.cf(f).norm())).collect())];
+    let mut gam = vec![Series::line(
+        &format!("|γ(f)|, {label}"),
+        BLUE,
+        fs.iter().map(|&f| (f, jitter.cf(f).norm())).collect(),
+    )];
     if let Some(r) = reference {
-        gam.push(Series::dashed("|γ(f)|, experiment file", BLACK, fs.iter().map(|&f| (f, r.cf(f).norm())).collect()));
+        gam.push(Series::dashed(
+            "|γ(f)|, experiment file",
+            BLACK,
+            fs.iter().map(|&f| (f, r.cf(f).norm())).collect(),
+        ));
     }
     figure(
         "Jitter damping of the first moment",
@@ -251,7 +350,12 @@ fn moment_figure(title: &str, grid: &SampleGrid, signal: &AnySignal, jitter: &An
 }
 
 /// True and estimated jitter densities (point masses as stems), with a histogram of known `τ`.
-fn jitter_figure(title: &str, truth: &AnyJitter, estimates: &[(&str, &AnyJitter)], tau: Option<&[f64]>) -> String {
+fn jitter_figure(
+    title: &str,
+    truth: &AnyJitter,
+    estimates: &[(&str, &AnyJitter)],
+    tau: Option<&[f64]>,
+) -> String {
     let mut all: Vec<&AnyJitter> = vec![truth];
     all.extend(estimates.iter().map(|e| e.1));
     let taus = tau_axis(&all, &[]);
@@ -264,18 +368,35 @@ fn jitter_figure(title: &str, truth: &AnyJitter, estimates: &[(&str, &AnyJitter)
             color: GREEN,
             opacity: 0.35,
             style: Style::Bars { width },
-            points: bars.into_iter().map(|(x, c)| (x, c / (n * width))).collect(),
+            points: bars
+                .into_iter()
+                .map(|(x, c)| (x, c / (n * width)))
+                .collect(),
         });
     }
     series.extend(pdf_series("experiment file", BLACK, truth, &taus, false));
     for (i, (label, j)) in estimates.iter().enumerate() {
         let color = if i == 0 { BLUE } else { RED };
-        series.extend(pdf_series(&format!("{label} estimate"), color, j, &taus, true));
+        series.extend(pdf_series(
+            &format!("{label} estimate"),
+            color,
+            j,
+            &taus,
+            true,
+        ));
     }
     figure(
         "Jitter density",
         title,
-        &[Panel { title: "p(τ)".into(), xlabel: "τ (s)".into(), ylabel: "density (1/s)".into(), y_from_zero: true, yrange: pdf_yrange(truth, &taus), series, ..Default::default() }],
+        &[Panel {
+            title: "p(τ)".into(),
+            xlabel: "τ (s)".into(),
+            ylabel: "density (1/s)".into(),
+            y_from_zero: true,
+            yrange: pdf_yrange(truth, &taus),
+            series,
+            ..Default::default()
+        }],
         1,
     )
 }
@@ -322,18 +443,55 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
             let (bars, width) = svg::histogram(&v);
             let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
             let mean = finite.iter().sum::<f64>() / finite.len().max(1) as f64;
-            let mut series = vec![Series { label: format!("{} runs", finite.len()), color: BLUE, opacity: 0.55, style: Style::Bars { width }, points: bars }];
+            let mut series = vec![Series {
+                label: format!("{} runs", finite.len()),
+                color: BLUE,
+                opacity: 0.55,
+                style: Style::Bars { width },
+                points: bars,
+            }];
             if let Some(t) = p.truth.get(i).copied().flatten() {
-                series.push(Series { label: "true".into(), color: BLACK, opacity: 1.0, style: Style::VRule { dash: None }, points: vec![(t, 0.0)] });
+                series.push(Series {
+                    label: "true".into(),
+                    color: BLACK,
+                    opacity: 1.0,
+                    style: Style::VRule { dash: None },
+                    points: vec![(t, 0.0)],
+                });
             }
             if !finite.is_empty() {
-                series.push(Series { label: "mean".into(), color: RED, opacity: 1.0, style: Style::VRule { dash: Some("6 4") }, points: vec![(mean, 0.0)] });
+                series.push(Series {
+                    label: "mean".into(),
+                    color: RED,
+                    opacity: 1.0,
+                    style: Style::VRule { dash: Some("6 4") },
+                    points: vec![(mean, 0.0)],
+                });
             }
-            Panel { title: name.clone(), xlabel: "estimate".into(), ylabel: "count".into(), y_from_zero: true, series, ..Default::default() }
+            Panel {
+                title: name.clone(),
+                xlabel: "estimate".into(),
+                ylabel: "count".into(),
+                y_from_zero: true,
+                series,
+                ..Default::default()
+            }
         })
         .collect();
     let cols = if panels.len() <= 1 { 1 } else { 2 };
-    out.push(("histograms.svg".to_string(), figure(&format!("Monte Carlo estimates ({}, {} converged runs)", p.method, p.values.len()), &title, &panels, cols)));
+    out.push((
+        "histograms.svg".to_string(),
+        figure(
+            &format!(
+                "Monte Carlo estimates ({}, {} converged runs)",
+                p.method,
+                p.values.len()
+            ),
+            &title,
+            &panels,
+            cols,
+        ),
+    ));
 
     let grid = &exp.grid;
     if exp.system.estimate && p.true_signal.frequency_response(0.0).is_some() {
@@ -342,9 +500,21 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
         let mut ph = Vec::new();
         for (k, s) in p.fitted.iter().enumerate() {
             if let Some((m, a)) = bode_points(&s.signal, &fs) {
-                let label = if k == 0 { format!("{} estimates", p.method) } else { String::new() };
-                mag.push(Series::line(&label, BLUE, m).with_opacity(0.3).with_width(1.0));
-                ph.push(Series::line(&label, BLUE, a).with_opacity(0.3).with_width(1.0));
+                let label = if k == 0 {
+                    format!("{} estimates", p.method)
+                } else {
+                    String::new()
+                };
+                mag.push(
+                    Series::line(&label, BLUE, m)
+                        .with_opacity(0.3)
+                        .with_width(1.0),
+                );
+                ph.push(
+                    Series::line(&label, BLUE, a)
+                        .with_opacity(0.3)
+                        .with_width(1.0),
+                );
             }
         }
         if let Some((m, a)) = bode_points(p.true_signal, &fs) {
@@ -354,11 +524,29 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
         out.push((
             "bode.svg".to_string(),
             figure(
-                &format!("Bode diagram, true and estimated ({} runs shown)", p.fitted.len()),
+                &format!(
+                    "Bode diagram, true and estimated ({} runs shown)",
+                    p.fitted.len()
+                ),
                 &title,
                 &[
-                    Panel { title: "magnitude |G(i2πf)|".into(), xlabel: "frequency (Hz)".into(), ylabel: "|G|".into(), xlog: true, ylog: true, series: mag, ..Default::default() },
-                    Panel { title: "phase".into(), xlabel: "frequency (Hz)".into(), ylabel: "phase (degrees)".into(), xlog: true, series: ph, ..Default::default() },
+                    Panel {
+                        title: "magnitude |G(i2πf)|".into(),
+                        xlabel: "frequency (Hz)".into(),
+                        ylabel: "|G|".into(),
+                        xlog: true,
+                        ylog: true,
+                        series: mag,
+                        ..Default::default()
+                    },
+                    Panel {
+                        title: "phase".into(),
+                        xlabel: "frequency (Hz)".into(),
+                        ylabel: "phase (degrees)".into(),
+                        xlog: true,
+                        series: ph,
+                        ..Default::default()
+                    },
                 ],
                 1,
             ),
@@ -371,7 +559,11 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
         let taus = tau_axis(&all, &[]);
         let mut series = Vec::new();
         for (k, (_, j)) in est.iter().enumerate() {
-            let label = if k == 0 { format!("{} estimates", p.method) } else { String::new() };
+            let label = if k == 0 {
+                format!("{} estimates", p.method)
+            } else {
+                String::new()
+            };
             for s in pdf_series(&label, BLUE, j, &taus, false) {
                 series.push(s.with_opacity(0.3).with_width(1.0));
             }
@@ -380,13 +572,34 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
         out.push((
             "jitter-pdf.svg".to_string(),
             figure(
-                &format!("Jitter density, true and estimated ({} runs shown)", est.len()),
+                &format!(
+                    "Jitter density, true and estimated ({} runs shown)",
+                    est.len()
+                ),
                 &title,
-                &[Panel { title: "p(τ)".into(), xlabel: "τ (s)".into(), ylabel: "density (1/s)".into(), y_from_zero: true, yrange: pdf_yrange(&exp.jitter.truth, &taus), series, ..Default::default() }],
+                &[Panel {
+                    title: "p(τ)".into(),
+                    xlabel: "τ (s)".into(),
+                    ylabel: "density (1/s)".into(),
+                    y_from_zero: true,
+                    yrange: pdf_yrange(&exp.jitter.truth, &taus),
+                    series,
+                    ..Default::default()
+                }],
                 1,
             ),
         ));
     }
-    out.push(("moment.svg".to_string(), moment_figure(&format!("{title} (realisation 0)"), grid, p.true_signal, &exp.jitter.truth, "true", None)));
+    out.push((
+        "moment.svg".to_string(),
+        moment_figure(
+            &format!("{title} (realisation 0)"),
+            grid,
+            p.true_signal,
+            &exp.jitter.truth,
+            "true",
+            None,
+        ),
+    ));
     out
 }

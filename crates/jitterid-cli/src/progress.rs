@@ -50,7 +50,10 @@ impl Progress {
         let filled = (done.min(total) * WIDTH / total) as usize;
         let secs = self.start.elapsed().as_secs_f64();
         let eta = if done > 0 && done < total {
-            format!(", ~{:.0} s left", secs / done as f64 * (total - done) as f64)
+            format!(
+                ", ~{:.0} s left",
+                secs / done as f64 * (total - done) as f64
+            )
         } else {
             String::new()
         };

@@ -63,15 +63,39 @@ pub struct Series {
 impl Series {
     /// A solid line.
     pub fn line(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Self {
-        Self { label: label.into(), color, opacity: 1.0, style: Style::Line { width: 1.8, dash: None }, points }
+        Self {
+            label: label.into(),
+            color,
+            opacity: 1.0,
+            style: Style::Line {
+                width: 1.8,
+                dash: None,
+            },
+            points,
+        }
     }
     /// A dashed line.
     pub fn dashed(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Self {
-        Self { label: label.into(), color, opacity: 1.0, style: Style::Line { width: 1.8, dash: Some("6 4") }, points }
+        Self {
+            label: label.into(),
+            color,
+            opacity: 1.0,
+            style: Style::Line {
+                width: 1.8,
+                dash: Some("6 4"),
+            },
+            points,
+        }
     }
     /// Markers.
     pub fn markers(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Self {
-        Self { label: label.into(), color, opacity: 0.75, style: Style::Markers { radius: 2.2 }, points }
+        Self {
+            label: label.into(),
+            color,
+            opacity: 0.75,
+            style: Style::Markers { radius: 2.2 },
+            points,
+        }
     }
     /// Sets the opacity.
     pub fn with_opacity(mut self, o: f64) -> Self {
@@ -109,7 +133,10 @@ pub struct Panel {
 }
 
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 /// A compact label for a tick value.
@@ -197,7 +224,13 @@ impl Axis {
             let pad = 0.03 * (b - a).max(0.1);
             let (a, b) = (a - pad, b + pad);
             let decades = b - a;
-            let mantissas: &[f64] = if decades > 4.0 { &[1.0] } else if decades > 1.5 { &[1.0, 3.0] } else { &[1.0, 2.0, 5.0] };
+            let mantissas: &[f64] = if decades > 4.0 {
+                &[1.0]
+            } else if decades > 1.5 {
+                &[1.0, 3.0]
+            } else {
+                &[1.0, 2.0, 5.0]
+            };
             let mut ticks = Vec::new();
             let mut e = a.floor() as i32;
             while f64::from(e) <= b.ceil() && ticks.len() < 40 {
@@ -210,10 +243,20 @@ impl Axis {
                 }
                 e += 1;
             }
-            Axis { lo: 10f64.powf(a), hi: 10f64.powf(b), log, ticks }
+            Axis {
+                lo: 10f64.powf(a),
+                hi: 10f64.powf(b),
+                log,
+                ticks,
+            }
         } else {
             let (a, b, t, step) = linear_ticks(lo, hi);
-            Axis { lo: a, hi: b, log, ticks: t.into_iter().map(|v| (v, fmt_tick(v, step))).collect() }
+            Axis {
+                lo: a,
+                hi: b,
+                log,
+                ticks: t.into_iter().map(|v| (v, fmt_tick(v, step))).collect(),
+            }
         }
     }
 
@@ -380,12 +423,16 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
         s,
         r#"<clipPath id="clip{id}"><rect x="{ox}" y="{oy}" width="{w}" height="{h}"/></clipPath><g clip-path="url(#clip{id})">"#
     );
-    let ok = |x: f64, y: f64| x.is_finite() && y.is_finite() && (!p.xlog || x > 0.0) && (!p.ylog || y > 0.0);
+    let ok = |x: f64, y: f64| {
+        x.is_finite() && y.is_finite() && (!p.xlog || x > 0.0) && (!p.ylog || y > 0.0)
+    };
     for se in &p.series {
         let op = se.opacity;
         match &se.style {
             Style::Line { width, dash } => {
-                let dash = dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default();
+                let dash = dash
+                    .map(|d| format!(r#" stroke-dasharray="{d}""#))
+                    .unwrap_or_default();
                 let mut run: Vec<String> = Vec::new();
                 let flush = |run: &mut Vec<String>, s: &mut String| {
                     if run.len() >= 2 {
@@ -400,7 +447,11 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
                 };
                 for &(x, y) in &se.points {
                     if ok(x, y) {
-                        run.push(format!("{:.1},{:.1}", px(x), py(y).clamp(oy - 2.0 * h, oy + 3.0 * h)));
+                        run.push(format!(
+                            "{:.1},{:.1}",
+                            px(x),
+                            py(y).clamp(oy - 2.0 * h, oy + 3.0 * h)
+                        ));
                     } else {
                         flush(&mut run, s);
                     }
@@ -439,7 +490,9 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
                 }
             }
             Style::VRule { dash } => {
-                let dash = dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default();
+                let dash = dash
+                    .map(|d| format!(r#" stroke-dasharray="{d}""#))
+                    .unwrap_or_default();
                 for &(x, _) in &se.points {
                     if x.is_finite() && (!p.xlog || x > 0.0) {
                         let _ = writeln!(
@@ -473,7 +526,13 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
     // Legend.
     let entries: Vec<&Series> = p.series.iter().filter(|se| !se.label.is_empty()).collect();
     if !entries.is_empty() {
-        let lw = entries.iter().map(|e| e.label.chars().count()).max().unwrap_or(0) as f64 * 6.8 + 40.0;
+        let lw = entries
+            .iter()
+            .map(|e| e.label.chars().count())
+            .max()
+            .unwrap_or(0) as f64
+            * 6.8
+            + 40.0;
         let lh = entries.len() as f64 * 16.0 + 8.0;
         let lx = ox + w - lw - 8.0;
         let ly = oy + 8.0;
@@ -484,8 +543,19 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
         for (i, e) in entries.iter().enumerate() {
             let y = ly + 14.0 + i as f64 * 16.0;
             let sym = match &e.style {
-                Style::Markers { .. } => format!(r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#, lx + 16.0, y - 4.0, e.color),
-                Style::Bars { .. } => format!(r#"<rect x="{:.1}" y="{:.1}" width="14" height="9" fill="{}" fill-opacity="{}"/>"#, lx + 9.0, y - 9.0, e.color, e.opacity),
+                Style::Markers { .. } => format!(
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#,
+                    lx + 16.0,
+                    y - 4.0,
+                    e.color
+                ),
+                Style::Bars { .. } => format!(
+                    r#"<rect x="{:.1}" y="{:.1}" width="14" height="9" fill="{}" fill-opacity="{}"/>"#,
+                    lx + 9.0,
+                    y - 9.0,
+                    e.color,
+                    e.opacity
+                ),
                 Style::Line { dash, .. } | Style::VRule { dash } => format!(
                     r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"{}/>"#,
                     lx + 6.0,
@@ -493,9 +563,16 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
                     lx + 26.0,
                     y - 4.0,
                     e.color,
-                    dash.map(|d| format!(r#" stroke-dasharray="{d}""#)).unwrap_or_default()
+                    dash.map(|d| format!(r#" stroke-dasharray="{d}""#))
+                        .unwrap_or_default()
                 ),
-                Style::Stems => format!(r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-width="2"/>"#, lx + 16.0, y - 10.0, y, e.color),
+                Style::Stems => format!(
+                    r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-width="2"/>"#,
+                    lx + 16.0,
+                    y - 10.0,
+                    y,
+                    e.color
+                ),
             };
             let _ = writeln!(
                 s,
@@ -522,15 +599,27 @@ pub fn histogram(values: &[f64]) -> (Vec<(f64, f64)>, f64) {
             counts[(x - lo) as usize] += 1;
         }
         return (
-            counts.iter().enumerate().map(|(i, &c)| (lo + i as f64, c as f64)).collect(),
+            counts
+                .iter()
+                .enumerate()
+                .map(|(i, &c)| (lo + i as f64, c as f64))
+                .collect(),
             0.9,
         );
     }
     let bins = ((v.len() as f64).sqrt().ceil() as usize).clamp(1, 30);
-    let width = if hi > lo { (hi - lo) / bins as f64 } else { (lo.abs() * 0.01).max(1e-6) };
+    let width = if hi > lo {
+        (hi - lo) / bins as f64
+    } else {
+        (lo.abs() * 0.01).max(1e-6)
+    };
     let mut counts = vec![0usize; bins];
     for x in &v {
-        let i = if hi > lo { (((x - lo) / width) as usize).min(bins - 1) } else { 0 };
+        let i = if hi > lo {
+            (((x - lo) / width) as usize).min(bins - 1)
+        } else {
+            0
+        };
         counts[i] += 1;
     }
     let base = if hi > lo { lo } else { lo - width / 2.0 };

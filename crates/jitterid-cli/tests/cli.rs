@@ -22,18 +22,25 @@ fn stderr(o: &Output) -> String {
 
 fn ok(args: &[&str]) -> String {
     let o = run(args);
-    assert!(o.status.success(), "jitterid {args:?} failed: {}", stderr(&o));
+    assert!(
+        o.status.success(),
+        "jitterid {args:?} failed: {}",
+        stderr(&o)
+    );
     stdout(&o)
 }
 
 fn json(args: &[&str]) -> Value {
     let text = ok(args);
-    serde_json::from_str(&text).unwrap_or_else(|e| panic!("jitterid {args:?}: not JSON ({e}): {text}"))
+    serde_json::from_str(&text)
+        .unwrap_or_else(|e| panic!("jitterid {args:?}: not JSON ({e}): {text}"))
 }
 
 /// A fresh, empty directory for one test.
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("jitterid-cli").join(name);
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("jitterid-cli")
+        .join(name);
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -64,7 +71,10 @@ fn s(p: &Path) -> &str {
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map(|r| r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect())
+        .map(|r| {
+            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
         .unwrap_or_default();
     v.sort();
     v
@@ -97,7 +107,15 @@ fn simulate_then_fit_every_example() {
     for exp in examples() {
         let stem = exp.file_stem().unwrap().to_string_lossy().into_owned();
         let data = dir.join(format!("{stem}.csv"));
-        let report = ok(&["simulate", s(&exp), "--seed", "7", "--out", s(&data), "--truth"]);
+        let report = ok(&[
+            "simulate",
+            s(&exp),
+            "--seed",
+            "7",
+            "--out",
+            s(&data),
+            "--truth",
+        ]);
         assert!(report.contains("samples"), "{report}");
         let text = std::fs::read_to_string(&data).unwrap();
         let header = text.lines().next().unwrap();
@@ -109,7 +127,10 @@ fn simulate_then_fit_every_example() {
         let params = fit["parameters"].as_array().unwrap();
         assert!(!params.is_empty(), "{stem}");
         for p in params {
-            assert!(p["name"].is_string() && p["estimate"].is_number(), "{stem}: {p}");
+            assert!(
+                p["name"].is_string() && p["estimate"].is_number(),
+                "{stem}: {p}"
+            );
         }
         // The readable table has the same parameters.
         let table = ok(&["fit", s(&exp), "--data", s(&data)]);
@@ -126,9 +147,24 @@ fn simulate_then_fit_every_example() {
 fn table2_fit_is_close_to_the_truth_and_plots() {
     let dir = scratch("table2-fit");
     let data = dir.join("d.csv");
-    ok(&["simulate", &example("table2.toml"), "--seed", "3", "--out", s(&data)]);
+    ok(&[
+        "simulate",
+        &example("table2.toml"),
+        "--seed",
+        "3",
+        "--out",
+        s(&data),
+    ]);
     let plots = dir.join("figures");
-    let fit = json(&["fit", &example("table2.toml"), "--data", s(&data), "--json", "--plot", s(&plots)]);
+    let fit = json(&[
+        "fit",
+        &example("table2.toml"),
+        "--data",
+        s(&data),
+        "--json",
+        "--plot",
+        s(&plots),
+    ]);
     let truth = [0.2, -0.5, -0.25, 0.3];
     let names = ["gain", "zero0", "pole0.re", "pole0.im"];
     let params = fit["parameters"].as_array().unwrap();
@@ -139,16 +175,30 @@ fn table2_fit_is_close_to_the_truth_and_plots() {
         let se = p["stderr"].as_f64().unwrap();
         assert!((e - t).abs() < 5.0 * se, "{n}: {e} ± {se} vs {t}");
     }
-    assert_eq!(files_in(&plots), ["bode.svg", "jitter-pdf.svg", "moment.svg", "spectrum.svg"]);
+    assert_eq!(
+        files_in(&plots),
+        ["bode.svg", "jitter-pdf.svg", "moment.svg", "spectrum.svg"]
+    );
     for f in files_in(&plots) {
         let svg = std::fs::read_to_string(plots.join(&f)).unwrap();
-        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{f}");
+        assert!(
+            svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{f}"
+        );
         assert!(svg.contains("<polyline"), "{f} draws no curve");
     }
     let bode = std::fs::read_to_string(plots.join("bode.svg")).unwrap();
     assert!(bode.contains("naive LS") && bode.contains("bcls") && bode.contains("data Y/U"));
     // Naive LS on the same data, by the command-line override.
-    let ls = json(&["fit", &example("table2.toml"), "--data", s(&data), "--json", "--method", "ls"]);
+    let ls = json(&[
+        "fit",
+        &example("table2.toml"),
+        "--data",
+        s(&data),
+        "--json",
+        "--method",
+        "ls",
+    ]);
     assert_eq!(ls["method"], "ls");
 }
 
@@ -163,7 +213,15 @@ fn fit_reads_the_input_from_the_side_file_or_input_flag() {
     let o = run(&["fit", &example("table2.toml"), "--data", s(&data)]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("d.input.csv"), "{}", stderr(&o));
-    let b = json(&["fit", &example("table2.toml"), "--data", s(&data), "--json", "--input", s(&moved)]);
+    let b = json(&[
+        "fit",
+        &example("table2.toml"),
+        "--data",
+        s(&data),
+        "--json",
+        "--input",
+        s(&moved),
+    ]);
     assert_eq!(a["parameters"], b["parameters"]);
 }
 
@@ -174,9 +232,36 @@ fn simulate_is_montecarlo_realisation() {
     let a = dir.join("a.csv");
     let b = dir.join("b.csv");
     let c = dir.join("c.csv");
-    ok(&["simulate", &example("table2.toml"), "--seed", "11", "--run", "2", "--out", s(&a)]);
-    ok(&["simulate", &example("table2.toml"), "--seed", "11", "--run", "2", "--out", s(&b)]);
-    ok(&["simulate", &example("table2.toml"), "--seed", "11", "--run", "3", "--out", s(&c)]);
+    ok(&[
+        "simulate",
+        &example("table2.toml"),
+        "--seed",
+        "11",
+        "--run",
+        "2",
+        "--out",
+        s(&a),
+    ]);
+    ok(&[
+        "simulate",
+        &example("table2.toml"),
+        "--seed",
+        "11",
+        "--run",
+        "2",
+        "--out",
+        s(&b),
+    ]);
+    ok(&[
+        "simulate",
+        &example("table2.toml"),
+        "--seed",
+        "11",
+        "--run",
+        "3",
+        "--out",
+        s(&c),
+    ]);
     let read = |p: &Path| std::fs::read_to_string(p).unwrap();
     assert_eq!(read(&a), read(&b));
     assert_ne!(read(&a), read(&c));
@@ -188,7 +273,15 @@ fn montecarlo_every_example() {
         let stem = exp.file_stem().unwrap().to_string_lossy().into_owned();
         // Table 1 profiles n over ten values per fit: fewer runs keep the debug build quick.
         let runs = if stem.starts_with("table1") { "2" } else { "4" };
-        let j = json(&["montecarlo", s(&exp), "--runs", runs, "--seed", "5", "--json"]);
+        let j = json(&[
+            "montecarlo",
+            s(&exp),
+            "--runs",
+            runs,
+            "--seed",
+            "5",
+            "--json",
+        ]);
         assert_eq!(j["runs"].as_u64().unwrap().to_string(), runs, "{stem}");
         assert_eq!(j["method"], "bcls");
         assert!(j["seconds"].as_f64().unwrap() >= 0.0);
@@ -213,17 +306,53 @@ fn montecarlo_every_example() {
 
 #[test]
 fn table2_parameters_are_in_model_order() {
-    let j = json(&["montecarlo", &example("table2.toml"), "--runs", "2", "--json"]);
-    let names: Vec<&str> = j["parameters"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    let j = json(&[
+        "montecarlo",
+        &example("table2.toml"),
+        "--runs",
+        "2",
+        "--json",
+    ]);
+    let names: Vec<&str> = j["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
     assert_eq!(names, ["gain", "zero0", "pole0.re", "pole0.im"]);
-    let truth: Vec<f64> = j["parameters"].as_array().unwrap().iter().map(|p| p["true"].as_f64().unwrap()).collect();
+    let truth: Vec<f64> = j["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["true"].as_f64().unwrap())
+        .collect();
     assert_eq!(truth, [0.2, -0.5, -0.25, 0.3]);
 }
 
 #[test]
 fn montecarlo_does_not_depend_on_threads() {
-    let one = json(&["montecarlo", &example("table2.toml"), "--runs", "6", "--seed", "9", "--threads", "1", "--json"]);
-    let two = json(&["montecarlo", &example("table2.toml"), "--runs", "6", "--seed", "9", "--threads", "2", "--json"]);
+    let one = json(&[
+        "montecarlo",
+        &example("table2.toml"),
+        "--runs",
+        "6",
+        "--seed",
+        "9",
+        "--threads",
+        "1",
+        "--json",
+    ]);
+    let two = json(&[
+        "montecarlo",
+        &example("table2.toml"),
+        "--runs",
+        "6",
+        "--seed",
+        "9",
+        "--threads",
+        "2",
+        "--json",
+    ]);
     assert_eq!(one["parameters"], two["parameters"]);
     assert_eq!(one["converged"], two["converged"]);
 }
@@ -235,8 +364,32 @@ fn shards_merge_to_the_unsharded_study() {
     let whole = json(&["montecarlo", &exp, "--runs", "7", "--seed", "4", "--json"]);
     let s0 = dir.join("s0.json");
     let s1 = dir.join("s1.json");
-    ok(&["montecarlo", &exp, "--runs", "7", "--seed", "4", "--json", "--shard", "0/2", "--out", s(&s0)]);
-    ok(&["montecarlo", &exp, "--runs", "7", "--seed", "4", "--json", "--shard", "1/2", "--out", s(&s1)]);
+    ok(&[
+        "montecarlo",
+        &exp,
+        "--runs",
+        "7",
+        "--seed",
+        "4",
+        "--json",
+        "--shard",
+        "0/2",
+        "--out",
+        s(&s0),
+    ]);
+    ok(&[
+        "montecarlo",
+        &exp,
+        "--runs",
+        "7",
+        "--seed",
+        "4",
+        "--json",
+        "--shard",
+        "1/2",
+        "--out",
+        s(&s1),
+    ]);
     let shard0: Value = serde_json::from_str(&std::fs::read_to_string(&s0).unwrap()).unwrap();
     assert_eq!(shard0["runs"], 3);
     assert_eq!(shard0["realizations"].as_array().unwrap().len(), 3);
@@ -247,7 +400,11 @@ fn shards_merge_to_the_unsharded_study() {
     // A missing shard is an error.
     let o = run(&["merge", s(&s0)]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("shard 1/2 is missing"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("shard 1/2 is missing"),
+        "{}",
+        stderr(&o)
+    );
     // The table form works too.
     assert!(ok(&["merge", s(&s0), s(&s1)]).contains("pole0.im"));
 }
@@ -256,11 +413,28 @@ fn shards_merge_to_the_unsharded_study() {
 fn montecarlo_plots() {
     let dir = scratch("mc-plots");
     let p1 = dir.join("table2");
-    ok(&["montecarlo", &example("table2.toml"), "--runs", "4", "--plot", s(&p1)]);
+    ok(&[
+        "montecarlo",
+        &example("table2.toml"),
+        "--runs",
+        "4",
+        "--plot",
+        s(&p1),
+    ]);
     assert_eq!(files_in(&p1), ["bode.svg", "histograms.svg", "moment.svg"]);
     let p2 = dir.join("table1");
-    ok(&["montecarlo", &example("table1-uniform-n2-a0.5.toml"), "--runs", "2", "--plot", s(&p2)]);
-    assert_eq!(files_in(&p2), ["histograms.svg", "jitter-pdf.svg", "moment.svg"]);
+    ok(&[
+        "montecarlo",
+        &example("table1-uniform-n2-a0.5.toml"),
+        "--runs",
+        "2",
+        "--plot",
+        s(&p2),
+    ]);
+    assert_eq!(
+        files_in(&p2),
+        ["histograms.svg", "jitter-pdf.svg", "moment.svg"]
+    );
     let h = std::fs::read_to_string(p2.join("histograms.svg")).unwrap();
     assert!(h.contains("jitter.sigma") && h.contains("<rect"));
 }
@@ -269,13 +443,22 @@ fn montecarlo_plots() {
 fn ml_is_accepted_in_files_but_not_available() {
     let dir = scratch("ml");
     let exp = dir.join("ml.toml");
-    let text = std::fs::read_to_string(example("table2.toml")).unwrap().replace("method = \"bcls\"", "method = \"ml\"");
+    let text = std::fs::read_to_string(example("table2.toml"))
+        .unwrap()
+        .replace("method = \"bcls\"", "method = \"ml\"");
     std::fs::write(&exp, text).unwrap();
     let data = dir.join("d.csv");
     ok(&["simulate", s(&exp), "--out", s(&data)]);
     for args in [
         vec!["fit", s(&exp), "--data", s(&data)],
-        vec!["fit", &example("table2.toml") as &str, "--data", s(&data), "--method", "ml"],
+        vec![
+            "fit",
+            &example("table2.toml") as &str,
+            "--data",
+            s(&data),
+            "--method",
+            "ml",
+        ],
     ] {
         let o = run(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");
@@ -287,7 +470,13 @@ fn ml_is_accepted_in_files_but_not_available() {
 
 #[test]
 fn help_and_version() {
-    for sub in [&[][..], &["simulate"], &["fit"], &["montecarlo"], &["merge"]] {
+    for sub in [
+        &[][..],
+        &["simulate"],
+        &["fit"],
+        &["montecarlo"],
+        &["merge"],
+    ] {
         let mut args: Vec<&str> = sub.to_vec();
         args.push("--help");
         let out = ok(&args);
@@ -344,7 +533,11 @@ fn bad_experiment(name: &str, text: &str, want: &[&str]) {
     for w in want {
         assert!(e.contains(w), "{name}: `{w}` not in: {e}");
     }
-    assert!(files_in(&out_dir).is_empty(), "{name}: left {:?}", files_in(&out_dir));
+    assert!(
+        files_in(&out_dir).is_empty(),
+        "{name}: left {:?}",
+        files_in(&out_dir)
+    );
 }
 
 #[test]
@@ -357,30 +550,103 @@ fn the_good_experiment_is_good() {
 
 #[test]
 fn bad_experiment_files() {
-    bad_experiment("malformed", &GOOD.replace("[system]", "[system"), &["exp.toml:9:"]);
-    bad_experiment("unknown-key", &GOOD.replace("gain = 0.2", "gian = 0.2"), &["exp.toml:11:", "gian", "did you mean `gain`"]);
-    bad_experiment("unknown-section", &format!("{GOOD}\n[estimat]\nmethod = \"ls\"\n"), &["estimat"]);
-    bad_experiment("key-of-other-kind", &GOOD.replace("gain = 0.2", "gain = 0.2\nnum = [1.0]"), &["exp.toml:12:", "[system] num", "zpk"]);
-    bad_experiment("wrong-type", &GOOD.replace("samples = 50", "samples = \"50\""), &["exp.toml:3:", "samples"]);
-    bad_experiment("wrong-type-float", &GOOD.replace("samples = 50", "samples = 50.5"), &["exp.toml:3:", "samples"]);
-    bad_experiment("missing-value", &GOOD.replace("gain = 0.2\n", ""), &["exp.toml:9:", "[system] gain", "missing"]);
-    bad_experiment("missing-section", &GOOD.replace("[sampling]\ninterval = 1.0\nsamples = 50\n", ""), &["[sampling]"]);
-    bad_experiment("nan", &GOOD.replace("gain = 0.2", "gain = nan"), &["exp.toml:11:", "gain", "finite"]);
-    bad_experiment("negative", &GOOD.replace("interval = 1.0", "interval = -1.0"), &["exp.toml:2:", "interval", "> 0"]);
-    bad_experiment("unstable", &GOOD.replace("[[-0.25, 0.3]]", "[[0.25, 0.3]]"), &["exp.toml:13:", "poles", "stable"]);
-    bad_experiment("bad-pair", &GOOD.replace("[[-0.25, 0.3]]", "[[-0.25, -0.3]]"), &["exp.toml:13:", "poles", "im > 0"]);
-    bad_experiment("unknown-family", &GOOD.replace("uniform-sum", "uniform"), &["exp.toml:17:", "family", "uniform-sum"]);
-    bad_experiment("unknown-kind", &GOOD.replace("\"zpk\"", "\"ss\""), &["exp.toml:10:", "kind"]);
-    bad_experiment("bad-method", &format!("{GOOD}\n[estimate]\nmethod = \"mle\"\n"), &["exp.toml:25:", "method"]);
-    bad_experiment("bad-frequencies", &format!("{GOOD}\n[estimate]\nfrequencies = {{ min = 0.1, maks = 0.2 }}\n"), &["exp.toml:25:", "frequencies", "maks"]);
+    bad_experiment(
+        "malformed",
+        &GOOD.replace("[system]", "[system"),
+        &["exp.toml:9:"],
+    );
+    bad_experiment(
+        "unknown-key",
+        &GOOD.replace("gain = 0.2", "gian = 0.2"),
+        &["exp.toml:11:", "gian", "did you mean `gain`"],
+    );
+    bad_experiment(
+        "unknown-section",
+        &format!("{GOOD}\n[estimat]\nmethod = \"ls\"\n"),
+        &["estimat"],
+    );
+    bad_experiment(
+        "key-of-other-kind",
+        &GOOD.replace("gain = 0.2", "gain = 0.2\nnum = [1.0]"),
+        &["exp.toml:12:", "[system] num", "zpk"],
+    );
+    bad_experiment(
+        "wrong-type",
+        &GOOD.replace("samples = 50", "samples = \"50\""),
+        &["exp.toml:3:", "samples"],
+    );
+    bad_experiment(
+        "wrong-type-float",
+        &GOOD.replace("samples = 50", "samples = 50.5"),
+        &["exp.toml:3:", "samples"],
+    );
+    bad_experiment(
+        "missing-value",
+        &GOOD.replace("gain = 0.2\n", ""),
+        &["exp.toml:9:", "[system] gain", "missing"],
+    );
+    bad_experiment(
+        "missing-section",
+        &GOOD.replace("[sampling]\ninterval = 1.0\nsamples = 50\n", ""),
+        &["[sampling]"],
+    );
+    bad_experiment(
+        "nan",
+        &GOOD.replace("gain = 0.2", "gain = nan"),
+        &["exp.toml:11:", "gain", "finite"],
+    );
+    bad_experiment(
+        "negative",
+        &GOOD.replace("interval = 1.0", "interval = -1.0"),
+        &["exp.toml:2:", "interval", "> 0"],
+    );
+    bad_experiment(
+        "unstable",
+        &GOOD.replace("[[-0.25, 0.3]]", "[[0.25, 0.3]]"),
+        &["exp.toml:13:", "poles", "stable"],
+    );
+    bad_experiment(
+        "bad-pair",
+        &GOOD.replace("[[-0.25, 0.3]]", "[[-0.25, -0.3]]"),
+        &["exp.toml:13:", "poles", "im > 0"],
+    );
+    bad_experiment(
+        "unknown-family",
+        &GOOD.replace("uniform-sum", "uniform"),
+        &["exp.toml:17:", "family", "uniform-sum"],
+    );
+    bad_experiment(
+        "unknown-kind",
+        &GOOD.replace("\"zpk\"", "\"ss\""),
+        &["exp.toml:10:", "kind"],
+    );
+    bad_experiment(
+        "bad-method",
+        &format!("{GOOD}\n[estimate]\nmethod = \"mle\"\n"),
+        &["exp.toml:25:", "method"],
+    );
+    bad_experiment(
+        "bad-frequencies",
+        &format!("{GOOD}\n[estimate]\nfrequencies = {{ min = 0.1, maks = 0.2 }}\n"),
+        &["exp.toml:25:", "frequencies", "maks"],
+    );
     bad_experiment("not-utf8", "[sampling]\ninterval = \u{0}\n", &["exp.toml"]);
     bad_experiment("empty", "", &["[sampling]"]);
     bad_experiment("input-for-sinusoid", "[sampling]\ninterval = 1.0\nsamples = 8\n[system]\nkind = \"sinusoid\"\namplitude = 1.0\nfrequency = 0.1\n[input]\nkind = \"sine\"\nfrequency = 0.1\n", &["[input]"]);
     // A file that does not exist.
     let dir = scratch("bad-exp-missing-file");
-    let o = run(&["simulate", s(&dir.join("nope.toml")), "--out", s(&dir.join("d.csv"))]);
+    let o = run(&[
+        "simulate",
+        s(&dir.join("nope.toml")),
+        "--out",
+        s(&dir.join("d.csv")),
+    ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("nope.toml: cannot read: file does not exist"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("nope.toml: cannot read: file does not exist"),
+        "{}",
+        stderr(&o)
+    );
     assert!(files_in(&dir).is_empty());
 }
 
@@ -389,7 +655,14 @@ fn bad_experiment_files() {
 fn bad_data(name: &str, csv: &str, want: &[&str]) {
     let dir = scratch(&format!("bad-data-{name}"));
     let exp = dir.join("exp.toml");
-    std::fs::write(&exp, GOOD.replace("kind = \"random-binary\"\nmean_dwell = 8.0", "kind = \"sine\"\nfrequency = 0.05")).unwrap();
+    std::fs::write(
+        &exp,
+        GOOD.replace(
+            "kind = \"random-binary\"\nmean_dwell = 8.0",
+            "kind = \"sine\"\nfrequency = 0.05",
+        ),
+    )
+    .unwrap();
     let data = dir.join("data.csv");
     std::fs::write(&data, csv).unwrap();
     let plots = dir.join("figs");
@@ -402,14 +675,24 @@ fn bad_data(name: &str, csv: &str, want: &[&str]) {
         assert!(e.contains(w), "{name}: `{w}` not in: {e}");
     }
     assert!(o.stdout.is_empty(), "{name}: printed {}", stdout(&o));
-    assert!(files_in(&plots).is_empty(), "{name}: left {:?}", files_in(&plots));
+    assert!(
+        files_in(&plots).is_empty(),
+        "{name}: left {:?}",
+        files_in(&plots)
+    );
 }
 
 /// `text` with its (1-based) line `n` replaced.
 fn with_line(text: &str, n: usize, new: &str) -> String {
     text.lines()
         .enumerate()
-        .map(|(i, l)| if i + 1 == n { new.to_string() } else { l.to_string() })
+        .map(|(i, l)| {
+            if i + 1 == n {
+                new.to_string()
+            } else {
+                l.to_string()
+            }
+        })
         .collect::<Vec<_>>()
         .join("\n")
         + "\n"
@@ -430,31 +713,84 @@ fn bad_data_files() {
     {
         let dir = scratch("good-data");
         let exp = dir.join("exp.toml");
-        std::fs::write(&exp, GOOD.replace("kind = \"random-binary\"\nmean_dwell = 8.0", "kind = \"sine\"\nfrequency = 0.05")).unwrap();
+        std::fs::write(
+            &exp,
+            GOOD.replace(
+                "kind = \"random-binary\"\nmean_dwell = 8.0",
+                "kind = \"sine\"\nfrequency = 0.05",
+            ),
+        )
+        .unwrap();
         let data = dir.join("data.csv");
         std::fs::write(&data, &good).unwrap();
         ok(&["fit", s(&exp), "--data", s(&data)]);
     }
-    bad_data("header", &good.replacen("k,t,y", "k,t,x", 1), &["data.csv:1:", "header", "`y`"]);
-    bad_data("no-header", &good.replacen("k,t,y\n", "", 1), &["data.csv:1:", "header"]);
-    bad_data("non-numeric", &with_line(&good, 7, "5,5.0,abc"), &["data.csv:7:", "column `y`", "number", "abc"]);
-    bad_data("nan", &with_line(&good, 5, "3,3.0,NaN"), &["data.csv:5:", "column `y`", "finite"]);
-    bad_data("unequal-columns", &with_line(&good, 6, "4,4.0"), &["data.csv:6:", "expected 3 cells"]);
-    bad_data("too-few-rows", &good_csv(49), &["49 data rows", "expected 50"]);
-    bad_data("wrong-times", &with_line(&good, 9, "7,7.5,0.1"), &["data.csv:9:", "column `t`"]);
-    bad_data("duplicate-column", &good.replacen("k,t,y", "k,y,y", 1), &["data.csv:1:", "twice"]);
+    bad_data(
+        "header",
+        &good.replacen("k,t,y", "k,t,x", 1),
+        &["data.csv:1:", "header", "`y`"],
+    );
+    bad_data(
+        "no-header",
+        &good.replacen("k,t,y\n", "", 1),
+        &["data.csv:1:", "header"],
+    );
+    bad_data(
+        "non-numeric",
+        &with_line(&good, 7, "5,5.0,abc"),
+        &["data.csv:7:", "column `y`", "number", "abc"],
+    );
+    bad_data(
+        "nan",
+        &with_line(&good, 5, "3,3.0,NaN"),
+        &["data.csv:5:", "column `y`", "finite"],
+    );
+    bad_data(
+        "unequal-columns",
+        &with_line(&good, 6, "4,4.0"),
+        &["data.csv:6:", "expected 3 cells"],
+    );
+    bad_data(
+        "too-few-rows",
+        &good_csv(49),
+        &["49 data rows", "expected 50"],
+    );
+    bad_data(
+        "wrong-times",
+        &with_line(&good, 9, "7,7.5,0.1"),
+        &["data.csv:9:", "column `t`"],
+    );
+    bad_data(
+        "duplicate-column",
+        &good.replacen("k,t,y", "k,y,y", 1),
+        &["data.csv:1:", "twice"],
+    );
     bad_data("empty", "", &["empty"]);
     // A data file that does not exist.
     let dir = scratch("bad-data-missing");
-    let o = run(&["fit", &example("sine.toml"), "--data", s(&dir.join("none.csv"))]);
+    let o = run(&[
+        "fit",
+        &example("sine.toml"),
+        "--data",
+        s(&dir.join("none.csv")),
+    ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("none.csv: cannot read: file does not exist"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("none.csv: cannot read: file does not exist"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
 fn no_partial_output_when_the_target_cannot_be_written() {
     let dir = scratch("unwritable");
-    let o = run(&["simulate", &example("table2.toml"), "--out", s(&dir.join("no/such/dir/d.csv"))]);
+    let o = run(&[
+        "simulate",
+        &example("table2.toml"),
+        "--out",
+        s(&dir.join("no/such/dir/d.csv")),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(stderr(&o).trim_end().lines().count(), 1);
     assert!(files_in(&dir).is_empty());

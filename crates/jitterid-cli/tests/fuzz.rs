@@ -28,7 +28,9 @@ fn example_texts() -> Vec<String> {
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .collect();
     v.sort();
-    v.iter().map(|p| std::fs::read_to_string(p).unwrap()).collect()
+    v.iter()
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect()
 }
 
 /// An empty directory: `kind = "csv"` inputs resolve against it and find nothing.
@@ -41,7 +43,10 @@ fn empty_dir() -> PathBuf {
 fn check_toml(text: &str) {
     if let Err(e) = experiment::parse("fuzz.toml", text, &empty_dir()) {
         let m = e.message();
-        assert!(!m.contains('\n') && !m.contains('\r'), "not one line: {m:?}");
+        assert!(
+            !m.contains('\n') && !m.contains('\r'),
+            "not one line: {m:?}"
+        );
         assert!(m.starts_with("fuzz.toml"), "file not named first: {m:?}");
     }
 }
@@ -55,7 +60,10 @@ fn check_csv(text: &str) {
         }
         Err(e) => {
             let m = e.message();
-            assert!(!m.contains('\n') && !m.contains('\r'), "not one line: {m:?}");
+            assert!(
+                !m.contains('\n') && !m.contains('\r'),
+                "not one line: {m:?}"
+            );
             assert!(m.starts_with("fuzz.csv"), "file not named first: {m:?}");
         }
     }
@@ -137,13 +145,22 @@ fn mutate(text: &str, edits: &[(usize, u8, String)]) -> String {
             }
             2 => {
                 // Replace the rest of the line from `at` with the token.
-                let end = chars[at..].iter().position(|c| *c == '\n').map_or(n, |p| at + p);
+                let end = chars[at..]
+                    .iter()
+                    .position(|c| *c == '\n')
+                    .map_or(n, |p| at + p);
                 chars.splice(at..end, tok.chars());
             }
             _ => {
                 // Duplicate the line at `at` (repeated keys and sections).
-                let start = chars[..at].iter().rposition(|c| *c == '\n').map_or(0, |p| p + 1);
-                let end = chars[at..].iter().position(|c| *c == '\n').map_or(n, |p| at + p + 1);
+                let start = chars[..at]
+                    .iter()
+                    .rposition(|c| *c == '\n')
+                    .map_or(0, |p| p + 1);
+                let end = chars[at..]
+                    .iter()
+                    .position(|c| *c == '\n')
+                    .map_or(n, |p| at + p + 1);
                 let line: Vec<char> = chars[start..end].to_vec();
                 chars.splice(start..start, line);
             }

@@ -1,14 +1,14 @@
 //! Tests of the maximum-likelihood layer (issue 4) through the public API.
 
 use jitterid_estimate::ml::*;
-use jitterid_estimate::{ModelStructure, Record};
+use jitterid_estimate::montecarlo::Summary;
+use jitterid_estimate::solver::{SolverError, Termination};
+use jitterid_estimate::{ArmaNoise, ModelStructure, Record};
 use jitterid_jitter::{Gaussian, JitterModel, NoJitter, TwoPoint, UniformSum};
-use jitterid_signal::{
-    simulate, LtiResponse, PiecewiseConstant, RandomBinary, Root, SampleGrid, Signal, Sinusoid,
-    Zpk,
-};
+use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Sinusoid, Zpk};
+use jitterid_window::{DirichletWindow, FrequencySet};
 use rand::rngs::StdRng;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 
 /// The Table 1 system `1/(s+2)` driven by the paper's random binary input.
 fn table1_signal(seed: u64, n: usize) -> LtiResponse<Zpk> {
@@ -83,4 +83,567 @@ fn exact_likelihood_matches_brute_force() {
         println!("{name}: worst |Δ log p| = {worst:e}");
         assert!(worst < 1e-9, "{name}: {worst}");
     }
+}
+
+/// A standard normal draw (Box–Muller).
+fn normal(rng: &mut StdRng) -> f64 {
+    let u: f64 = rng.random::<f64>().max(1e-300);
+    let v: f64 = rng.random();
+    (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+}
+
+#[test]
+fn second_moments_and_dtft_covariance_match_monte_carlo() {
+    // 4000 records of the Table 1 system (N = 40) with one input, fresh jitter and noise.
+    // Each sample mean, variance and DTFT covariance entry is compared with the model by its
+    // Monte Carlo standard error (from the empirical fourth moment), |z| ≤ 4.5: with about
+    // 200 comparisons the chance of a false alarm is below 1e-3 (and the seed is fixed).
+    let n = 40;
+    let signal = table1_signal(4, n);
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let jitter = UniformSum::new(2, 0.5).unwrap();
+    let sigma = 0.01;
+    let structure = ModelStructure::oe(signal.clone(), jitter)
+        .with_noise_std(sigma)
+        .unwrap();
+    let mom = second_moments(&structure, &grid, sigma, false).unwrap();
+    assert!(mom.variance.iter().all(|&l| l >= sigma * sigma));
+    let reps = 4000;
+    let mut rng = StdRng::seed_from_u64(77);
+    let ys: Vec<Vec<f64>> = (0..reps)
+        .map(|_| simulate(&signal, &jitter, &grid, sigma, &mut rng).unwrap().y)
+        .collect();
+    for k in 0..n {
+        let col: Vec<f64> = ys.iter().map(|y| y[k]).collect();
+        let mean = col.iter().sum::<f64>() / reps as f64;
+        let var = col.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (reps - 1) as f64;
+        let m4 = col.iter().map(|v| (v - mean).powi(4)).sum::<f64>() / reps as f64;
+        let z_mean = (mean - mom.mean[k]) / (mom.variance[k] / reps as f64).sqrt();
+        let z_var = (var - mom.variance[k]) / ((m4 - var * var).max(1e-300) / reps as f64).sqrt();
+        assert!(z_mean.abs() < 4.5, "mean of sample {k}: z = {z_mean}");
+        assert!(z_var.abs() < 4.5, "variance of sample {k}: z = {z_var}");
+    }
+    // DTFT covariance over an arbitrary list and over DFT-grid points (both code paths).
+    for freqs in [
+        FrequencySet::list(&grid, vec![0.05, 0.13, 0.3]).unwrap(),
+        FrequencySet::band(&grid, 0.0, 0.1).unwrap(),
+    ] {
+        let cov = dtft_covariance(&grid, &mom.variance, &DirichletWindow, &freqs).unwrap();
+        let flat = mom.variance.iter().sum::<f64>();
+        for a in 0..freqs.len() {
+            assert!((cov.variance(a) - flat).abs() < 1e-12 * flat, "flat noise floor");
+        }
+        let real = cov.real();
+        let f = freqs.frequencies();
+        let d: Vec<Vec<f64>> = ys
+            .iter()
+            .map(|y| {
+                let mut out = Vec::new();
+                for &fr in f {
+                    let (mut re, mut im) = (0.0, 0.0);
+                    for k in 0..n {
+                        let ph = std::f64::consts::TAU * fr * k as f64;
+                        let e = y[k] - mom.mean[k];
+                        re += e * ph.cos();
+                        im -= e * ph.sin();
+                    }
+                    out.push(re);
+                    out.push(im);
+                }
+                out
+            })
+            .collect();
+        for i in 0..2 * f.len() {
+            for j in 0..2 * f.len() {
+                let prods: Vec<f64> = d.iter().map(|v| v[i] * v[j]).collect();
+                let mean = prods.iter().sum::<f64>() / reps as f64;
+                let sd = (prods.iter().map(|p| (p - mean).powi(2)).sum::<f64>()
+                    / (reps - 1) as f64)
+                    .sqrt();
+                let z = (mean - real[i][j]) / (sd / (reps as f64).sqrt());
+                assert!(z.abs() < 4.5, "cov[{i}][{j}]: {mean} vs {}: z = {z}", real[i][j]);
+            }
+        }
+    }
+}
+
+/// A JOE structure of the Table 1 system with the gain and pole estimated.
+fn joe_structure<J: JitterModel + Clone>(jitter: J, n: usize) -> ModelStructure<LtiResponse<Zpk>, J> {
+    ModelStructure::joe(table1_signal(5, n), jitter)
+}
+
+#[test]
+fn second_moment_gradients_match_differences() {
+    let n = 30;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let structure = joe_structure(UniformSum::new(1, 0.4).unwrap(), n);
+    let theta = likelihood_params(&structure, 0.02);
+    let m = second_moments(&structure, &grid, 0.02, true).unwrap();
+    assert_eq!(m.names, vec!["gain", "pole0", "jitter.a", "noise.std"]);
+    let (dm, dl) = (m.mean_gradient.unwrap(), m.variance_gradient.unwrap());
+    for j in 0..theta.len() {
+        let h = 1e-6 * theta[j].abs().max(1e-3);
+        let at = |d: f64| {
+            let mut p = theta.clone();
+            p[j] += d;
+            let s = structure.with_params(&p[..3]).unwrap();
+            second_moments(&s, &grid, p[3], false).unwrap()
+        };
+        let (up, dn) = (at(h), at(-h));
+        for k in 0..n {
+            let fm = (up.mean[k] - dn.mean[k]) / (2.0 * h);
+            let fl = (up.variance[k] - dn.variance[k]) / (2.0 * h);
+            assert!((dm[j][k] - fm).abs() < 1e-6 * (1.0 + fm.abs()), "dm {j} {k}: {} vs {fm}", dm[j][k]);
+            assert!((dl[j][k] - fl).abs() < 1e-6 * (1.0 + fl.abs()), "dλ {j} {k}: {} vs {fl}", dl[j][k]);
+        }
+    }
+}
+
+/// Checks an objective's gradient against central differences of its cost.
+fn check_gradient<O: Objective>(o: &O, theta: &[f64], tol: f64) {
+    let (f, g) = o.cost_gradient(theta);
+    assert!(f.is_finite());
+    let scale = g.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    for j in 0..theta.len() {
+        let h = 1e-5 * theta[j].abs().max(1e-3);
+        let mut p = theta.to_vec();
+        p[j] += h;
+        let fu = o.cost(&p);
+        p[j] -= 2.0 * h;
+        let fd = o.cost(&p);
+        let num = (fu - fd) / (2.0 * h);
+        assert!((g[j] - num).abs() < tol * scale, "∂/∂θ{j}: {} vs {num} (scale {scale})", g[j]);
+    }
+}
+
+#[test]
+fn likelihood_gradients_match_differences() {
+    let n = 40;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let truth = UniformSum::new(1, 0.4).unwrap();
+    let structure = joe_structure(truth, n);
+    let mut rng = StdRng::seed_from_u64(3);
+    let data = simulate(&structure.signal, &truth, &grid, 0.02, &mut rng).unwrap();
+    let record = Record::new(grid, data.y).unwrap();
+    // Away from the optimum, so that the gradient is not small.
+    let theta = vec![1.05, -1.9, 0.43, 0.025];
+    let quasi = LikelihoodObjective::new(&structure, &QuasiMl, &record);
+    check_gradient(&quasi, &theta, 1e-6);
+    let exact = ExactMl::default();
+    let exact_obj = LikelihoodObjective::new(&structure, &exact, &record);
+    check_gradient(&exact_obj, &theta, 1e-6);
+    // A fixed signal uses the prepared table.
+    let fixed = structure.clone().with_estimated(false, true, false);
+    let o = LikelihoodObjective::new(&fixed, &exact, &record);
+    check_gradient(&o, &[0.43, 0.025], 1e-6);
+}
+
+#[test]
+fn without_jitter_both_criteria_are_the_gaussian_likelihood() {
+    let n = 50;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let signal = table1_signal(8, n);
+    let sigma = 0.03;
+    let mut rng = StdRng::seed_from_u64(8);
+    let data = simulate(&signal, &NoJitter, &grid, sigma, &mut rng).unwrap();
+    let record = Record::new(grid, data.y.clone()).unwrap();
+    let structure = ModelStructure::oe(signal.clone(), NoJitter);
+    let direct: f64 = (0..n)
+        .map(|k| {
+            let e = data.y[k] - signal.value(grid.time(k));
+            -0.5 * (e / sigma).powi(2) - sigma.ln() - 0.5 * (std::f64::consts::TAU).ln()
+        })
+        .sum();
+    let exact: f64 = ExactMl::default()
+        .log_likelihoods(&structure, &record, sigma)
+        .unwrap()
+        .iter()
+        .sum();
+    let o = LikelihoodObjective::new(&structure, &QuasiMl, &record);
+    let mut theta = likelihood_params(&structure, sigma);
+    let quasi = -o.evaluate(&theta).unwrap();
+    assert!((exact - direct).abs() < 1e-10 * direct.abs(), "{exact} vs {direct}");
+    assert!((quasi - direct).abs() < 1e-10 * direct.abs(), "{quasi} vs {direct}");
+    // And the gradient in the signal's parameters and σ_v agrees between the criteria.
+    let e = ExactMl::default();
+    let oe = LikelihoodObjective::new(&structure, &e, &record);
+    theta[0] *= 1.01;
+    let (_, gq) = o.cost_gradient(&theta);
+    let (_, ge) = oe.cost_gradient(&theta);
+    for (a, b) in gq.iter().zip(&ge) {
+        assert!((a - b).abs() < 1e-7 * (1.0 + a.abs()), "{a} vs {b}");
+    }
+}
+
+#[test]
+fn exact_ml_is_unbiased_and_its_hessian_predicts_the_spread() {
+    // Gaussian jitter σ = 1/6 on the Table 1 system (a regular problem), σ_v = 0.01 known,
+    // 24 records. The mean must lie within 4 Monte Carlo standard errors of the truth, and the
+    // Monte Carlo std over the mean inverse-Hessian std within 1 ± 0.45 (three standard
+    // errors of a std estimated from 24 values, relative SE ≈ 1/√46 ≈ 0.15).
+    let truth = Gaussian::new(1.0 / 6.0).unwrap();
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let mut est = Summary::default();
+    let mut se = Summary::default();
+    for r in 0..24 {
+        let signal = table1_signal(100 + r, 200);
+        let mut rng = StdRng::seed_from_u64(200 + r);
+        let data = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap();
+        let record = Record::new(grid, data.y).unwrap();
+        let structure = ModelStructure::oe(signal, Gaussian::new(0.2).unwrap())
+            .with_estimated(false, true, false)
+            .with_noise_std(0.01)
+            .unwrap();
+        let opts = MlOptions {
+            covariance: true,
+            ..Default::default()
+        };
+        let fit = ml_estimate(&structure, &record, &ExactMl::default(), &opts).unwrap();
+        assert!(fit.converged, "{:?}", fit.termination);
+        est.push(fit.params[0]);
+        se.push(fit.std_errors.unwrap()[0]);
+    }
+    let z = (est.mean - 1.0 / 6.0) / est.se();
+    assert!(z.abs() < 4.0, "mean {} (z = {z})", est.mean);
+    let ratio = est.std() / se.mean;
+    assert!((ratio - 1.0).abs() < 0.45, "MC std {} vs Hessian std {}", est.std(), se.mean);
+}
+
+#[test]
+fn uniform_sum_profile_finds_sigma() {
+    let truth = UniformSum::new(0, 0.5).unwrap();
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let signal = table1_signal(31, 200);
+    let mut rng = StdRng::seed_from_u64(32);
+    let data = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap();
+    let record = Record::new(grid, data.y).unwrap();
+    let structure = ModelStructure::oe(signal, UniformSum::new(0, 0.45).unwrap())
+        .with_estimated(false, true, false)
+        .with_noise_std(0.01)
+        .unwrap();
+    let opts = MlOptions {
+        covariance: true,
+        ..Default::default()
+    };
+    for crit in ["exact", "quasi"] {
+        let p = if crit == "exact" {
+            ml_profile_uniform_sum(&structure, &record, &ExactMl::default(), &opts, 0..=4)
+        } else {
+            ml_profile_uniform_sum(&structure, &record, &QuasiMl, &opts, 0..=4)
+        }
+        .unwrap();
+        assert_eq!(p.costs.len(), 5);
+        let s = p.sigma().unwrap();
+        println!("{crit}: n = {}, σ = {s}, se {:?}", p.n, p.sigma_std());
+        assert!((s - 0.5 / 3f64.sqrt()).abs() < 0.05, "{crit}: σ = {s}");
+        assert!(p.sigma_std().unwrap() > 0.0);
+    }
+}
+
+#[test]
+fn fisher_information_exact_equals_gaussian_without_jitter() {
+    // Without jitter the samples are Gaussian, so the exact information (integrated over y)
+    // equals the Slepian–Bangs one: the integration over y is accurate to ~1e-10.
+    let n = 50;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let sine = Sinusoid::new(1.0, 0.13, 0.4).unwrap();
+    let structure = ModelStructure::oe(sine, NoJitter);
+    let exact = exact_fisher(&structure, &grid, 0.05, &FisherOptions::default()).unwrap();
+    let gauss = gaussian_fisher(&structure, &grid, 0.05).unwrap();
+    assert_eq!(exact.names, vec!["amplitude", "frequency", "phase", "noise.std"]);
+    assert!(exact.max_mass_error.unwrap() < 1e-10);
+    for i in 0..4 {
+        for j in 0..4 {
+            let (a, b) = (exact.matrix[i][j], gauss.matrix[i][j]);
+            assert!((a - b).abs() < 1e-7 * (gauss.matrix[i][i] * gauss.matrix[j][j]).sqrt(), "[{i}][{j}] {a} vs {b}");
+        }
+    }
+    // σ_v block: 2N/σ².
+    assert!((gauss.matrix[3][3] - 2.0 * n as f64 / 0.0025).abs() < 1e-9 * gauss.matrix[3][3]);
+}
+
+#[test]
+fn fisher_information_of_small_gaussian_jitter_is_nearly_gaussian() {
+    // A slow tone with small Gaussian jitter: s(t + τ) is nearly linear in τ over the jitter,
+    // so y is nearly Gaussian and the exact information about σ is close to the Gaussian one
+    // (the relative difference is of the order of (2πf0σ)² ≈ 1e-5, here bounded by 1%).
+    let n = 60;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let sine = Sinusoid::new(1.0, 0.11, 0.2).unwrap();
+    let structure = ModelStructure::oe(sine, Gaussian::new(0.005).unwrap())
+        .with_estimated(false, true, false)
+        .with_noise_std(0.001)
+        .unwrap();
+    let exact = exact_fisher(&structure, &grid, 0.001, &FisherOptions::default()).unwrap();
+    let gauss = gaussian_fisher(&structure, &grid, 0.001).unwrap();
+    let (a, b) = (exact.matrix[0][0], gauss.matrix[0][0]);
+    assert!((a / b - 1.0).abs() < 0.01, "{a} vs {b}");
+    assert!(exact.max_mass_error.unwrap() < 1e-8);
+    let crb = exact.crb_std_of("jitter.sigma").unwrap();
+    assert!(crb > 0.0 && crb < 0.005);
+}
+
+#[test]
+fn bad_input_gives_typed_errors() {
+    let n = 20;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let signal = table1_signal(2, n);
+    let mut rng = StdRng::seed_from_u64(2);
+    let jitter = UniformSum::new(0, 0.3).unwrap();
+    let data = simulate(&signal, &jitter, &grid, 0.01, &mut rng).unwrap();
+    let structure = ModelStructure::oe(signal.clone(), jitter)
+        .with_estimated(false, true, false)
+        .with_noise_std(0.01)
+        .unwrap();
+    let exact = ExactMl::default();
+    // A far outlier is handled in log form: finite, about −(y/σ_v)²/2.
+    let mut y = data.y.clone();
+    y[7] = 3.0;
+    let record = Record::new(grid, y.clone()).unwrap();
+    let lp = exact.log_likelihoods(&structure, &record, 0.01).unwrap();
+    assert!(lp[7].is_finite() && lp[7] < -3e4, "{}", lp[7]);
+    // One whose likelihood underflows even in log form is an error.
+    y[7] = 1e160;
+    let record = Record::new(grid, y).unwrap();
+    assert!(matches!(
+        exact.log_likelihoods(&structure, &record, 0.01),
+        Err(MlError::LikelihoodUnderflow { index: 7, .. })
+    ));
+    assert!(matches!(
+        ml_estimate(&structure, &record, &exact, &MlOptions::default()),
+        Err(MlError::LikelihoodUnderflow { index: 7, .. })
+    ));
+    let record = Record::new(grid, data.y.clone()).unwrap();
+    // λ_k → 0: no noise, and samples where the jittered signal does not move (before the
+    // input's first step, or a constant input).
+    let flat = LtiResponse::new(
+        Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap(),
+        jitterid_signal::PiecewiseConstant::new(vec![-1.0, 100.0], vec![0.0]).unwrap(),
+    );
+    let quiet = ModelStructure::oe(flat, jitter)
+        .with_estimated(false, true, false)
+        .with_noise_std(0.0)
+        .unwrap();
+    assert!(matches!(
+        ml_estimate(&quiet, &record, &QuasiMl, &MlOptions::default()),
+        Err(MlError::VanishingVariance { .. })
+    ));
+    assert!(matches!(
+        ml_estimate(&quiet, &record, &exact, &MlOptions::default()),
+        Err(MlError::NoNoise { .. })
+    ));
+    // A reach wider than the record.
+    let wide = ModelStructure::oe(signal.clone(), UniformSum::new(0, 30.0).unwrap())
+        .with_estimated(false, true, false)
+        .with_noise_std(0.01)
+        .unwrap();
+    for res in [
+        ml_estimate(&wide, &record, &exact, &MlOptions::default()),
+        ml_estimate(&wide, &record, &QuasiMl, &MlOptions::default()),
+    ] {
+        assert!(matches!(res, Err(MlError::ReachExceedsRecord { duration, .. }) if duration == 20.0));
+    }
+    // Coloured noise with the exact criterion.
+    let bj = ModelStructure::bj(signal, jitter, ArmaNoise::new(vec![0.5], vec![]).unwrap());
+    assert!(matches!(
+        ml_estimate(&bj, &record, &exact, &MlOptions::default()),
+        Err(MlError::ColouredNoise { .. })
+    ));
+    // Invalid quadrature options.
+    let bad = ExactMl {
+        resolution: 0.0,
+        ..ExactMl::default()
+    };
+    assert!(matches!(
+        bad.log_likelihoods(&structure, &record, 0.01),
+        Err(MlError::InvalidArgument { name: "resolution", .. })
+    ));
+}
+
+#[test]
+fn sine_record_too_short_is_an_error() {
+    let sine = Sinusoid::new(1.0, 0.3, 0.1).unwrap();
+    for (n, f) in [(5usize, 0.3), (40, 0.03)] {
+        let sine = Sinusoid::new(1.0, f, 0.1).unwrap();
+        let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+        let y: Vec<f64> = grid.times().map(|t| sine.value(t)).collect();
+        let record = Record::new(grid, y).unwrap();
+        assert!(matches!(
+            sine_least_squares(&record),
+            Err(MlError::SineRecordTooShort { samples, .. }) if samples == n
+        ));
+    }
+    let grid = SampleGrid::new(0.0, 1.0, 64).unwrap();
+    let y: Vec<f64> = grid.times().map(|t| sine.value(t)).collect();
+    let ls = sine_least_squares(&Record::new(grid, y).unwrap()).unwrap();
+    assert!((ls.frequency - 0.3).abs() < 1e-9 && (ls.amplitude - 1.0).abs() < 1e-9);
+    assert!((ls.phase - 0.1).abs() < 1e-9);
+}
+
+#[test]
+fn sine_aliases_are_told_apart_by_a_known_jitter_and_not_by_an_estimated_one() {
+    let (a, f0, phi, sj, sv) = (1.0, 1.78, 0.3, 0.05, 0.01);
+    let sine = Sinusoid::new(a, f0, phi).unwrap();
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let jitter = Gaussian::new(sj).unwrap();
+    let exact = ExactMl::default();
+    for seed in 0..3 {
+        let mut rng = StdRng::seed_from_u64(40 + seed);
+        let data = simulate(&sine, &jitter, &grid, sv, &mut rng).unwrap();
+        let record = Record::new(grid, data.y).unwrap();
+        let ls = sine_least_squares(&record).unwrap();
+        assert!((ls.frequency - 0.22).abs() < 1e-3, "baseband {}", ls.frequency);
+        let fits: Vec<SineFit> = [1.78, 0.78]
+            .iter()
+            .map(|&f| {
+                fit_sine(&record, &ls, f, jitter, false, None, &exact, &MlOptions::default()).unwrap()
+            })
+            .collect();
+        assert!(fits[0].estimate.converged && fits[1].estimate.converged);
+        assert!((fits[0].frequency - f0).abs() < 1e-3);
+        assert!(
+            fits[0].estimate.neg_log_likelihood < fits[1].estimate.neg_log_likelihood - 10.0,
+            "{} vs {}",
+            fits[0].estimate.neg_log_likelihood,
+            fits[1].estimate.neg_log_likelihood
+        );
+    }
+    // With σ free the two aliases are the same model: (f0, σ) and (f0 − 1, σ f0/(f0 − 1))
+    // give every sample the same distribution, so equal likelihoods at matched parameters.
+    let mut rng = StdRng::seed_from_u64(50);
+    let data = simulate(&sine, &jitter, &grid, sv, &mut rng).unwrap();
+    let record = Record::new(grid, data.y).unwrap();
+    let at = |f: f64, s: f64, crit: &dyn Fn(&ModelStructure<Sinusoid, Gaussian>) -> f64| {
+        let m = ModelStructure::oe(Sinusoid::new(a, f, phi).unwrap(), Gaussian::new(s).unwrap())
+            .with_noise_std(sv)
+            .unwrap();
+        crit(&m)
+    };
+    let e = |m: &ModelStructure<Sinusoid, Gaussian>| -> f64 {
+        exact.log_likelihoods(m, &record, sv).unwrap().iter().sum()
+    };
+    let q = |m: &ModelStructure<Sinusoid, Gaussian>| -> f64 {
+        -LikelihoodObjective::new(m, &QuasiMl, &record)
+            .evaluate(&likelihood_params(m, sv))
+            .unwrap()
+    };
+    let s_alias = sj * f0 / (f0 - 1.0);
+    for (name, c) in [("exact", &e as &dyn Fn(&_) -> f64), ("quasi", &q)] {
+        let (l1, l2) = (at(f0, sj, c), at(f0 - 1.0, s_alias, c));
+        assert!((l1 - l2).abs() < 1e-8 * l1.abs(), "{name}: {l1} vs {l2}");
+        // With σ known, the alias at the true σ is much less likely.
+        assert!(at(f0 - 1.0, sj, c) < l1 - 100.0, "{name}");
+    }
+}
+
+#[test]
+fn quasi_ml_with_coloured_noise() {
+    // v = e_k + 0.5 e_{k−1}: autocovariance 1.25, 0.5, 0, …
+    let noise = ArmaNoise::new(vec![0.5], vec![]).unwrap();
+    let r = noise_autocovariance(&noise, 1.0, 6);
+    for (got, want) in r.iter().zip([1.25, 0.5, 0.0, 0.0, 0.0, 0.0]) {
+        assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+    }
+    // Estimate the MA coefficient and σ_e with the signal and a small jitter known; the
+    // estimates must lie within 4 inverse-Hessian standard errors of the truth.
+    let n = 300;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let signal = table1_signal(12, n);
+    let jitter = UniformSum::new(0, 0.2).unwrap();
+    let mut rng = StdRng::seed_from_u64(13);
+    let clean = simulate(&signal, &jitter, &grid, 0.0, &mut rng).unwrap();
+    let e: Vec<f64> = (0..=n).map(|_| 0.02 * normal(&mut rng)).collect();
+    let y: Vec<f64> = (0..n).map(|k| clean.y[k] + e[k + 1] + 0.5 * e[k]).collect();
+    let record = Record::new(grid, y).unwrap();
+    let structure = ModelStructure::bj(signal, jitter, ArmaNoise::new(vec![0.2], vec![]).unwrap())
+        .with_estimated(false, false, true);
+    let o = LikelihoodObjective::new(&structure, &QuasiMl, &record);
+    check_gradient(&o, &[0.3, 0.03], 1e-5);
+    let opts = MlOptions {
+        covariance: true,
+        ..Default::default()
+    };
+    let fit = ml_estimate(&structure, &record, &QuasiMl, &opts).unwrap();
+    assert!(fit.converged, "{:?}", fit.termination);
+    assert_eq!(fit.names, vec!["noise.c1", "noise.std"]);
+    let se = fit.std_errors.unwrap();
+    assert!(((fit.params[0] - 0.5) / se[0]).abs() < 4.0, "c1 = {} ± {}", fit.params[0], se[0]);
+    assert!(((fit.params[1] - 0.02) / se[1]).abs() < 4.0, "σ = {} ± {}", fit.params[1], se[1]);
+}
+
+/// Rosenbrock's function with its gradient; `+∞` for `x < −1.5` (an infeasible region).
+struct Rosen;
+
+impl Objective for Rosen {
+    fn num_params(&self) -> usize {
+        2
+    }
+    fn cost(&self, p: &[f64]) -> f64 {
+        if p[0] < -1.5 {
+            return f64::INFINITY;
+        }
+        100.0 * (p[1] - p[0] * p[0]).powi(2) + (1.0 - p[0]).powi(2)
+    }
+    fn cost_gradient(&self, p: &[f64]) -> (f64, Vec<f64>) {
+        let g = vec![
+            -400.0 * p[0] * (p[1] - p[0] * p[0]) - 2.0 * (1.0 - p[0]),
+            200.0 * (p[1] - p[0] * p[0]),
+        ];
+        (self.cost(p), g)
+    }
+}
+
+/// `(x − 2)²`, infinite for `x ≤ 0`.
+struct Parabola;
+
+impl Objective for Parabola {
+    fn num_params(&self) -> usize {
+        1
+    }
+    fn cost(&self, p: &[f64]) -> f64 {
+        if p[0] <= 0.0 {
+            f64::INFINITY
+        } else {
+            (p[0] - 2.0).powi(2)
+        }
+    }
+}
+
+#[test]
+fn minimisers_converge_and_respect_infeasible_regions() {
+    let r = Bfgs::default().minimize(&Rosen, &[-1.2, 1.0]).unwrap();
+    assert!(r.converged, "{:?}", r.termination);
+    assert!((r.params[0] - 1.0).abs() < 1e-5 && (r.params[1] - 1.0).abs() < 1e-5, "{:?}", r.params);
+    let r = Brent::default().minimize(&Parabola, &[5.0]).unwrap();
+    assert!(r.converged && (r.params[0] - 2.0).abs() < 1e-7, "{r:?}");
+    let r = Brent::default().minimize(&Parabola, &[0.01]).unwrap();
+    assert!(r.converged && (r.params[0] - 2.0).abs() < 1e-7, "{r:?}");
+    let r = ArgminNelderMead::default().minimize(&Rosen, &[-1.2, 1.0]).unwrap();
+    assert!((r.params[0] - 1.0).abs() < 1e-3, "{r:?}");
+    assert!(matches!(
+        Brent::default().minimize(&Rosen, &[0.0, 0.0]),
+        Err(SolverError::InvalidOption { .. })
+    ));
+    assert!(matches!(
+        Bfgs::default().minimize(&Rosen, &[-2.0, 0.0]),
+        Err(SolverError::NonFiniteResidual { .. })
+    ));
+    let r = Bfgs {
+        max_iters: 3,
+        ..Bfgs::default()
+    }
+    .minimize(&Rosen, &[-1.2, 1.0])
+    .unwrap();
+    assert!(!r.converged && r.termination == Termination::MaxIterations);
+    // argmin's L-BFGS on the adapter.
+    use argmin::core::{Executor, State};
+    use argmin::solver::linesearch::MoreThuenteLineSearch;
+    use argmin::solver::quasinewton::LBFGS;
+    let solver = LBFGS::new(MoreThuenteLineSearch::new(), 7);
+    let res = Executor::new(ArgminObjective(&Rosen), solver)
+        .configure(|s| s.param(vec![-1.2, 1.0]).max_iters(200))
+        .run()
+        .unwrap();
+    let best = res.state.get_best_param().unwrap();
+    assert!((best[0] - 1.0).abs() < 1e-4, "{best:?}");
 }

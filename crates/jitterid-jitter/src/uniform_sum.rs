@@ -133,8 +133,17 @@ impl UniformSum {
 /// `g[i] = f_k(x - i)` for `i = 0..=⌊x⌋` are updated in place for `k = 2..=m`; terms with
 /// `x - i < 0` vanish and are never stored. Cost `O(m x)`.
 fn irwin_hall(m: usize, x: f64) -> f64 {
+    // A small stack buffer for the usual small n: zeroing the full one costs more than the
+    // recursion itself.
+    if m < 16 {
+        irwin_hall_in(m, x, &mut [0.0; 17])
+    } else {
+        irwin_hall_in(m, x, &mut [0.0; MAX_N as usize + 2])
+    }
+}
+
+fn irwin_hall_in(m: usize, x: f64, g: &mut [f64]) -> f64 {
     let imax = (x.floor() as usize).min(m - 1);
-    let mut g = [0.0; MAX_N as usize + 2];
     // f_1 = 1 on [0, 1), half-open so that integer knots are not counted twice.
     for (i, gi) in g.iter_mut().enumerate().take(imax + 1) {
         *gi = if x - (i as f64) < 1.0 { 1.0 } else { 0.0 };

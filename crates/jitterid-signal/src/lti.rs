@@ -7,6 +7,7 @@ use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
+use std::sync::OnceLock;
 
 /// The output `s(t) = (g ∗ u)(t)` of a rational model `G` driven by a known input, exactly.
 ///
@@ -25,9 +26,10 @@ pub struct LtiResponse<M> {
     input: Input,
     steps: Vec<(f64, f64)>,
     /// Right after step `j`: the input level `Σ_{l≤j} Δu_l` and, per representative pole,
-    /// `X_ij = Σ_{l≤j} Δu_l e^{p_i (t_j − t_l)}`, so that `s(t)` costs `O(log J + poles)`.
+    /// `X_ij = Σ_{l≤j} Δu_l e^{p_i (t_j − t_l)}` (row-major), so that `s(t)` costs
+    /// `O(log J + poles)`. Built on the first evaluation of `s(t)`: estimation never needs it.
     #[serde(skip)]
-    prefix: Vec<(f64, Vec<Complex64>)>,
+    prefix: OnceLock<(Vec<f64>, Vec<Complex64>)>,
 }
 
 impl<M: RationalModel> LtiResponse<M> {
@@ -38,17 +40,15 @@ impl<M: RationalModel> LtiResponse<M> {
             Input::Piecewise(p) => p.steps(),
             Input::Tones(_) => Vec::new(),
         };
-        let mut out = Self {
+        Self {
             model,
             input,
             steps,
-            prefix: Vec::new(),
-        };
-        out.prefix = out.prefix_states();
-        out
+            prefix: OnceLock::new(),
+        }
     }
 
-    fn prefix_states(&self) -> Vec<(f64, Vec<Complex64>)> {
+    fn prefix_states(&self) -> (Vec<f64>, Vec<Complex64>) {
         let poles: Vec<Complex64> = self
             .representatives()
             .iter()
@@ -57,20 +57,21 @@ impl<M: RationalModel> LtiResponse<M> {
         let mut level = 0.0;
         let mut x = vec![Complex64::new(0.0, 0.0); poles.len()];
         let mut prev = f64::NEG_INFINITY;
-        self.steps
-            .iter()
-            .map(|&(tj, du)| {
-                for (xi, p) in x.iter_mut().zip(&poles) {
-                    if prev.is_finite() {
-                        *xi *= (p * (tj - prev)).exp();
-                    }
-                    *xi += du;
+        let mut levels = Vec::with_capacity(self.steps.len());
+        let mut states = Vec::with_capacity(self.steps.len() * poles.len());
+        for &(tj, du) in &self.steps {
+            for (xi, p) in x.iter_mut().zip(&poles) {
+                if prev.is_finite() {
+                    *xi *= (p * (tj - prev)).exp();
                 }
-                level += du;
-                prev = tj;
-                (level, x.clone())
-            })
-            .collect()
+                *xi += du;
+            }
+            level += du;
+            prev = tj;
+            levels.push(level);
+            states.extend_from_slice(&x);
+        }
+        (levels, states)
     }
 
     /// The model `G`.
@@ -370,14 +371,12 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        let mut out = Self {
+        Ok(Self {
             model: self.model.with_params(params)?,
             input: self.input.clone(),
             steps: self.steps.clone(),
-            prefix: Vec::new(),
-        };
-        out.prefix = out.prefix_states();
-        Ok(out)
+            prefix: OnceLock::new(),
+        })
     }
 
     fn value(&self, t: f64) -> f64 {
@@ -390,34 +389,20 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                     (g * Complex64::from_polar(c.amplitude, TAU * c.frequency * t + c.phase)).im
                 })
                 .sum(),
-            Input::Piecewise(_) if self.prefix.len() == self.steps.len() => {
+            Input::Piecewise(_) => {
                 let j = self.steps.partition_point(|s| s.0 <= t);
                 if j == 0 {
                     return 0.0;
                 }
                 let m = self.modal();
-                let (level, x) = &self.prefix[j - 1];
+                let reps = self.representatives();
+                let (levels, states) = self.prefix.get_or_init(|| self.prefix_states());
+                let x = &states[(j - 1) * reps.len()..j * reps.len()];
                 let dt = t - self.steps[j - 1].0;
-                let mut s = m.dc_gain * level;
-                for (&(i, w), xi) in self.representatives().iter().zip(x) {
+                let mut s = m.dc_gain * levels[j - 1];
+                for (&(i, w), xi) in reps.iter().zip(x) {
                     let (p, r) = (m.poles[i], m.residues[i]);
                     s += w * (r / p * xi * (p * dt).exp()).re;
-                }
-                s
-            }
-            Input::Piecewise(_) => {
-                // A deserialised value has no prefix states: sum over the steps.
-                let m = self.modal();
-                let reps = self.representatives();
-                let mut s = 0.0;
-                for &(tj, du) in self.steps.iter().take_while(|(tj, _)| *tj <= t) {
-                    let x = t - tj;
-                    let mut step = m.dc_gain;
-                    for &(i, w) in &reps {
-                        let (p, r) = (m.poles[i], m.residues[i]);
-                        step += w * (r / p * (p * x).exp()).re;
-                    }
-                    s += du * step;
                 }
                 s
             }

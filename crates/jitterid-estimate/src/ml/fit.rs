@@ -3,6 +3,7 @@
 //! the negative log-likelihood.
 
 use super::criterion::LikelihoodCriterion;
+use super::fisher::gaussian_fisher;
 use super::moments::second_moments;
 use super::objective::{LikelihoodObjective, Objective, TransformedObjective};
 use super::optim::MlSolver;
@@ -209,7 +210,26 @@ where
         .unwrap_or_else(|| default_transforms(structure));
     let constrained = TransformedObjective::new(&objective, transforms)?;
     let phi0 = constrained.to_internal(&start)?;
-    let report = options.solver.minimize(&constrained, &phi0)?;
+    // The metric of BFGS: the inverse of the Gaussian (Slepian–Bangs) information at the start
+    // in the unconstrained coordinates, which puts parameters of very different curvature
+    // (a frequency and an amplitude) on one scale.
+    let metric = if p > 1 {
+        gaussian_fisher(structure, record.grid(), sigma0)
+            .ok()
+            .and_then(|info| {
+                let d: Vec<f64> = phi0
+                    .iter()
+                    .zip(constrained.transforms())
+                    .map(|(&f, t)| t.derivative(f))
+                    .collect();
+                spd_inverse(&Mat::from_fn(p, p, |i, j| d[i] * info.matrix[i][j] * d[j]))
+            })
+    } else {
+        None
+    };
+    let report = options
+        .solver
+        .minimize_with_metric(&constrained, &phi0, metric.as_deref())?;
     let params = constrained.to_external(&report.params);
     let (_, sigma) = super::param::split(structure, &params)?;
     let covariance = if options.covariance {

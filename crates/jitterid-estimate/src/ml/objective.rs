@@ -180,6 +180,11 @@ impl<'a, O: Objective + ?Sized> TransformedObjective<'a, O> {
         Ok(TransformedObjective { inner, transforms })
     }
 
+    /// The transforms, one per parameter.
+    pub fn transforms(&self) -> &[Transform] {
+        &self.transforms
+    }
+
     /// `θ(φ)`.
     pub fn to_external(&self, phi: &[f64]) -> Vec<f64> {
         phi.iter()

@@ -71,10 +71,24 @@ impl MlSolver {
         objective: &O,
         start: &[f64],
     ) -> Result<SolverReport, SolverError> {
+        self.minimize_with_metric(objective, start, None)
+    }
+
+    /// As [`minimize`](Self::minimize), with an initial inverse Hessian for BFGS.
+    ///
+    /// # Errors
+    ///
+    /// As [`minimize`](Self::minimize).
+    pub fn minimize_with_metric<O: Objective + ?Sized>(
+        &self,
+        objective: &O,
+        start: &[f64],
+        metric: Option<&[Vec<f64>]>,
+    ) -> Result<SolverReport, SolverError> {
         match self {
             MlSolver::Auto if start.len() == 1 => Brent::default().minimize(objective, start),
-            MlSolver::Auto => Bfgs::default().minimize(objective, start),
-            MlSolver::Bfgs(b) => b.minimize(objective, start),
+            MlSolver::Auto => Bfgs::default().minimize_with_metric(objective, start, metric),
+            MlSolver::Bfgs(b) => b.minimize_with_metric(objective, start, metric),
             MlSolver::Brent(b) => b.minimize(objective, start),
             MlSolver::NelderMead(n) => n.minimize(objective, start),
         }
@@ -176,6 +190,22 @@ impl Bfgs {
         objective: &O,
         start: &[f64],
     ) -> Result<SolverReport, SolverError> {
+        self.minimize_with_metric(objective, start, None)
+    }
+
+    /// Minimises `objective` from `start` with the initial inverse Hessian `metric` (for
+    /// example the inverse of an expected information matrix; ignored unless it is a
+    /// symmetric matrix of the right size with a positive diagonal).
+    ///
+    /// # Errors
+    ///
+    /// As [`minimize`](Self::minimize).
+    pub fn minimize_with_metric<O: Objective + ?Sized>(
+        &self,
+        objective: &O,
+        start: &[f64],
+        metric: Option<&[Vec<f64>]>,
+    ) -> Result<SolverReport, SolverError> {
         self.validate()?;
         check_start(objective, start)?;
         let n = start.len();
@@ -194,8 +224,15 @@ impl Bfgs {
                 .collect()
         };
         let first_scale = |g: &[f64]| self.initial_step / inf_norm(g).max(1e-300);
-        let mut h = identity(first_scale(&g));
-        let mut updated = false;
+        let valid_metric = metric.filter(|m| {
+            m.len() == n
+                && m.iter().all(|r| r.len() == n && r.iter().all(|v| v.is_finite()))
+                && (0..n).all(|i| m[i][i] > 0.0)
+        });
+        let (mut h, mut updated) = match valid_metric {
+            Some(m) => (m.to_vec(), true),
+            None => (identity(first_scale(&g)), false),
+        };
         let mut small_changes = 0;
         let mut iterations = 0;
         let termination = loop {
