@@ -647,3 +647,40 @@ fn minimisers_converge_and_respect_infeasible_regions() {
     let best = res.state.get_best_param().unwrap();
     assert!((best[0] - 1.0).abs() < 1e-4, "{best:?}");
 }
+
+/// Timing of one likelihood evaluation per `n` (release: `cargo test --release --test ml
+/// timing -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn timing() {
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let signal = table1_signal(11, 200);
+    let mut rng = StdRng::seed_from_u64(12);
+    let truth = UniformSum::new(0, 0.5).unwrap();
+    let data = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap();
+    let record = Record::new(grid, data.y).unwrap();
+    for n in [0u32, 2, 5, 9] {
+        let a = 0.5 / 3f64.sqrt() * (3.0 * (n as f64 + 1.0)).sqrt();
+        let structure = ModelStructure::oe(signal.clone(), UniformSum::new(n, a).unwrap())
+            .with_estimated(false, true, false)
+            .with_noise_std(0.01)
+            .unwrap();
+        for (name, e) in [
+            ("exact", ExactMl::default()),
+            ("serial", ExactMl { parallel: false, ..ExactMl::default() }),
+            ("no shortcut", ExactMl { parallel: false, shortcut: false, ..ExactMl::default() }),
+        ] {
+            let o = LikelihoodObjective::new(&structure, &e, &record);
+            let t = std::time::Instant::now();
+            let reps = 20;
+            let mut v = 0.0;
+            for _ in 0..reps {
+                v = o.cost(&[a]);
+            }
+            println!("n = {n} {name}: {:.3} ms per evaluation ({v})", t.elapsed().as_secs_f64() * 1e3 / reps as f64);
+        }
+        let t = std::time::Instant::now();
+        let fit = ml_estimate(&structure, &record, &ExactMl::default(), &MlOptions::default()).unwrap();
+        println!("n = {n}: fit {:.1} ms, {} iterations", t.elapsed().as_secs_f64() * 1e3, fit.iterations);
+    }
+}

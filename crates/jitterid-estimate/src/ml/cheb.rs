@@ -85,8 +85,9 @@ const MAX_DEPTH: u32 = 12;
 impl PiecewiseCheb {
     /// Interpolates `f` (which writes `channels` values at `t`) on each of `intervals`,
     /// halving a segment until the interpolant matches `f` at the test points within
-    /// `rel_tol × (channel's max |f| on the segment + floor)`, where `floor` is `1e-3` of the
-    /// largest value of the channel seen so far.
+    /// `rel_tol × (channel's max |f| on the segment + the largest |f| of the channel seen so
+    /// far)`: relative to the function's scale, so that the rounding noise of `f` where it
+    /// nearly cancels does not force endless halving.
     pub(crate) fn build(
         intervals: &[(f64, f64)],
         channels: usize,
@@ -125,7 +126,7 @@ impl PiecewiseCheb {
                     'test: for &x in &b.tests {
                         f(mid + half * x, &mut vals);
                         for c in 0..channels {
-                            let floor = 1e-3 * global[c].max(seg_max[c]);
+                            let floor = global[c];
                             let err = (clenshaw(&coefs[c], x) - vals[c]).abs();
                             if !(err <= rel_tol * (seg_max[c] + floor)) {
                                 ok = false;

@@ -64,7 +64,7 @@ const MAX_RATE_WIDTH: f64 = 6.0;
 const MAX_REFINE: usize = 4096;
 
 /// Relative accuracy asked of the signal and density tables.
-const TABLE_TOL: f64 = 1e-14;
+const TABLE_TOL: f64 = 1e-13;
 
 fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
     static R: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
