@@ -141,14 +141,11 @@ pub trait Criterion: fmt::Debug + Send + Sync {
     }
 
     /// `∂r/∂θ` (rows residuals, columns the structure's free parameters).
-    fn jacobian<S: Signal, J: JitterModel + Clone, N: NoiseModel, W: Window>(
+    fn jacobian<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel, W: Window>(
         &self,
         data: &FrequencyData<W>,
         model: &ModelStructure<S, J, N>,
-    ) -> Mat<f64>
-    where
-        S: Clone,
-    {
+    ) -> Mat<f64> {
         let (ns, nj, nn) = model.blocks();
         let rows = data.num_residuals();
         let mut jac = Mat::<f64>::zeros(rows, ns + nj + nn);

@@ -677,7 +677,7 @@ fn timing() {
             for _ in 0..reps {
                 v = o.cost(&[a]);
             }
-            println!("n = {n} {name}: {:.3} ms per evaluation ({v})", t.elapsed().as_secs_f64() * 1e3 / reps as f64);
+            println!("n = {n} {name}: {:.3} ms per evaluation ({v}) {:?}", t.elapsed().as_secs_f64() * 1e3 / reps as f64, dbg_stats().map(|x| x / reps));
         }
         let t = std::time::Instant::now();
         let fit = ml_estimate(&structure, &record, &ExactMl::default(), &MlOptions::default()).unwrap();

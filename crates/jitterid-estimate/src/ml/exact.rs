@@ -283,6 +283,7 @@ pub(crate) struct SignalEval<'a, S: ?Sized> {
 impl<S: Signal + ?Sized> SignalEval<'_, S> {
     #[inline]
     fn value(&self, t: f64) -> f64 {
+        DBG_EVALS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         match self.table.segment(t) {
             Some(seg) => self.table.eval0(seg, t),
             None => self.signal.value(t),
@@ -342,6 +343,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
     ) -> f64 {
         let jp = self.jitter;
         let local = local_breaks(self.breaks, t, jp.lo, jp.hi);
+        DBG_SAMPLES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         if self.opts.shortcut && local.is_empty() {
             if let Some(mu) = &jp.moments {
                 if let Some(v) = self.shortcut(t, y, mu, grad.as_deref().map(|g| g.len()), scratch)
@@ -349,11 +351,14 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                     if let Some(g) = grad {
                         g.copy_from_slice(&scratch.ch[..g.len()]);
                     }
+                    DBG_SHORT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     return v;
                 }
             }
         }
         self.build_rule(t, y, &local, scratch);
+        DBG_NODES.fetch_add(scratch.s.len(), std::sync::atomic::Ordering::Relaxed);
+        DBG_STEEP.fetch_add(scratch.steep.len(), std::sync::atomic::Ordering::Relaxed);
         self.sum(t, y, grad, scratch)
     }
 
@@ -695,4 +700,14 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         }
         log_p
     }
+}
+
+pub static DBG_EVALS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_SAMPLES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_SHORT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_NODES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_STEEP: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub fn dbg_stats() -> [usize; 5] {
+    use std::sync::atomic::Ordering::Relaxed;
+    [DBG_EVALS.swap(0, Relaxed), DBG_SAMPLES.swap(0, Relaxed), DBG_SHORT.swap(0, Relaxed), DBG_NODES.swap(0, Relaxed), DBG_STEEP.swap(0, Relaxed)]
 }
