@@ -202,3 +202,53 @@ fn bcls_on_the_full_grid_is_time_domain_least_squares() {
     assert!((Bcls.cost(&half, &structure) - time).abs() > 1e-6 * time);
     let _ = NoJitter.variance();
 }
+
+/// The criteria's analytic Jacobians (signal block) and their finite-difference blocks (jitter,
+/// noise shape) against central differences of the residuals through the solver's generic
+/// `fd_jacobian`.
+#[test]
+fn criterion_jacobians_match_finite_differences() {
+    use jitterid::estimate::solver::{fd_jacobian, LeastSquares};
+    use jitterid::estimate::FitProblem;
+    let g = eq17(0.2, 0.5, -0.25, 0.3);
+    let input = binary(8, 4.0, 0.0, 121.0);
+    let grid = SampleGrid::new(0.0, 1.0, 120).unwrap();
+    let jitter = UniformSum::new(1, 0.4).unwrap();
+    let signal = LtiResponse::new(g, input);
+    let mut rng = realization_rng(2, 2);
+    let y = simulate(&signal, &jitter, &grid, 0.02, &mut rng).unwrap().y;
+    let record = Record::new(grid, y).unwrap();
+    let noise = WithFloor::new(ArmaNoise::new(vec![0.3], vec![-0.6]).unwrap(), 0.2).unwrap();
+    let structure = ModelStructure::jbj(signal, jitter, noise);
+    let data = FrequencyData::new(record, DirichletWindow, FrequencySet::dft(&grid)).unwrap();
+    fn check<C: Criterion, N: jitterid::estimate::NoiseModel>(
+        c: &C,
+        data: &FrequencyData<DirichletWindow>,
+        s: &ModelStructure<LtiResponse<Zpk>, UniformSum, N>,
+    ) {
+        let problem = FitProblem { structure: s, criterion: c, data };
+        let theta = s.params();
+        let analytic = problem.jacobian(&theta).unwrap();
+        let fd = fd_jacobian(&problem, &theta, 1e-6).unwrap();
+        let scale = (0..analytic.ncols())
+            .flat_map(|j| (0..analytic.nrows()).map(move |i| (i, j)))
+            .map(|(i, j)| analytic[(i, j)].abs())
+            .fold(0.0, f64::max);
+        for j in 0..analytic.ncols() {
+            for i in 0..analytic.nrows() {
+                // Central differences with a relative step 1e-6: truncation ~1e-12·|r'''|,
+                // rounding ~1e-16·|r|/1e-6; both far below 1e-6 of the largest entry.
+                assert!(
+                    (analytic[(i, j)] - fd[(i, j)]).abs() <= 1e-6 * scale,
+                    "{} column {j} row {i}: {} vs {}",
+                    c.name(),
+                    analytic[(i, j)],
+                    fd[(i, j)]
+                );
+            }
+        }
+    }
+    check(&BoxJenkins, &data, &structure);
+    check(&Bcls, &data, &structure.clone().with_estimated(true, true, false));
+    check(&Ls, &data, &structure.clone().with_estimated(true, false, false));
+}

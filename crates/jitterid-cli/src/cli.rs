@@ -181,12 +181,15 @@ where
                 };
             }
             let text = e.render().to_string();
+            // clap's message runs until the usage line; fold it into one line.
             let first = text
                 .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("error: invalid arguments");
-            let first = first.trim();
-            let first = first.strip_prefix("error: ").unwrap_or(first);
+                .map(str::trim)
+                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+                .filter(|l| !l.is_empty())
+                .collect::<Vec<_>>()
+                .join(" ");
+            let first = first.strip_prefix("error: ").unwrap_or(&first).to_string();
             eprintln!("error: {first} (see jitterid --help)");
             return ExitCode::from(2);
         }

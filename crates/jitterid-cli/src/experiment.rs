@@ -412,6 +412,9 @@ fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> CliError {
         key = None;
     }
     msg = msg
+        .replace("expected i64", "expected a whole number")
+        .replace("expected f64", "expected a number")
+        .replace("expected a sequence", "expected a list")
         .replace("expected struct table ", "expected the table ")
         .replace(
             "expected struct experiment file",

@@ -309,6 +309,7 @@ fn moment_figure(
     let damped = moment(grid, signal, jitter);
     let undamped = moment(grid, signal, &NoJitter);
     let fs: Vec<f64> = damped.iter().map(|x| x.0).collect();
+    let dense = fs.len() > 300;
     let mut gam = vec![Series::line(
         &format!("|γ(f)|, {label}"),
         BLUE,
@@ -331,8 +332,10 @@ fn moment_figure(
                 ylabel: "magnitude".into(),
                 ylog: true,
                 series: vec![
-                    Series::line("with jitter damping", BLUE, abs_points(&damped)).with_width(2.4),
-                    Series::dashed("without jitter (γ ≡ 1)", ORANGE, abs_points(&undamped)),
+                    Series::line("with jitter damping", BLUE, abs_points(&damped))
+                        .with_width(if dense { 1.4 } else { 2.4 }),
+                    Series::dashed("without jitter (γ ≡ 1)", ORANGE, abs_points(&undamped))
+                        .with_width(if dense { 1.0 } else { 1.8 }),
                 ],
                 ..Default::default()
             },

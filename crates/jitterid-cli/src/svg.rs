@@ -250,12 +250,18 @@ impl Axis {
                 ticks,
             }
         } else {
-            let (a, b, t, step) = linear_ticks(lo, hi);
+            // The given range (already padded by the caller), with the nice ticks inside it.
+            let (_, _, t, step) = linear_ticks(lo, hi);
+            let eps = 1e-9 * step;
             Axis {
-                lo: a,
-                hi: b,
+                lo,
+                hi,
                 log,
-                ticks: t.into_iter().map(|v| (v, fmt_tick(v, step))).collect(),
+                ticks: t
+                    .into_iter()
+                    .filter(|v| *v >= lo - eps && *v <= hi + eps)
+                    .map(|v| (v, fmt_tick(v, step)))
+                    .collect(),
             }
         }
     }
@@ -361,8 +367,11 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
             if p.y_from_zero && !p.ylog {
                 let (a, b) = (a.min(0.0), b.max(0.0));
                 (a, b + 0.08 * (b - a))
-            } else {
+            } else if p.ylog {
                 (a, b)
+            } else {
+                let pad = 0.04 * (b - a);
+                (a - pad, b + pad)
             }
         }),
     };
@@ -534,8 +543,46 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
             * 6.8
             + 40.0;
         let lh = entries.len() as f64 * 16.0 + 8.0;
-        let lx = ox + w - lw - 8.0;
-        let ly = oy + 8.0;
+        // The corner that hides the fewest points: top right, top left, bottom right, bottom left.
+        let corners = [
+            (ox + w - lw - 8.0, oy + 8.0),
+            (ox + 8.0, oy + 8.0),
+            (ox + w - lw - 8.0, oy + h - lh - 8.0),
+            (ox + 8.0, oy + h - lh - 8.0),
+        ];
+        let hidden = |(cx, cy): (f64, f64)| -> usize {
+            p.series
+                .iter()
+                .map(|se| {
+                    se.points
+                        .iter()
+                        .filter(|&&(x, y)| {
+                            if !ok(x, y) && !matches!(se.style, Style::VRule { .. }) {
+                                return false;
+                            }
+                            let gx = px(x);
+                            let inside_x = gx >= cx - 4.0 && gx <= cx + lw + 4.0;
+                            match se.style {
+                                Style::VRule { .. } => inside_x,
+                                Style::Bars { .. } | Style::Stems => {
+                                    inside_x && py(y) <= cy + lh + 4.0
+                                }
+                                _ => {
+                                    let gy = py(y);
+                                    inside_x && gy >= cy - 4.0 && gy <= cy + lh + 4.0
+                                }
+                            }
+                        })
+                        .count()
+                })
+                .sum()
+        };
+        let (lx, ly) = corners
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by_key(|(i, c)| (hidden(*c), *i))
+            .map_or(corners[0], |x| x.1);
         let _ = writeln!(
             s,
             r##"<rect x="{lx:.1}" y="{ly:.1}" width="{lw:.1}" height="{lh:.1}" fill="white" fill-opacity="0.85" stroke="#bbb"/>"##

@@ -476,10 +476,21 @@ fn ml_fits() {
     let p = fit["parameters"].as_array().unwrap();
     let names: Vec<&str> = p.iter().map(|p| p["name"].as_str().unwrap()).collect();
     assert_eq!(names, ["jitter.n", "jitter.a", "jitter.sigma"]);
-    let (a, se) = (p[1]["estimate"].as_f64().unwrap(), p[1]["stderr"].as_f64().unwrap());
+    let (a, se) = (
+        p[1]["estimate"].as_f64().unwrap(),
+        p[1]["stderr"].as_f64().unwrap(),
+    );
     assert!((a - 0.4).abs() < 5.0 * se, "{a} ± {se}");
     // The same data by BCLS, through the command-line override.
-    let b = json(&["fit", s(&exp), "--data", s(&data), "--json", "--method", "bcls"]);
+    let b = json(&[
+        "fit",
+        s(&exp),
+        "--data",
+        s(&data),
+        "--json",
+        "--method",
+        "bcls",
+    ]);
     assert_eq!(b["method"], "bcls");
 }
 

@@ -170,6 +170,51 @@ impl PiecewiseCheb {
         (t <= self.ends[i]).then_some(i)
     }
 
+    /// The segment containing `t`, trying `hint` and its successor first (updated).
+    #[inline]
+    pub(crate) fn segment_near(&self, t: f64, hint: &mut usize) -> Option<usize> {
+        let h = *hint;
+        if h < self.starts.len() && self.starts[h] <= t {
+            if t <= self.ends[h] {
+                return Some(h);
+            }
+            if h + 1 < self.starts.len() && self.starts[h + 1] <= t && t <= self.ends[h + 1] {
+                *hint = h + 1;
+                return Some(h + 1);
+            }
+        }
+        let s = self.segment(t)?;
+        *hint = s;
+        Some(s)
+    }
+
+    /// Channel 0 at 16 points of one segment `seg` (vectorised Clenshaw).
+    #[inline]
+    pub(crate) fn eval0_16(&self, seg: usize, ts: &[f64; 16], out: &mut [f64; 16]) {
+        let (a, b) = (self.starts[seg], self.ends[seg]);
+        let (c0, scale) = (-(a + b) / (b - a), 2.0 / (b - a));
+        let base = seg * self.channels * CHEB_POINTS;
+        let c = &self.coefs[base..base + CHEB_POINTS];
+        let mut x = [0.0; 16];
+        let mut x2 = [0.0; 16];
+        for i in 0..16 {
+            x[i] = (scale * ts[i] + c0).clamp(-1.0, 1.0);
+            x2[i] = 2.0 * x[i];
+        }
+        let mut b1 = [0.0; 16];
+        let mut b2 = [0.0; 16];
+        for &cj in c[1..].iter().rev() {
+            for i in 0..16 {
+                let b0 = cj + x2[i] * b1[i] - b2[i];
+                b2[i] = b1[i];
+                b1[i] = b0;
+            }
+        }
+        for i in 0..16 {
+            out[i] = c[0] + x[i] * b1[i] - b2[i];
+        }
+    }
+
     #[inline]
     fn local(&self, seg: usize, t: f64) -> f64 {
         let (a, b) = (self.starts[seg], self.ends[seg]);

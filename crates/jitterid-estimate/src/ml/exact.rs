@@ -213,10 +213,31 @@ impl JitterPrep {
     }
 
     #[inline]
-    fn pdf(&self, tau: f64) -> f64 {
-        match self.pdf.segment(tau) {
+    fn pdf(&self, tau: f64, hint: &mut usize) -> f64 {
+        match self.pdf.segment_near(tau, hint) {
             Some(seg) => self.pdf.eval0(seg, tau).max(0.0),
             None => 0.0,
+        }
+    }
+
+    /// The density at 16 increasing points.
+    #[inline]
+    fn pdf16(&self, taus: &[f64; 16], out: &mut [f64; 16], hint: &mut usize) {
+        let first = self.pdf.segment_near(taus[0], hint);
+        let mut last_hint = *hint;
+        let last = self.pdf.segment_near(taus[15], &mut last_hint);
+        match (first, last) {
+            (Some(a), Some(b)) if a == b => {
+                self.pdf.eval0_16(a, taus, out);
+                for v in out.iter_mut() {
+                    *v = v.max(0.0);
+                }
+            }
+            _ => {
+                for (o, &t) in out.iter_mut().zip(taus) {
+                    *o = self.pdf(t, hint);
+                }
+            }
         }
     }
 }
@@ -282,18 +303,37 @@ pub(crate) struct SignalEval<'a, S: ?Sized> {
 
 impl<S: Signal + ?Sized> SignalEval<'_, S> {
     #[inline]
-    fn value(&self, t: f64) -> f64 {
-        DBG_EVALS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        match self.table.segment(t) {
+    fn value(&self, t: f64, hint: &mut usize) -> f64 {
+        match self.table.segment_near(t, hint) {
             Some(seg) => self.table.eval0(seg, t),
             None => self.signal.value(t),
         }
     }
 
+    /// `s(t + τ_i)` at 16 increasing offsets.
+    #[inline]
+    fn values16(&self, t: f64, taus: &[f64; 16], out: &mut [f64; 16], hint: &mut usize) {
+        let mut ts = [0.0; 16];
+        for i in 0..16 {
+            ts[i] = t + taus[i];
+        }
+        let first = self.table.segment_near(ts[0], hint);
+        let mut last_hint = *hint;
+        let last = self.table.segment_near(ts[15], &mut last_hint);
+        match (first, last) {
+            (Some(a), Some(b)) if a == b => self.table.eval0_16(a, &ts, out),
+            _ => {
+                for (o, &t) in out.iter_mut().zip(&ts) {
+                    *o = self.value(t, hint);
+                }
+            }
+        }
+    }
+
     /// `[s, ∂s/∂θ…]` into `out` (length `1 + grad_channels`).
     #[inline]
-    fn all(&self, t: f64, out: &mut [f64]) {
-        match self.table.segment(t) {
+    fn all(&self, t: f64, out: &mut [f64], hint: &mut usize) {
+        match self.table.segment_near(t, hint) {
             Some(seg) => self.table.eval_all(seg, t, out),
             None => {
                 out[0] = self.signal.value(t);
@@ -312,6 +352,8 @@ pub(crate) struct Scratch {
     steep: Vec<Steep>,
     cut: Vec<(f64, f64)>,
     ch: Vec<f64>,
+    sig_hint: usize,
+    pdf_hint: usize,
 }
 
 #[derive(Debug, Clone)]
@@ -343,7 +385,6 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
     ) -> f64 {
         let jp = self.jitter;
         let local = local_breaks(self.breaks, t, jp.lo, jp.hi);
-        DBG_SAMPLES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         if self.opts.shortcut && local.is_empty() {
             if let Some(mu) = &jp.moments {
                 if let Some(v) = self.shortcut(t, y, mu, grad.as_deref().map(|g| g.len()), scratch)
@@ -351,14 +392,11 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                     if let Some(g) = grad {
                         g.copy_from_slice(&scratch.ch[..g.len()]);
                     }
-                    DBG_SHORT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     return v;
                 }
             }
         }
         self.build_rule(t, y, &local, scratch);
-        DBG_NODES.fetch_add(scratch.s.len(), std::sync::atomic::Ordering::Relaxed);
-        DBG_STEEP.fetch_add(scratch.steep.len(), std::sync::atomic::Ordering::Relaxed);
         self.sum(t, y, grad, scratch)
     }
 
@@ -367,15 +405,16 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
     pub(crate) fn signal_range(&self, t: f64) -> (f64, f64) {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
+        let mut hint = 0;
         for c in &self.jitter.coarse {
             for &tau in c.nodes.iter().chain([c.a, c.b].iter()) {
-                let s = self.signal.value(t + tau);
+                let s = self.signal.value(t + tau, &mut hint);
                 lo = lo.min(s);
                 hi = hi.max(s);
             }
         }
         for a in &self.jitter.atoms {
-            let s = self.signal.value(t + a.position);
+            let s = self.signal.value(t + a.position, &mut hint);
             lo = lo.min(s);
             hi = hi.max(s);
         }
@@ -394,13 +433,21 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         let b = basis();
         let (mid, half) = (0.5 * (jp.lo + jp.hi), 0.5 * (jp.hi - jp.lo));
         let sigma = self.sigma;
-        let mut s = [0.0; CHEB_POINTS];
-        for (si, &x) in s.iter_mut().zip(&b.nodes) {
-            *si = self.signal.value(t + mid + half * x);
+        // The Chebyshev nodes in increasing order (the basis stores them decreasing).
+        let mut taus = [0.0; CHEB_POINTS];
+        for i in 0..CHEB_POINTS {
+            taus[i] = mid + half * b.nodes[CHEB_POINTS - 1 - i];
         }
-        let tv: f64 = s.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
+        let mut sv = [0.0; CHEB_POINTS];
+        self.signal.values16(t, &taus, &mut sv, &mut scratch.sig_hint);
+        let tv: f64 = sv.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
         if !(tv <= 2.0 * sigma) {
             return None;
+        }
+        // Back to the basis' order.
+        let mut s = [0.0; CHEB_POINTS];
+        for i in 0..CHEB_POINTS {
+            s[i] = sv[CHEB_POINTS - 1 - i];
         }
         let inv2 = 0.5 / (sigma * sigma);
         let mut e = [0.0; CHEB_POINTS];
@@ -430,7 +477,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 let mut chans = vec![0.0; 1 + self.signal.grad_channels];
                 let mut g = vec![[0.0; CHEB_POINTS]; ns];
                 for (i, &x) in b.nodes.iter().enumerate() {
-                    self.signal.all(t + mid + half * x, &mut chans);
+                    self.signal
+                        .all(t + mid + half * x, &mut chans, &mut scratch.sig_hint);
                     for j in 0..ns {
                         g[j][i] = h[i] * e[i] * chans[1 + j];
                     }
@@ -452,99 +500,128 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
     fn push_gl(&self, t: f64, a: f64, b: f64, scratch: &mut Scratch) {
         let (x, w) = gl16();
         let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        let mut taus = [0.0; 16];
         for i in 0..16 {
-            let tau = mid + half * x[i];
-            let wi = half * w[i] * self.jitter.pdf(tau);
+            taus[i] = mid + half * x[i];
+        }
+        let mut p = [0.0; 16];
+        self.jitter.pdf16(&taus, &mut p, &mut scratch.pdf_hint);
+        let mut sv = [0.0; 16];
+        self.signal.values16(t, &taus, &mut sv, &mut scratch.sig_hint);
+        for i in 0..16 {
+            let wi = half * w[i] * p[i];
             if wi > 0.0 {
-                scratch.tau.push(tau);
+                scratch.tau.push(taus[i]);
                 scratch.w.push(wi);
-                scratch.s.push(self.signal.value(t + tau));
+                scratch.s.push(sv[i]);
             }
         }
     }
 
+    /// One coarse interval `[a, b]` with its 16 nodes (and weights, when shared): either its
+    /// rule is pushed (the signal moves little), or it is kept for refinement. Returns whether
+    /// a node or gap comes within the window of `y`.
+    fn coarse(
+        &self,
+        t: f64,
+        y: f64,
+        (a, b): (f64, f64),
+        nodes: &[f64; 16],
+        weights: Option<&[f64; 16]>,
+        scratch: &mut Scratch,
+    ) -> bool {
+        let res = self.opts.resolution * self.sigma;
+        let reach = self.opts.window * self.sigma;
+        let mut sv = [0.0; 16];
+        self.signal.values16(t, nodes, &mut sv, &mut scratch.sig_hint);
+        let mut pt = [0.0; 18];
+        let mut pv = [0.0; 18];
+        pt[1..17].copy_from_slice(nodes);
+        pv[1..17].copy_from_slice(&sv);
+        // The ends, by linear extrapolation from the outer nodes (within 0.6% of the width).
+        pt[0] = a;
+        pt[17] = b;
+        pv[0] = pv[1] + (pv[1] - pv[2]) * (pt[1] - a) / (pt[2] - pt[1]);
+        pv[17] = pv[16] + (pv[16] - pv[15]) * (b - pt[16]) / (pt[16] - pt[15]);
+        let tv: f64 = pv.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
+        if tv <= res {
+            let mut near = false;
+            let mut own = [0.0; 16];
+            let ws = match weights {
+                Some(ws) => ws,
+                None => {
+                    let (_, gw) = gl16();
+                    let half = 0.5 * (b - a);
+                    self.jitter.pdf16(nodes, &mut own, &mut scratch.pdf_hint);
+                    for i in 0..16 {
+                        own[i] *= half * gw[i];
+                    }
+                    &own
+                }
+            };
+            for i in 0..16 {
+                if ws[i] > 0.0 {
+                    scratch.tau.push(nodes[i]);
+                    scratch.w.push(ws[i]);
+                    scratch.s.push(sv[i]);
+                    near |= (y - sv[i]).abs() <= reach;
+                }
+            }
+            return near;
+        }
+        // Steep: margins for the curvature between points, and activity.
+        let mut slope = [0.0; 17];
+        for j in 0..17 {
+            let dt = pt[j + 1] - pt[j];
+            slope[j] = if dt > 0.0 {
+                (pv[j + 1] - pv[j]) / dt
+            } else {
+                0.0
+            };
+        }
+        let mut curv = [0.0; 18];
+        for j in 1..17 {
+            let dt = pt[j + 1] - pt[j - 1];
+            curv[j] = if dt > 0.0 {
+                (2.0 * (slope[j] - slope[j - 1]) / dt).abs()
+            } else {
+                0.0
+            };
+        }
+        curv[0] = curv[1];
+        curv[17] = curv[16];
+        let mut st = Steep {
+            t: pt,
+            v: pv,
+            margin: [0.0; 17],
+            active: [false; 17],
+        };
+        let mut near = false;
+        for j in 0..17 {
+            let dt = pt[j + 1] - pt[j];
+            st.margin[j] = curv[j].max(curv[j + 1]) * dt * dt / 4.0;
+            let (lo, hi) = (pv[j].min(pv[j + 1]), pv[j].max(pv[j + 1]));
+            st.active[j] = y >= lo - st.margin[j] - reach && y <= hi + st.margin[j] + reach;
+            near |= st.active[j];
+        }
+        scratch.steep.push(st);
+        near
+    }
+
     fn build_rule(&self, t: f64, y: f64, local: &[f64], scratch: &mut Scratch) {
         let jp = self.jitter;
-        let sigma = self.sigma;
-        let res = self.opts.resolution * sigma;
-        let reach = self.opts.window * sigma;
+        let res = self.opts.resolution * self.sigma;
         scratch.tau.clear();
         scratch.w.clear();
         scratch.s.clear();
         scratch.steep.clear();
         let mut near = false;
-        let (x, w) = gl16();
-        // Coarse intervals: shared ones, or cut at the local breakpoints.
-        let mut handle = |a: f64, b: f64, nodes: &[f64; 16], weights: Option<&[f64; 16]>,
-                          scratch: &mut Scratch| {
-            let mut pt = [0.0; 18];
-            let mut pv = [0.0; 18];
-            pt[0] = a;
-            pt[17] = b;
-            pv[0] = self.signal.value(t + a);
-            pv[17] = self.signal.value(t + b);
-            for i in 0..16 {
-                pt[i + 1] = nodes[i];
-                pv[i + 1] = self.signal.value(t + nodes[i]);
-            }
-            let tv: f64 = pv.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
-            if tv <= res {
-                for i in 0..16 {
-                    let wi = match weights {
-                        Some(ws) => ws[i],
-                        None => {
-                            let half = 0.5 * (b - a);
-                            half * w[i] * self.jitter.pdf(nodes[i])
-                        }
-                    };
-                    if wi > 0.0 {
-                        scratch.tau.push(nodes[i]);
-                        scratch.w.push(wi);
-                        scratch.s.push(pv[i + 1]);
-                        if (y - pv[i + 1]).abs() <= reach {
-                            near = true;
-                        }
-                    }
-                }
-                return;
-            }
-            // Steep: margins for the curvature between points, and activity.
-            let mut slope = [0.0; 17];
-            for j in 0..17 {
-                let dt = pt[j + 1] - pt[j];
-                slope[j] = if dt > 0.0 { (pv[j + 1] - pv[j]) / dt } else { 0.0 };
-            }
-            let mut curv = [0.0; 18];
-            for j in 1..17 {
-                let dt = pt[j + 1] - pt[j - 1];
-                curv[j] = if dt > 0.0 {
-                    (2.0 * (slope[j] - slope[j - 1]) / dt).abs()
-                } else {
-                    0.0
-                };
-            }
-            curv[0] = curv[1];
-            curv[17] = curv[16];
-            let mut st = Steep {
-                t: pt,
-                v: pv,
-                margin: [0.0; 17],
-                active: [false; 17],
-            };
-            for j in 0..17 {
-                let dt = pt[j + 1] - pt[j];
-                st.margin[j] = curv[j].max(curv[j + 1]) * dt * dt / 4.0;
-                let (lo, hi) = (pv[j].min(pv[j + 1]), pv[j].max(pv[j + 1]));
-                st.active[j] = y >= lo - st.margin[j] - reach && y <= hi + st.margin[j] + reach;
-                near |= st.active[j];
-            }
-            scratch.steep.push(st);
-        };
         if local.is_empty() {
             for c in &jp.coarse {
-                handle(c.a, c.b, &c.nodes, Some(&c.weights), scratch);
+                near |= self.coarse(t, y, (c.a, c.b), &c.nodes, Some(&c.weights), scratch);
             }
         } else {
+            let (x, _) = gl16();
             let mut cut = std::mem::take(&mut scratch.cut);
             cut.clear();
             for c in &jp.coarse {
@@ -561,7 +638,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 for i in 0..16 {
                     nodes[i] = mid + half * x[i];
                 }
-                handle(a, b, &nodes, None, scratch);
+                near |= self.coarse(t, y, (a, b), &nodes, None, scratch);
             }
             scratch.cut = cut;
         }
@@ -574,7 +651,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         for atom in &jp.atoms {
             scratch.tau.push(atom.position);
             scratch.w.push(atom.mass);
-            scratch.s.push(self.signal.value(t + atom.position));
+            let s = self.signal.value(t + atom.position, &mut scratch.sig_hint);
+            scratch.s.push(s);
         }
     }
 
@@ -595,6 +673,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 return st.t[0];
             }
             if i == m {
+                *gap = 16;
                 return st.t[17];
             }
             let c = total * i as f64 / m as f64;
@@ -615,9 +694,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         for i in 0..m {
             let first_gap = gap;
             let b = boundary(i + 1, &mut gap);
-            // Gaps overlapped by [a, b]: first_gap..=gap (the gap containing b).
-            let last = if gap < 16 && b >= st.t[gap + 1] { gap + 1 } else { gap }.min(16);
-            let active = all_active || st.active[first_gap..=last].iter().any(|&x| x);
+            // [a, b] overlaps the gaps first_gap..=gap.
+            let active = all_active || st.active[first_gap..=gap].iter().any(|&x| x);
             if active {
                 if let Some(r) = run_start.take() {
                     self.push_gl(t, r, a, scratch);
@@ -651,7 +729,10 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         let mut total = 0.0;
         for (&s, &w) in scratch.s.iter().zip(&scratch.w) {
             let e = y - s;
-            total += w * (-e * e * inv2 - lmax).exp();
+            let q = -e * e * inv2 - lmax;
+            if q > -745.0 {
+                total += w * q.exp();
+            }
         }
         let mut shift = lmax;
         let mut use_logs = false;
@@ -686,7 +767,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 }
                 g[ns] += r * e * e;
                 if ns > 0 {
-                    self.signal.all(t + scratch.tau[i], &mut chans);
+                    self.signal
+                        .all(t + scratch.tau[i], &mut chans, &mut scratch.sig_hint);
                     for j in 0..ns {
                         g[j] += r * e * chans[1 + j];
                     }
@@ -700,14 +782,4 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         }
         log_p
     }
-}
-
-pub static DBG_EVALS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_SAMPLES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_SHORT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_NODES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_STEEP: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub fn dbg_stats() -> [usize; 5] {
-    use std::sync::atomic::Ordering::Relaxed;
-    [DBG_EVALS.swap(0, Relaxed), DBG_SAMPLES.swap(0, Relaxed), DBG_SHORT.swap(0, Relaxed), DBG_NODES.swap(0, Relaxed), DBG_STEEP.swap(0, Relaxed)]
 }

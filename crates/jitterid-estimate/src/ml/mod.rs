@@ -74,7 +74,7 @@ pub mod sine;
 
 pub use criterion::{Evaluation, GradientRequest, LikelihoodCriterion, LikelihoodData};
 pub use error::MlError;
-pub use exact::{ExactMl, dbg_stats};
+pub use exact::ExactMl;
 pub use fisher::{
     delta_method_std, exact_fisher, gaussian_fisher, FisherInformation, FisherOptions,
 };
