@@ -1,6 +1,6 @@
 //! The first moment `μ_Y` against independent routes (issue: workspace foundation, item 6).
 
-use jitterid::jitter::{JitterModel, NoJitter, UniformSum};
+use jitterid::jitter::{NoJitter, UniformSum};
 use jitterid::prelude::*;
 use jitterid::window::{
     dirichlet, first_moment, first_moment_integral, transform, DirichletWindow, FrequencySet,
