@@ -535,6 +535,147 @@ fn help_and_version() {
     assert_eq!(stderr(&o).trim_end().lines().count(), 1, "{}", stderr(&o));
 }
 
+/// Experiments that exercise the other kinds, families, noise models and solvers.
+const KINDS: &[(&str, &str, &[&str])] = &[
+    (
+        "tf-multisine-laplace",
+        r#"[sampling]
+interval = 0.5
+samples = 120
+start = 1.0
+[input]
+kind = "multisine"
+frequencies = [0.05, 0.13, 0.31]
+amplitudes = [1.0, 0.5, 0.5]
+[system]
+kind = "tf"
+num = [1.0]
+den = [1.0, 1.2, 1.0]
+estimate = true
+[jitter]
+family = "laplace"
+scale = 0.05
+estimate = true
+[noise]
+std = 0.01
+estimate = true
+[estimate]
+solver = "nelder-mead"
+max_iterations = 3000
+"#,
+        &["b0", "a1", "a0", "jitter.b", "noise.std"],
+    ),
+    (
+        "piecewise-two-point-band",
+        r#"[sampling]
+interval = 1.0
+samples = 60
+[input]
+kind = "piecewise"
+times = [0.0, 10.0, 25.0, 40.0]
+values = [1.0, -1.0, 0.5, 0.0]
+[system]
+kind = "zpk"
+gain = 1.0
+poles = [-0.5, -1.5]
+estimate = true
+[jitter]
+family = "two-point"
+d = 0.1
+[noise]
+std = 0.01
+[estimate]
+frequencies = { min = 0.0, max = 0.3 }
+solver = "gauss-newton"
+multistart = 2
+multistart_radius = 0.3
+"#,
+        &["gain", "pole0", "pole1"],
+    ),
+    (
+        "csv-input-shifted-exponential",
+        r#"[sampling]
+interval = 1.0
+samples = 60
+[input]
+kind = "csv"
+path = "u.csv"
+[system]
+kind = "zpk"
+gain = 0.5
+poles = [-0.5]
+estimate = true
+[jitter]
+family = "exponential"
+mean = 0.1
+offset = -0.1
+estimate = true
+[noise]
+std = 0.005
+"#,
+        &["gain", "pole0", "jitter.offset", "jitter.mean"],
+    ),
+    (
+        "bj-arma",
+        r#"[sampling]
+interval = 1.0
+samples = 100
+[input]
+kind = "random-binary"
+mean_dwell = 4.0
+[system]
+kind = "zpk"
+gain = 1.0
+poles = [-1.0]
+estimate = true
+[jitter]
+family = "gaussian"
+sigma = 0.1
+[noise]
+std = 0.02
+model = "arma"
+d = [-0.7]
+estimate = true
+[estimate]
+method = "bj"
+frequencies = [0.01, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4]
+"#,
+        &["gain", "pole0", "noise.d1", "noise.std"],
+    ),
+];
+
+#[test]
+fn other_kinds_families_noise_models_and_solvers() {
+    let dir = scratch("kinds");
+    std::fs::write(
+        dir.join("u.csv"),
+        "t,u\n0.0,0.0\n3.0,1.0\n17.5,0.0\n30.0,1.0\n50.0,0.0\n",
+    )
+    .unwrap();
+    for (name, text, names) in KINDS {
+        let exp = dir.join(format!("{name}.toml"));
+        std::fs::write(&exp, text).unwrap();
+        let data = dir.join(format!("{name}.csv"));
+        ok(&["simulate", s(&exp), "--out", s(&data)]);
+        let fit = json(&["fit", s(&exp), "--data", s(&data), "--json"]);
+        let got: Vec<&str> = fit["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(&got, names, "{name}");
+        let mc = json(&["montecarlo", s(&exp), "--runs", "2", "--json"]);
+        let got: Vec<&str> = mc["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["name"].as_str().unwrap())
+            .collect();
+        assert_eq!(&got, names, "{name}");
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input: exit status 2, one line naming the file and the line or key, no output left.
 

@@ -160,6 +160,11 @@ fn second_moments_and_dtft_covariance_match_monte_carlo() {
                 let sd = (prods.iter().map(|p| (p - mean).powi(2)).sum::<f64>()
                     / (reps - 1) as f64)
                     .sqrt();
+                if sd == 0.0 {
+                    // Im D(0) ≡ 0: the model must say so exactly.
+                    assert!(mean == 0.0 && real[i][j].abs() < 1e-15, "cov[{i}][{j}]");
+                    continue;
+                }
                 let z = (mean - real[i][j]) / (sd / (reps as f64).sqrt());
                 assert!(z.abs() < 4.5, "cov[{i}][{j}]: {mean} vs {}: z = {z}", real[i][j]);
             }
@@ -476,8 +481,9 @@ fn sine_record_too_short_is_an_error() {
     let grid = SampleGrid::new(0.0, 1.0, 64).unwrap();
     let y: Vec<f64> = grid.times().map(|t| sine.value(t)).collect();
     let ls = sine_least_squares(&Record::new(grid, y).unwrap()).unwrap();
-    assert!((ls.frequency - 0.3).abs() < 1e-9 && (ls.amplitude - 1.0).abs() < 1e-9);
-    assert!((ls.phase - 0.1).abs() < 1e-9);
+    // Noise-free data: the fit is exact to rounding.
+    assert!((ls.frequency - 0.3).abs() < 1e-12, "{}", ls.frequency);
+    assert!((ls.amplitude - 1.0).abs() < 1e-10 && (ls.phase - 0.1).abs() < 1e-10, "{ls:?}");
 }
 
 #[test]
@@ -649,7 +655,7 @@ fn minimisers_converge_and_respect_infeasible_regions() {
 }
 
 /// Timing of one likelihood evaluation per `n` (release: `cargo test --release --test ml
-/// timing -- --ignored --nocapture`).
+/// timing -- --ignored --nocapture`). Minimum over batches, robust to a loaded machine.
 #[test]
 #[ignore]
 fn timing() {
@@ -659,28 +665,51 @@ fn timing() {
     let truth = UniformSum::new(0, 0.5).unwrap();
     let data = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap();
     let record = Record::new(grid, data.y).unwrap();
-    for n in [0u32, 2, 5, 9] {
+    let min_time = |f: &mut dyn FnMut()| {
+        let mut best = f64::INFINITY;
+        for _ in 0..8 {
+            let t = std::time::Instant::now();
+            f();
+            best = best.min(t.elapsed().as_secs_f64() * 1e3);
+        }
+        best
+    };
+    let mut total = 0.0;
+    for n in 0u32..=9 {
         let a = 0.5 / 3f64.sqrt() * (3.0 * (n as f64 + 1.0)).sqrt();
         let structure = ModelStructure::oe(signal.clone(), UniformSum::new(n, a).unwrap())
             .with_estimated(false, true, false)
             .with_noise_std(0.01)
             .unwrap();
-        for (name, e) in [
-            ("exact", ExactMl::default()),
-            ("serial", ExactMl { parallel: false, ..ExactMl::default() }),
-            ("no shortcut", ExactMl { parallel: false, shortcut: false, ..ExactMl::default() }),
-        ] {
-            let o = LikelihoodObjective::new(&structure, &e, &record);
-            let t = std::time::Instant::now();
-            let reps = 20;
-            let mut v = 0.0;
-            for _ in 0..reps {
-                v = o.cost(&[a]);
-            }
-            println!("n = {n} {name}: {:.3} ms per evaluation ({v}) {:?}", t.elapsed().as_secs_f64() * 1e3 / reps as f64, dbg_stats().map(|x| x / reps));
-        }
-        let t = std::time::Instant::now();
-        let fit = ml_estimate(&structure, &record, &ExactMl::default(), &MlOptions::default()).unwrap();
-        println!("n = {n}: fit {:.1} ms, {} iterations", t.elapsed().as_secs_f64() * 1e3, fit.iterations);
+        let e = ExactMl { parallel: false, ..ExactMl::default() };
+        let o = LikelihoodObjective::new(&structure, &e, &record);
+        let ev = min_time(&mut || {
+            o.cost(&[a]);
+        });
+        let mut iters = 0;
+        let fit = min_time(&mut || {
+            iters = ml_estimate(&structure, &record, &e, &MlOptions::default())
+                .unwrap()
+                .iterations;
+        });
+        total += fit;
+        println!("n = {n}: {ev:.3} ms per evaluation, fit {fit:.1} ms ({iters} evaluations)");
+    }
+    println!("serial fits: {total:.1} ms");
+    let structure = ModelStructure::oe(signal.clone(), UniformSum::new(0, 0.55).unwrap())
+        .with_estimated(false, true, false)
+        .with_noise_std(0.01)
+        .unwrap();
+    for (name, e) in [
+        ("parallel samples", ExactMl::default()),
+        ("serial samples", ExactMl { parallel: false, ..ExactMl::default() }),
+    ] {
+        let mut n = 0;
+        let t = min_time(&mut || {
+            n = ml_profile_uniform_sum(&structure, &record, &e, &MlOptions::default(), 0..=9)
+                .unwrap()
+                .n;
+        });
+        println!("profile ({name}): {t:.1} ms, n = {n}");
     }
 }

@@ -77,6 +77,36 @@ pub(crate) struct PiecewiseCheb {
     channels: usize,
     /// Segment-major, then channel, then the 16 coefficients.
     coefs: Vec<f64>,
+    /// Channel 0 in the monomial basis of the local variable `x ∈ [−1, 1]`, per segment
+    /// (for the batched Horner evaluation).
+    mono0: Vec<[f64; CHEB_POINTS]>,
+}
+
+/// Monomial coefficients `a_k` with `Σ c_j T_j(x) = Σ a_k x^k`.
+fn chebyshev_to_monomial(c: &[f64]) -> [f64; CHEB_POINTS] {
+    // T_0 = 1, T_1 = x, T_{j+1} = 2x T_j − T_{j−1}, as coefficient rows.
+    let mut out = [0.0; CHEB_POINTS];
+    let mut t_prev = [0.0; CHEB_POINTS];
+    let mut t_cur = [0.0; CHEB_POINTS];
+    t_prev[0] = 1.0;
+    t_cur[1] = 1.0;
+    out[0] += c[0];
+    out[1] += c[1];
+    for &cj in &c[2..] {
+        let mut next = [0.0; CHEB_POINTS];
+        for k in 0..CHEB_POINTS - 1 {
+            next[k + 1] += 2.0 * t_cur[k];
+        }
+        for k in 0..CHEB_POINTS {
+            next[k] -= t_prev[k];
+        }
+        for k in 0..CHEB_POINTS {
+            out[k] += cj * next[k];
+        }
+        t_prev = t_cur;
+        t_cur = next;
+    }
+    out
 }
 
 /// Largest number of halvings of one input interval.
@@ -141,6 +171,7 @@ impl PiecewiseCheb {
                     }
                     out.starts.push(a);
                     out.ends.push(bb);
+                    out.mono0.push(chebyshev_to_monomial(&coefs[0]));
                     for c in &coefs {
                         out.coefs.extend_from_slice(c);
                     }
@@ -188,31 +219,58 @@ impl PiecewiseCheb {
         Some(s)
     }
 
-    /// Channel 0 at 16 points of one segment `seg` (vectorised Clenshaw).
+    /// Channel 0 at 16 points of one segment `seg` (Horner in the monomial basis, 16 lanes).
     #[inline]
     pub(crate) fn eval0_16(&self, seg: usize, ts: &[f64; 16], out: &mut [f64; 16]) {
         let (a, b) = (self.starts[seg], self.ends[seg]);
-        let (c0, scale) = (-(a + b) / (b - a), 2.0 / (b - a));
-        let base = seg * self.channels * CHEB_POINTS;
-        let c = &self.coefs[base..base + CHEB_POINTS];
+        let (mid, scale) = (0.5 * (a + b), 2.0 / (b - a));
+        let m = &self.mono0[seg];
         let mut x = [0.0; 16];
-        let mut x2 = [0.0; 16];
         for i in 0..16 {
-            x[i] = (scale * ts[i] + c0).clamp(-1.0, 1.0);
-            x2[i] = 2.0 * x[i];
+            x[i] = ((ts[i] - mid) * scale).clamp(-1.0, 1.0);
         }
-        let mut b1 = [0.0; 16];
-        let mut b2 = [0.0; 16];
-        for &cj in c[1..].iter().rev() {
+        let mut acc = [m[CHEB_POINTS - 1]; 16];
+        for &mk in m[..CHEB_POINTS - 1].iter().rev() {
             for i in 0..16 {
-                let b0 = cj + x2[i] * b1[i] - b2[i];
-                b2[i] = b1[i];
-                b1[i] = b0;
+                acc[i] = acc[i] * x[i] + mk;
             }
         }
-        for i in 0..16 {
-            out[i] = c[0] + x[i] * b1[i] - b2[i];
+        *out = acc;
+    }
+
+    /// Channel 0 at 16 increasing points, which may span several segments: each run of points
+    /// in one segment is evaluated by the vectorised Clenshaw. Points outside the table are
+    /// flagged `false` in the returned mask (their values are left untouched).
+    #[inline]
+    pub(crate) fn eval0_sorted16(
+        &self,
+        ts: &[f64; 16],
+        out: &mut [f64; 16],
+        hint: &mut usize,
+    ) -> [bool; 16] {
+        let mut ok = [false; 16];
+        let mut i = 0;
+        let mut tmp = [0.0; 16];
+        while i < 16 {
+            let Some(seg) = self.segment_near(ts[i], hint) else {
+                i += 1;
+                continue;
+            };
+            let end = self.ends[seg];
+            let mut j = i + 1;
+            while j < 16 && ts[j] <= end {
+                j += 1;
+            }
+            if j - i == 1 {
+                out[i] = self.eval0(seg, ts[i]);
+            } else {
+                self.eval0_16(seg, ts, &mut tmp);
+                out[i..j].copy_from_slice(&tmp[i..j]);
+            }
+            ok[i..j].iter_mut().for_each(|o| *o = true);
+            i = j;
         }
+        ok
     }
 
     #[inline]
@@ -266,6 +324,22 @@ mod tests {
             assert_eq!(table.eval0(seg, t), v[0]);
         }
         assert!(table.segment(-0.1).is_none() && table.segment(4.1).is_none());
+    }
+
+    #[test]
+    fn batched_horner_matches_clenshaw() {
+        let f = |t: f64, out: &mut [f64]| out[0] = (-2.0 * t).exp() * (3.0 * t).cos() + 0.5;
+        let table = PiecewiseCheb::build(&[(0.0, 2.0)], 1, 1e-14, f);
+        let mut hint = 0;
+        let ts: [f64; 16] = std::array::from_fn(|i| 0.05 + 0.12 * i as f64);
+        let mut out = [0.0; 16];
+        let ok = table.eval0_sorted16(&ts, &mut out, &mut hint);
+        for i in 0..16 {
+            assert!(ok[i]);
+            let mut v = [0.0];
+            f(ts[i], &mut v);
+            assert!((out[i] - v[0]).abs() < 2e-15, "{i}: {} vs {}", out[i], v[0]);
+        }
     }
 
     #[test]

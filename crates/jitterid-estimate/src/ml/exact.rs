@@ -212,32 +212,12 @@ impl JitterPrep {
         }
     }
 
-    #[inline]
-    fn pdf(&self, tau: f64, hint: &mut usize) -> f64 {
-        match self.pdf.segment_near(tau, hint) {
-            Some(seg) => self.pdf.eval0(seg, tau).max(0.0),
-            None => 0.0,
-        }
-    }
-
     /// The density at 16 increasing points.
     #[inline]
     fn pdf16(&self, taus: &[f64; 16], out: &mut [f64; 16], hint: &mut usize) {
-        let first = self.pdf.segment_near(taus[0], hint);
-        let mut last_hint = *hint;
-        let last = self.pdf.segment_near(taus[15], &mut last_hint);
-        match (first, last) {
-            (Some(a), Some(b)) if a == b => {
-                self.pdf.eval0_16(a, taus, out);
-                for v in out.iter_mut() {
-                    *v = v.max(0.0);
-                }
-            }
-            _ => {
-                for (o, &t) in out.iter_mut().zip(taus) {
-                    *o = self.pdf(t, hint);
-                }
-            }
+        let ok = self.pdf.eval0_sorted16(taus, out, hint);
+        for i in 0..16 {
+            out[i] = if ok[i] { out[i].max(0.0) } else { 0.0 };
         }
     }
 }
@@ -317,15 +297,10 @@ impl<S: Signal + ?Sized> SignalEval<'_, S> {
         for i in 0..16 {
             ts[i] = t + taus[i];
         }
-        let first = self.table.segment_near(ts[0], hint);
-        let mut last_hint = *hint;
-        let last = self.table.segment_near(ts[15], &mut last_hint);
-        match (first, last) {
-            (Some(a), Some(b)) if a == b => self.table.eval0_16(a, &ts, out),
-            _ => {
-                for (o, &t) in out.iter_mut().zip(&ts) {
-                    *o = self.value(t, hint);
-                }
+        let ok = self.table.eval0_sorted16(&ts, out, hint);
+        for i in 0..16 {
+            if !ok[i] {
+                out[i] = self.signal.value(ts[i]);
             }
         }
     }

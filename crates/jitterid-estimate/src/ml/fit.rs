@@ -6,7 +6,7 @@ use super::criterion::LikelihoodCriterion;
 use super::fisher::gaussian_fisher;
 use super::moments::second_moments;
 use super::objective::{LikelihoodObjective, Objective, TransformedObjective};
-use super::optim::MlSolver;
+use super::optim::{Brent, MlSolver};
 use super::param::{default_transforms, likelihood_param_names, likelihood_params, Layout};
 use super::MlError;
 use crate::data::Record;
@@ -254,6 +254,12 @@ where
     })
 }
 
+/// In the integer-`n` profile of a one-parameter fit, every `n` is first fitted to a loose
+/// tolerance (`1e-3` in `ln a`, which leaves `−log L` within about `1e-2` of its minimum), and
+/// only the `n` whose loose minimum is within this margin of the best are refined; the others
+/// cannot win.
+pub const PROFILE_MARGIN: f64 = 3.0;
+
 /// The result of [`ml_profile_uniform_sum`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MlProfile {
@@ -299,24 +305,65 @@ where
 {
     let sigma = structure.jitter.std_dev();
     let ns: Vec<u32> = ns.into_iter().collect();
+    let layout = Layout::of(structure);
+    // One parameter with the default solver: a coarse pass for every n, then the n that can
+    // still win refined (see `PROFILE_MARGIN`).
+    let staged = layout.len() == 1 && layout.nj == 1 && options.solver == MlSolver::Auto;
     let inner = MlOptions {
         covariance: false,
+        solver: if staged {
+            MlSolver::Brent(Brent {
+                tolerance: 1e-3,
+                ..Brent::default()
+            })
+        } else {
+            options.solver.clone()
+        },
         ..options.clone()
     };
-    let fits: Vec<(u32, Result<MlEstimate, MlError>)> = ns
+    let fit_at = |n: u32, a: f64, opts: &MlOptions| {
+        UniformSum::new(n, a).map_err(MlError::from).and_then(|j| {
+            let mut s = structure.clone();
+            s.jitter = j;
+            ml_estimate(&s, record, criterion, opts)
+        })
+    };
+    let mut fits: Vec<(u32, Result<MlEstimate, MlError>)> = ns
         .par_iter()
         .map(|&n| {
             let a = sigma * (3.0 * (f64::from(n) + 1.0)).sqrt();
-            let fit = UniformSum::new(n, a)
-                .map_err(MlError::from)
-                .and_then(|j| {
-                    let mut s = structure.clone();
-                    s.jitter = j;
-                    ml_estimate(&s, record, criterion, &inner)
-                });
-            (n, fit)
+            (n, fit_at(n, a, &inner))
         })
         .collect();
+    if staged {
+        let best = fits
+            .iter()
+            .filter_map(|(_, f)| f.as_ref().ok().filter(|e| e.converged))
+            .map(|e| e.neg_log_likelihood)
+            .fold(f64::INFINITY, f64::min);
+        let fine = MlOptions {
+            covariance: false,
+            solver: MlSolver::Brent(Brent {
+                bracket_step: 0.01,
+                ..Brent::default()
+            }),
+            ..options.clone()
+        };
+        fits.par_iter_mut().for_each(|(n, fit)| {
+            let refine = match fit {
+                Ok(e) => !(e.neg_log_likelihood > best + PROFILE_MARGIN),
+                Err(_) => false,
+            };
+            if refine {
+                if let Ok(e) = fit {
+                    let a = e.params[0];
+                    if let Ok(better) = fit_at(*n, a, &fine) {
+                        *fit = Ok(better);
+                    }
+                }
+            }
+        });
+    }
     let mut best: Option<(u32, MlEstimate)> = None;
     let mut costs = Vec::new();
     let mut first_error = None;
@@ -347,7 +394,7 @@ where
     };
     if options.covariance {
         let mut s = structure.clone();
-        let k = Layout::of(structure);
+        let k = layout;
         let theta = estimate.params.clone();
         // Rebuild the winning structure and evaluate the Hessian there.
         let a = if k.nj > 0 {

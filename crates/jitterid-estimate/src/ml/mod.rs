@@ -78,7 +78,9 @@ pub use exact::ExactMl;
 pub use fisher::{
     delta_method_std, exact_fisher, gaussian_fisher, FisherInformation, FisherOptions,
 };
-pub use fit::{ml_estimate, ml_profile_uniform_sum, MlEstimate, MlOptions, MlProfile};
+pub use fit::{
+    ml_estimate, ml_profile_uniform_sum, MlEstimate, MlOptions, MlProfile, PROFILE_MARGIN,
+};
 pub use moments::{
     dtft_covariance, expected_squares_gradient, second_moments, DtftCovariance, SecondMoments,
 };

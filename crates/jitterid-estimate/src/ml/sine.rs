@@ -45,10 +45,76 @@ pub struct SineLs {
     pub phase: f64,
     /// Root mean square of the residuals.
     pub residual_rms: f64,
+    /// Samples in the record.
+    pub samples: usize,
+    /// Sampling interval `T` (s).
+    pub interval: f64,
+}
+
+/// Gauss–Newton polish of `y ≈ a sin(2πft) + b cos(2πft)` in `(a, b, f)` from `f`: a few
+/// steps reach the precision of the data (Brent on the residual sum of squares alone stops
+/// at `√ε` relative in `f`).
+fn polish(record: &Record, f0: f64) -> Option<(f64, f64, f64)> {
+    let grid = record.grid();
+    let (a, b, _) = linear_fit_ab(record, f0)?;
+    let mut p = [a, b, f0];
+    for _ in 0..4 {
+        let mut jtj = [[0.0; 3]; 3];
+        let mut jtr = [0.0; 3];
+        for (k, &y) in record.y().iter().enumerate() {
+            let t = grid.time(k);
+            let (sn, cs) = (TAU * (p[2] * t).fract()).sin_cos();
+            let r = y - p[0] * sn - p[1] * cs;
+            let j = [sn, cs, TAU * t * (p[0] * cs - p[1] * sn)];
+            for u in 0..3 {
+                jtr[u] += j[u] * r;
+                for v in 0..3 {
+                    jtj[u][v] += j[u] * j[v];
+                }
+            }
+        }
+        let d = solve3(jtj, jtr)?;
+        for u in 0..3 {
+            p[u] += d[u];
+        }
+    }
+    Some((p[0], p[1], p[2]))
+}
+
+/// Solves a 3×3 system by Gaussian elimination with partial pivoting.
+fn solve3(mut m: [[f64; 3]; 3], mut r: [f64; 3]) -> Option<[f64; 3]> {
+    for c in 0..3 {
+        let piv = (c..3).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs()))?;
+        if !(m[piv][c].abs() > 0.0) {
+            return None;
+        }
+        m.swap(c, piv);
+        r.swap(c, piv);
+        for i in c + 1..3 {
+            let f = m[i][c] / m[c][c];
+            for j in c..3 {
+                m[i][j] -= f * m[c][j];
+            }
+            r[i] -= f * r[c];
+        }
+    }
+    let mut x = [0.0; 3];
+    for c in (0..3).rev() {
+        let s: f64 = (c + 1..3).map(|j| m[c][j] * x[j]).sum();
+        x[c] = (r[c] - s) / m[c][c];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// `(Â, φ̂, rss)` of the linear least-squares fit `y ≈ a sin(2πft) + b cos(2πft)` on the grid.
 fn linear_fit(record: &Record, f: f64) -> Option<(f64, f64, f64)> {
+    let (a, b, rss) = linear_fit_ab(record, f)?;
+    // a sin θ + b cos θ = A sin(θ + φ): a = A cos φ, b = A sin φ.
+    Some((a.hypot(b), b.atan2(a), rss))
+}
+
+/// `(a, b, rss)` of the linear least-squares fit `y ≈ a sin(2πft) + b cos(2πft)`.
+fn linear_fit_ab(record: &Record, f: f64) -> Option<(f64, f64, f64)> {
     let grid = record.grid();
     let (mut ss, mut cc, mut sc, mut ys, mut yc) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for (k, &y) in record.y().iter().enumerate() {
@@ -67,8 +133,7 @@ fn linear_fit(record: &Record, f: f64) -> Option<(f64, f64, f64)> {
     let b = (yc * ss - ys * sc) / det;
     let yy: f64 = record.y().iter().map(|y| y * y).sum();
     let rss = (yy - a * ys - b * yc).max(0.0);
-    // a sin θ + b cos θ = A sin(θ + φ): a = A cos φ, b = A sin φ.
-    Some((a.hypot(b), b.atan2(a), rss))
+    Some((a, b, rss))
 }
 
 struct Rss<'a>(&'a Record);
@@ -137,12 +202,20 @@ pub fn sine_least_squares(record: &Record) -> Result<SineLs, MlError> {
     if !(f > 0.0 && f < 0.5 / t) || (f - f_peak).abs() > 2.0 * df {
         f = f_peak;
     }
+    if let Some((_, _, fp)) = polish(record, f) {
+        let better = linear_fit(record, fp).map(|r| r.2) <= linear_fit(record, f).map(|r| r.2);
+        if fp > 0.0 && fp < 0.5 / t && (fp - f).abs() < df && better {
+            f = fp;
+        }
+    }
     let (a, phi, rss) = linear_fit(record, f).ok_or_else(|| too_short(cycles))?;
     Ok(SineLs {
         amplitude: a,
         frequency: f,
         phase: phi,
         residual_rms: (rss / n as f64).sqrt(),
+        samples: n,
+        interval: t,
     })
 }
 
@@ -157,41 +230,44 @@ pub fn attenuation_sigma(fitted_amplitude: f64, true_amplitude: f64, frequency: 
     Some((-2.0 * r.ln()).sqrt() / (TAU * frequency))
 }
 
-/// The start `(A, φ)` at alias `frequency` of the least-squares fit `ls` of a record with
-/// interval `interval`, for a jitter of characteristic function `γ` (the amplitude is
-/// undamped by `|γ(f)|`).
+/// The start `(A, f, φ)` at the alias of the least-squares fit `ls` nearest to the nominal
+/// `frequency` (`f = f_b + j/T` or `j/T − f_b` with the fitted baseband `f_b`), for a jitter
+/// of characteristic function `γ` (the amplitude is undamped by `|γ(f)|`).
 ///
 /// # Errors
 ///
-/// [`MlError::InvalidArgument`] if `frequency` is not an alias of `ls.frequency` (within
-/// `1e-6/T`) or not positive.
+/// [`MlError::InvalidArgument`] if `frequency` is not positive or not within `1/(2NT)` of
+/// an alias of `ls.frequency`.
 pub fn alias_start<J: JitterModel + ?Sized>(
     ls: &SineLs,
     frequency: f64,
-    interval: f64,
     jitter: &J,
-) -> Result<(f64, f64), MlError> {
+) -> Result<(f64, f64, f64), MlError> {
     let bad = MlError::InvalidArgument {
         name: "alias frequency",
         value: frequency,
-        reason: "must be > 0 and an alias f_b + j/T or j/T − f_b of the baseband frequency",
+        reason: "must be > 0 and within 1/(2NT) of an alias f_b + j/T or j/T − f_b of the baseband frequency",
     };
+    let t = ls.interval;
     if !(frequency > 0.0) {
         return Err(bad);
     }
-    let x = frequency * interval;
-    let xb = ls.frequency * interval;
-    let near_int = |v: f64| (v - v.round()).abs() < 1e-6;
-    let phase = if near_int(x - xb) {
-        ls.phase
-    } else if near_int(x + xb) {
+    let tol = 0.5 / ls.samples as f64;
+    let x = frequency * t;
+    let xb = ls.frequency * t;
+    let (f, phase) = if (x - xb - (x - xb).round()).abs() < tol {
+        (((x - xb).round() + xb) / t, ls.phase)
+    } else if (x + xb - (x + xb).round()).abs() < tol {
         // sin(−2πf_b t + φ') = sin(2πf_b t + φ) with φ' = π − φ.
-        PI - ls.phase
+        (((x + xb).round() - xb) / t, PI - ls.phase)
     } else {
         return Err(bad);
     };
-    let damping = jitter.cf(frequency).norm().max(1e-3);
-    Ok((ls.amplitude / damping, phase))
+    if !(f > 0.0) {
+        return Err(bad);
+    }
+    let damping = jitter.cf(f).norm().max(1e-3);
+    Ok((ls.amplitude / damping, f, phase))
 }
 
 /// A maximum-likelihood sine fit.
@@ -214,8 +290,9 @@ pub struct SineFit {
 }
 
 /// Fits `A, f0, φ`, the jitter's parameters (if `estimate_jitter`) and `σ_v` (unless
-/// `noise_std` is given) by maximum likelihood, starting at alias `frequency` of the
-/// least-squares fit `ls` with jitter `jitter` (known, or the start).
+/// `noise_std` is given) by maximum likelihood, starting at the alias of the least-squares
+/// fit `ls` nearest to the nominal `frequency` ([`alias_start`]) with jitter `jitter` (known,
+/// or the start).
 ///
 /// # Errors
 ///
@@ -235,8 +312,8 @@ where
     J: JitterModel + Clone,
     C: LikelihoodCriterion,
 {
-    let (a, phi) = alias_start(ls, frequency, record.grid().interval(), &jitter)?;
-    let signal = Sinusoid::new(a, frequency, phi)?;
+    let (a, f, phi) = alias_start(ls, frequency, &jitter)?;
+    let signal = Sinusoid::new(a, f, phi)?;
     let mut structure = ModelStructure::oe(signal, jitter).with_estimated(true, estimate_jitter, false);
     if let Some(s) = noise_std {
         structure = structure.with_noise_std(s)?;
