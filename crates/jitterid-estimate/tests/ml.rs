@@ -654,6 +654,46 @@ fn minimisers_converge_and_respect_infeasible_regions() {
     assert!((best[0] - 1.0).abs() < 1e-4, "{best:?}");
 }
 
+/// Timing of the sine case (release: `cargo test --release --test ml timing_sine --
+/// --ignored --nocapture`).
+#[test]
+#[ignore]
+fn timing_sine() {
+    let sine = Sinusoid::new(1.0, 1.78, 0.3).unwrap();
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let jitter = Gaussian::new(0.05).unwrap();
+    let mut rng = StdRng::seed_from_u64(40);
+    let data = simulate(&sine, &jitter, &grid, 0.01, &mut rng).unwrap();
+    let record = Record::new(grid, data.y).unwrap();
+    let ls = sine_least_squares(&record).unwrap();
+    for (name, e) in [
+        ("exact", ExactMl::default()),
+        ("serial", ExactMl { parallel: false, ..ExactMl::default() }),
+    ] {
+        let structure = ModelStructure::oe(sine, jitter).with_estimated(true, false, false);
+        let o = LikelihoodObjective::new(&structure, &e, &record);
+        let theta = [1.0, 1.78, 0.3, 0.01];
+        let t = std::time::Instant::now();
+        for _ in 0..5 {
+            o.cost(&theta);
+        }
+        println!("{name}: cost {:.2} ms", t.elapsed().as_secs_f64() * 200.0);
+        let t = std::time::Instant::now();
+        for _ in 0..5 {
+            o.cost_gradient(&theta);
+        }
+        println!("{name}: cost+gradient {:.2} ms", t.elapsed().as_secs_f64() * 200.0);
+        let t = std::time::Instant::now();
+        let fit = fit_sine(&record, &ls, 1.78, jitter, false, None, &e, &MlOptions::default()).unwrap();
+        println!(
+            "{name}: fit {:.1} ms, {} iterations, {:?}",
+            t.elapsed().as_secs_f64() * 1e3,
+            fit.estimate.iterations,
+            fit.estimate.termination
+        );
+    }
+}
+
 /// Timing of one likelihood evaluation per `n` (release: `cargo test --release --test ml
 /// timing -- --ignored --nocapture`). Minimum over batches, robust to a loaded machine.
 #[test]
