@@ -68,11 +68,20 @@ pub fn arb_response(end: f64) -> impl Strategy<Value = LtiResponse<Zpk>> {
 
 /// A strictly proper stable model (fewer zeros than poles), so `s(t)` has no jumps.
 pub fn arb_strict_system() -> impl Strategy<Value = Zpk> {
-    (0.1f64..3.0, -3.0f64..-0.1, prop::option::of((-2.0f64..-0.1, 0.1f64..3.0)), -3.0f64..3.0)
+    (
+        0.1f64..3.0,
+        -3.0f64..-0.1,
+        prop::option::of((-2.0f64..-0.1, 0.1f64..3.0)),
+        -3.0f64..3.0,
+    )
         .prop_filter_map("distinct poles", |(k, real, pair, zero)| {
             let mut poles = vec![Root::Real(real)];
             poles.extend(pair.map(|(re, im)| Root::Pair { re, im }));
-            let zeros = if poles.len() > 1 { vec![Root::Real(zero)] } else { vec![] };
+            let zeros = if poles.len() > 1 {
+                vec![Root::Real(zero)]
+            } else {
+                vec![]
+            };
             Zpk::new(k, zeros, poles).ok()
         })
 }
@@ -83,8 +92,7 @@ pub fn arb_smooth_jitter() -> impl Strategy<Value = Arc<dyn JitterModel>> {
     prop_oneof![
         (1u32..6, 0.05f64..0.8)
             .prop_map(|(n, a)| Arc::new(UniformSum::new(n, a).unwrap()) as Arc<dyn JitterModel>),
-        (0.03f64..0.3)
-            .prop_map(|s| Arc::new(Gaussian::new(s).unwrap()) as Arc<dyn JitterModel>),
+        (0.03f64..0.3).prop_map(|s| Arc::new(Gaussian::new(s).unwrap()) as Arc<dyn JitterModel>),
         (0.03f64..0.1).prop_map(|b| Arc::new(Laplace::new(b).unwrap()) as Arc<dyn JitterModel>),
         (-0.3f64..0.3, 0.05f64..0.4).prop_map(|(c, a)| {
             Arc::new(Shifted::new(UniformSum::new(1, a).unwrap(), c).unwrap())

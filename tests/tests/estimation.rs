@@ -41,12 +41,28 @@ fn eq17_fit<C: Criterion>(
         .unwrap();
     let g = eq17(truth[0], truth[1], truth[2], truth[3]);
     let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
-    let data = simulate(&LtiResponse::new(g, input.clone()), &jitter, &grid, 0.01, &mut rng).unwrap();
+    let data = simulate(
+        &LtiResponse::new(g, input.clone()),
+        &jitter,
+        &grid,
+        0.01,
+        &mut rng,
+    )
+    .unwrap();
     let s = perturbed(&truth, 0.2, &mut rng);
     let start = LtiResponse::new(eq17(s[0], s[1], s[2], s[3]), input);
     let structure = ModelStructure::oe(start, jitter);
-    let opts = EstimateOptions { covariance: false, ..EstimateOptions::default() };
-    let e = estimate(&structure, &Record::new(grid, data.y).unwrap(), criterion, &opts).ok()?;
+    let opts = EstimateOptions {
+        covariance: false,
+        ..EstimateOptions::default()
+    };
+    let e = estimate(
+        &structure,
+        &Record::new(grid, data.y).unwrap(),
+        criterion,
+        &opts,
+    )
+    .ok()?;
     e.converged.then_some(e.params)
 }
 
@@ -62,7 +78,12 @@ fn bcls_is_unbiased_on_table_2() {
     let want = [0.2, -0.5, -0.25, 0.3]; // the zero is at −z
     for (i, w) in want.iter().enumerate() {
         let s: Summary = fits.iter().map(|p| p[i]).collect();
-        assert!((s.mean - w).abs() <= 3.0 * s.se(), "param {i}: mean {} ± {} vs {w}", s.mean, s.se());
+        assert!(
+            (s.mean - w).abs() <= 3.0 * s.se(),
+            "param {i}: mean {} ± {} vs {w}",
+            s.mean,
+            s.se()
+        );
     }
 }
 
@@ -81,8 +102,18 @@ fn naive_ls_is_biased_where_bcls_is_not() {
     assert!(ls.len() >= 11 && bc.len() >= 11);
     let k_ls: Summary = ls.iter().map(|p| p[0]).collect();
     let k_bc: Summary = bc.iter().map(|p| p[0]).collect();
-    assert!(k_ls.mean < 2.0 - 5.0 * k_ls.se(), "LS gain {} ± {}", k_ls.mean, k_ls.se());
-    assert!((k_bc.mean - 2.0).abs() <= 3.0 * k_bc.se(), "BCLS gain {} ± {}", k_bc.mean, k_bc.se());
+    assert!(
+        k_ls.mean < 2.0 - 5.0 * k_ls.se(),
+        "LS gain {} ± {}",
+        k_ls.mean,
+        k_ls.se()
+    );
+    assert!(
+        (k_bc.mean - 2.0).abs() <= 3.0 * k_bc.se(),
+        "BCLS gain {} ± {}",
+        k_bc.mean,
+        k_bc.se()
+    );
 }
 
 #[test]
@@ -94,19 +125,40 @@ fn joe_recovers_the_jitter_standard_deviation() {
     let mut est = Vec::new();
     for r in 0..runs {
         let mut rng = realization_rng(21, r);
-        let input = RandomBinary::new(2.0, 0.0, 1.0).unwrap().generate(0.0, 401.0, &mut rng).unwrap();
+        let input = RandomBinary::new(2.0, 0.0, 1.0)
+            .unwrap()
+            .generate(0.0, 401.0, &mut rng)
+            .unwrap();
         let g = Zpk::new(2.0, vec![], vec![Root::Real(-2.0)]).unwrap();
         let grid = SampleGrid::new(0.0, 1.0, 400).unwrap();
         let signal = LtiResponse::new(g, input);
-        let data = simulate(&signal, &Gaussian::new(sigma).unwrap(), &grid, 0.01, &mut rng).unwrap();
+        let data = simulate(
+            &signal,
+            &Gaussian::new(sigma).unwrap(),
+            &grid,
+            0.01,
+            &mut rng,
+        )
+        .unwrap();
         let start = Gaussian::new(sigma * (1.0 + rng.random_range(-0.2..=0.2))).unwrap();
         let structure = ModelStructure::joe(signal, start).with_estimated(false, true, false);
-        let e = estimate(&structure, &Record::new(grid, data.y).unwrap(), &Bcls, &EstimateOptions::default()).unwrap();
+        let e = estimate(
+            &structure,
+            &Record::new(grid, data.y).unwrap(),
+            &Bcls,
+            &EstimateOptions::default(),
+        )
+        .unwrap();
         assert!(e.converged, "run {r}: {}", e.termination);
         est.push(e.params[0]);
     }
     let s: Summary = est.into_iter().collect();
-    assert!((s.mean - sigma).abs() <= 3.0 * s.se(), "σ̂ {} ± {}", s.mean, s.se());
+    assert!(
+        (s.mean - sigma).abs() <= 3.0 * s.se(),
+        "σ̂ {} ± {}",
+        s.mean,
+        s.se()
+    );
     assert!(s.std() < 0.5 * sigma, "σ̂ is informative: std {}", s.std());
 }
 
@@ -137,15 +189,31 @@ fn box_jenkins_recovers_a_known_noise_model() {
         // The jitter's own noise is white: the residual spectrum is σ_e²(|H|² + ρ).
         let noise = WithFloor::new(ArmaNoise::new(vec![], vec![-0.5]).unwrap(), 0.1).unwrap();
         let structure = ModelStructure::bj(start, jitter, noise);
-        let fit = estimate(&structure, &Record::new(grid, y).unwrap(), &BoxJenkins, &EstimateOptions::default()).unwrap();
+        let fit = estimate(
+            &structure,
+            &Record::new(grid, y).unwrap(),
+            &BoxJenkins,
+            &EstimateOptions::default(),
+        )
+        .unwrap();
         assert!(fit.converged, "run {r}: {}", fit.termination);
         k0.push(fit.params[0]);
         d1.push(fit.params[4]);
     }
     let s: Summary = d1.into_iter().collect();
-    assert!((s.mean + 0.8).abs() <= 3.0 * s.se(), "d1 {} ± {}", s.mean, s.se());
+    assert!(
+        (s.mean + 0.8).abs() <= 3.0 * s.se(),
+        "d1 {} ± {}",
+        s.mean,
+        s.se()
+    );
     let g: Summary = k0.into_iter().collect();
-    assert!((g.mean - 0.2).abs() <= 3.0 * g.se(), "k0 {} ± {}", g.mean, g.se());
+    assert!(
+        (g.mean - 0.2).abs() <= 3.0 * g.se(),
+        "k0 {} ± {}",
+        g.mean,
+        g.se()
+    );
 }
 
 proptest! {
@@ -192,13 +260,23 @@ fn bcls_on_the_full_grid_is_time_domain_least_squares() {
     let mut rng = realization_rng(1, 1);
     let y = simulate(&signal, &jitter, &grid, 0.01, &mut rng).unwrap().y;
     let structure = ModelStructure::oe(signal.clone(), jitter);
-    let data = FrequencyData::new(Record::new(grid, y.clone()).unwrap(), DirichletWindow, FrequencySet::full_dft(&grid)).unwrap();
+    let data = FrequencyData::new(
+        Record::new(grid, y.clone()).unwrap(),
+        DirichletWindow,
+        FrequencySet::full_dft(&grid),
+    )
+    .unwrap();
     let m = signal.expected_values(&grid, &jitter);
     let time: f64 = 0.5 * 100.0 * y.iter().zip(&m).map(|(y, m)| (y - m).powi(2)).sum::<f64>();
     let freq = Bcls.cost(&data, &structure);
     assert!((time - freq).abs() <= 1e-10 * time, "{time} vs {freq}");
     // And on half the grid it is not the same number (only the full grid has Parseval).
-    let half = FrequencyData::new(Record::new(grid, y).unwrap(), DirichletWindow, FrequencySet::dft(&grid)).unwrap();
+    let half = FrequencyData::new(
+        Record::new(grid, y).unwrap(),
+        DirichletWindow,
+        FrequencySet::dft(&grid),
+    )
+    .unwrap();
     assert!((Bcls.cost(&half, &structure) - time).abs() > 1e-6 * time);
     let _ = NoJitter.variance();
 }
@@ -226,7 +304,11 @@ fn criterion_jacobians_match_finite_differences() {
         data: &FrequencyData<DirichletWindow>,
         s: &ModelStructure<LtiResponse<Zpk>, UniformSum, N>,
     ) {
-        let problem = FitProblem { structure: s, criterion: c, data };
+        let problem = FitProblem {
+            structure: s,
+            criterion: c,
+            data,
+        };
         let theta = s.params();
         let analytic = problem.jacobian(&theta).unwrap();
         let fd = fd_jacobian(&problem, &theta, 1e-6).unwrap();
@@ -249,6 +331,14 @@ fn criterion_jacobians_match_finite_differences() {
         }
     }
     check(&BoxJenkins, &data, &structure);
-    check(&Bcls, &data, &structure.clone().with_estimated(true, true, false));
-    check(&Ls, &data, &structure.clone().with_estimated(true, false, false));
+    check(
+        &Bcls,
+        &data,
+        &structure.clone().with_estimated(true, true, false),
+    );
+    check(
+        &Ls,
+        &data,
+        &structure.clone().with_estimated(true, false, false),
+    );
 }

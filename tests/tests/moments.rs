@@ -6,7 +6,9 @@ use jitterid::window::{
     dirichlet, first_moment, first_moment_integral, transform, DirichletWindow, FrequencySet,
     IntegralOptions, Window,
 };
-use jitterid_tests::{arb_jitter, arb_response, arb_smooth_jitter, arb_strict_system, binary, eq17};
+use jitterid_tests::{
+    arb_jitter, arb_response, arb_smooth_jitter, arb_strict_system, binary, eq17,
+};
 use proptest::prelude::*;
 use rand::SeedableRng;
 

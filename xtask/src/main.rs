@@ -1,4 +1,5 @@
 //! Project tasks: `cargo xtask demo`, `cargo xtask reproduce <case>`.
+#![allow(clippy::type_complexity)]
 
 mod demo;
 mod paper;
@@ -85,11 +86,14 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("demo") => demo::run(),
         Some("scale") => {
-            let sizes: Result<Vec<usize>, _> = args[1..].iter().map(|a| a.parse::<usize>()).collect();
+            let sizes: Result<Vec<usize>, _> =
+                args[1..].iter().map(|a| a.parse::<usize>()).collect();
             match sizes {
                 Ok(s) if !s.is_empty() => scale::run(&s),
                 Ok(_) => scale::run(&[200, 2_000, 20_000, 200_000, 1_000_000]),
-                Err(_) => Err("scale takes record lengths, e.g. `cargo xtask scale 200 2000`".into()),
+                Err(_) => {
+                    Err("scale takes record lengths, e.g. `cargo xtask scale 200 2000`".into())
+                }
             }
         }
         Some("speedup") => scale::speedup(),

@@ -465,4 +465,3 @@ fn table1(o: &Options) -> Result<(), String> {
         &md,
     )
 }
-

@@ -2,7 +2,9 @@
 
 use crate::paper;
 use jitterid::estimate::montecarlo::realization_rng;
-use jitterid::estimate::{estimate, Bcls, Criterion, EstimateOptions, FrequencyData, ModelStructure, Record};
+use jitterid::estimate::{
+    estimate, Bcls, Criterion, EstimateOptions, FrequencyData, ModelStructure, Record,
+};
 use jitterid::prelude::*;
 use jitterid::window::{DirichletWindow, FrequencySet};
 use std::time::Instant;
@@ -36,9 +38,15 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
         let steps = u.steps().len();
         let g = paper::eq17(0.2, 0.5, -0.25, 0.3).map_err(|e| e.to_string())?;
         let grid = paper::grid_of(n);
-        let y = simulate(&LtiResponse::new(g, u.clone()), &jitter, &grid, paper::NOISE_STD, &mut rng)
-            .map_err(|e| e.to_string())?
-            .y;
+        let y = simulate(
+            &LtiResponse::new(g, u.clone()),
+            &jitter,
+            &grid,
+            paper::NOISE_STD,
+            &mut rng,
+        )
+        .map_err(|e| e.to_string())?
+        .y;
         let record = Record::new(grid, y).map_err(|e| e.to_string())?;
         let start = paper::eq17(0.21, 0.45, -0.27, 0.33).map_err(|e| e.to_string())?;
         let structure = ModelStructure::oe(LtiResponse::new(start, u), jitter);
@@ -56,7 +64,10 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
                 })
                 .collect(),
         );
-        let no_cov = EstimateOptions { covariance: false, ..EstimateOptions::default() };
+        let no_cov = EstimateOptions {
+            covariance: false,
+            ..EstimateOptions::default()
+        };
         let mut iters = 0;
         let fit = median(
             (0..reps)
@@ -69,12 +80,19 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
                 .collect(),
         );
         let t = Instant::now();
-        let e = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).map_err(|e| e.to_string())?;
+        let e = estimate(&structure, &record, &Bcls, &EstimateOptions::default())
+            .map_err(|e| e.to_string())?;
         let full = t.elapsed().as_secs_f64() * 1e3;
         if !e.converged {
-            return Err(format!("N = {n}: the fit did not converge ({})", e.termination));
+            return Err(format!(
+                "N = {n}: the fit did not converge ({})",
+                e.termination
+            ));
         }
-        println!("| {n} | {steps} | {eval:.2} | {fit:.2} | {full:.2} | {iters} | {:.0} |", peak_rss_mib());
+        println!(
+            "| {n} | {steps} | {eval:.2} | {fit:.2} | {full:.2} | {iters} | {:.0} |",
+            peak_rss_mib()
+        );
         if let Some(b) = base {
             if n == 20_000 {
                 println!("\nfit time ratio N = 20 000 / N = 200: {:.1}\n", fit / b);
@@ -94,15 +112,26 @@ pub fn speedup() -> Result<(), String> {
             let u = paper::input(rng, 8.0);
             let g = paper::eq17(0.2, 0.5, -0.25, 0.3).expect("valid");
             let grid = paper::grid();
-            let y = simulate(&LtiResponse::new(g, u.clone()), &jitter, &grid, paper::NOISE_STD, rng)
-                .expect("valid")
-                .y;
+            let y = simulate(
+                &LtiResponse::new(g, u.clone()),
+                &jitter,
+                &grid,
+                paper::NOISE_STD,
+                rng,
+            )
+            .expect("valid")
+            .y;
             let s = paper::perturb(&[0.2, 0.5, -0.25, 0.3], 0.2, rng);
             let start = paper::eq17(s[0], s[1], s[2], s[3]).expect("stable start");
             let structure = ModelStructure::oe(LtiResponse::new(start, u), jitter);
-            estimate(&structure, &Record::new(grid, y).expect("finite"), &Bcls, &EstimateOptions::default())
-                .map(|e| e.params)
-                .ok()
+            estimate(
+                &structure,
+                &Record::new(grid, y).expect("finite"),
+                &Bcls,
+                &EstimateOptions::default(),
+            )
+            .map(|e| e.params)
+            .ok()
         })
     };
     let mut times = Vec::new();
@@ -118,7 +147,15 @@ pub fn speedup() -> Result<(), String> {
         results.push(r);
     }
     println!("Table 2 study, 128 BCLS fits with covariance:");
-    println!("1 thread: {:.3} s, 2 threads: {:.3} s, speedup {:.2}", times[0], times[1], times[0] / times[1]);
-    println!("estimates bit-for-bit identical on 1 and 2 threads: {}", results[0] == results[1]);
+    println!(
+        "1 thread: {:.3} s, 2 threads: {:.3} s, speedup {:.2}",
+        times[0],
+        times[1],
+        times[0] / times[1]
+    );
+    println!(
+        "estimates bit-for-bit identical on 1 and 2 threads: {}",
+        results[0] == results[1]
+    );
     Ok(())
 }

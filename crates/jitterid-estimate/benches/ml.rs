@@ -14,7 +14,9 @@ use std::hint::black_box;
 fn setup(seed: u64) -> (ModelStructure<LtiResponse<Zpk>, UniformSum>, Record) {
     let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap();
     let mut rng = StdRng::seed_from_u64(seed);
-    let u = RandomBinary::paper().generate(0.0, 201.0, &mut rng).unwrap();
+    let u = RandomBinary::paper()
+        .generate(0.0, 201.0, &mut rng)
+        .unwrap();
     let signal = LtiResponse::new(g, u);
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
     let truth = UniformSum::new(0, 0.5).unwrap();

@@ -159,8 +159,7 @@ fn project_to_time(
                 rot = Complex64::from_polar(1.0, TAU * ((f * t * k as f64).fract()));
             }
             for j in 0..p {
-                g[k * p + j] +=
-                    sw * (rot.re * jac[(2 * fi, j)] - rot.im * jac[(2 * fi + 1, j)]);
+                g[k * p + j] += sw * (rot.re * jac[(2 * fi, j)] - rot.im * jac[(2 * fi + 1, j)]);
             }
             rot *= step;
         }

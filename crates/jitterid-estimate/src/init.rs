@@ -60,6 +60,7 @@
 //! assert!((fit.params[3] - 0.3).abs() < 0.02);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+#![allow(clippy::wrong_self_convention)]
 
 use crate::data::Record;
 use crate::noise::NoiseModel;
@@ -304,11 +305,10 @@ pub fn fit_rational(
     let set = FrequencySet::list(grid, freqs.clone()).map_err(|_| InitError::NonFinite {
         frequency: freqs[last],
     })?;
-    let y = transform(grid, &DirichletWindow, record.y(), &set).map_err(|_| {
-        InitError::NonFinite {
+    let y =
+        transform(grid, &DirichletWindow, record.y(), &set).map_err(|_| InitError::NonFinite {
             frequency: freqs[0],
-        }
-    })?;
+        })?;
     let (t0, t_a) = (grid.start(), grid.start() - 0.5 * t);
     let t_b = t_a + len as f64 * t;
     let omega_n = TAU * freqs[last];
@@ -666,7 +666,10 @@ fn match_kinds(template: &[Root], roots: &[Complex64]) -> Vec<Root> {
         .filter(|r| r.im > 0.0)
         .map(|r| (r.re, r.im))
         .collect();
-    let want_reals = template.iter().filter(|r| matches!(r, Root::Real(_))).count();
+    let want_reals = template
+        .iter()
+        .filter(|r| matches!(r, Root::Real(_)))
+        .count();
     let want_pairs = template.len() - want_reals;
     reals.sort_by(f64::total_cmp);
     while reals.len() > want_reals && reals.len() >= 2 {
@@ -719,10 +722,7 @@ mod tests {
         Zpk::new(
             0.2,
             vec![Root::Real(-0.5)],
-            vec![Root::Pair {
-                re: -0.25,
-                im: 0.3,
-            }],
+            vec![Root::Pair { re: -0.25, im: 0.3 }],
         )
         .unwrap()
     }
@@ -730,15 +730,27 @@ mod tests {
     #[test]
     fn recovers_the_paper_system_from_its_exact_mean() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(11);
-        let u = RandomBinary::paper().generate(0.0, 201.0, &mut rng).unwrap();
+        let u = RandomBinary::paper()
+            .generate(0.0, 201.0, &mut rng)
+            .unwrap();
         let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
         let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
         let m = LtiResponse::new(paper(), u.clone()).expected_values(&grid, &jitter);
         let record = Record::new(grid, m).unwrap();
-        let template = Zpk::new(1.0, vec![Root::Real(-1.0)], vec![Root::Pair { re: -1.0, im: 1.0 }])
-            .unwrap();
-        let g = initial_model(&template, &record, &u.into(), Some(&jitter), &InitOptions::default())
-            .unwrap();
+        let template = Zpk::new(
+            1.0,
+            vec![Root::Real(-1.0)],
+            vec![Root::Pair { re: -1.0, im: 1.0 }],
+        )
+        .unwrap();
+        let g = initial_model(
+            &template,
+            &record,
+            &u.into(),
+            Some(&jitter),
+            &InitOptions::default(),
+        )
+        .unwrap();
         let p = g.params();
         for (got, want) in p.iter().zip([0.2, -0.5, -0.25, 0.3]) {
             assert!((got - want).abs() < 0.05 * want.abs(), "{p:?}");
@@ -757,7 +769,11 @@ mod tests {
             match_kinds(&[Root::Real(0.0), Root::Real(0.0)], &pair),
             vec![Root::Real(-1.5), Root::Real(-2.5)]
         );
-        let s = stabilize(&[Complex64::new(0.5, 2.0), Complex64::new(0.5, -2.0), Complex64::new(0.0, 0.0)]);
+        let s = stabilize(&[
+            Complex64::new(0.5, 2.0),
+            Complex64::new(0.5, -2.0),
+            Complex64::new(0.0, 0.0),
+        ]);
         assert!(s.iter().all(|p| p.re < 0.0));
         assert_eq!(s.len(), 3);
         assert_eq!(s[1], s[2].conj());
@@ -767,16 +783,29 @@ mod tests {
     #[test]
     fn simulated_record_gives_a_start_in_the_basin() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-        let u = RandomBinary::paper().generate(0.0, 201.0, &mut rng).unwrap();
+        let u = RandomBinary::paper()
+            .generate(0.0, 201.0, &mut rng)
+            .unwrap();
         let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
         let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
-        let data =
-            simulate(&LtiResponse::new(paper(), u.clone()), &jitter, &grid, 0.01, &mut rng)
-                .unwrap();
+        let data = simulate(
+            &LtiResponse::new(paper(), u.clone()),
+            &jitter,
+            &grid,
+            0.01,
+            &mut rng,
+        )
+        .unwrap();
         let record = Record::new(grid, data.y).unwrap();
         let tf = TransferFunction::new(&[1.0, 1.0], &[1.0, 1.0, 1.0]).unwrap();
-        let g = initial_model(&tf, &record, &u.into(), Some(&jitter), &InitOptions::default())
-            .unwrap();
+        let g = initial_model(
+            &tf,
+            &record,
+            &u.into(),
+            Some(&jitter),
+            &InitOptions::default(),
+        )
+        .unwrap();
         // b1, b0, a1, a0 of 0.2 (s + 0.5) / (s² + 0.5 s + 0.1525).
         for (got, want) in g.params().iter().zip([0.2, 0.1, 0.5, 0.1525]) {
             assert!((got - want).abs() < 0.15 * want, "{:?}", g.params());

@@ -39,18 +39,20 @@ mod data;
 mod error;
 mod fit;
 mod init;
+pub mod ml;
 pub mod montecarlo;
 mod noise;
 mod profile;
 pub mod solver;
 mod structure;
-pub mod ml;
 
 pub use criterion::{Bcls, BoxJenkins, Criterion, FrequencyData, Ls, WeightedBcls};
 pub use data::Record;
 pub use error::EstimateError;
 pub use fit::{estimate, Estimate, EstimateOptions, FitProblem, Frequencies};
-pub use init::{fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit};
+pub use init::{
+    fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
+};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
 pub use profile::{profile_uniform_sum, ProfileEstimate};
 pub use structure::ModelStructure;

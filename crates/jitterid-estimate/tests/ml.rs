@@ -1,11 +1,14 @@
 //! Tests of the maximum-likelihood layer (issue 4) through the public API.
+#![allow(clippy::needless_range_loop)]
 
 use jitterid_estimate::ml::*;
 use jitterid_estimate::montecarlo::Summary;
 use jitterid_estimate::solver::{SolverError, Termination};
 use jitterid_estimate::{ArmaNoise, ModelStructure, Record};
 use jitterid_jitter::{Gaussian, JitterModel, NoJitter, TwoPoint, UniformSum};
-use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Sinusoid, Zpk};
+use jitterid_signal::{
+    simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Sinusoid, Zpk,
+};
 use jitterid_window::{DirichletWindow, FrequencySet};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -22,8 +25,15 @@ fn table1_signal(seed: u64, n: usize) -> LtiResponse<Zpk> {
 
 /// `log p(y)` by brute force: composite Simpson on a fine grid over each piece, split at the
 /// signal's breakpoints, plus the atoms.
-fn brute_log_p<S: Signal, J: JitterModel>(signal: &S, jitter: &J, t: f64, y: f64, sigma: f64) -> f64 {
-    let phi = |e: f64| (-0.5 * (e / sigma).powi(2)).exp() / (sigma * (2.0 * std::f64::consts::PI).sqrt());
+fn brute_log_p<S: Signal, J: JitterModel>(
+    signal: &S,
+    jitter: &J,
+    t: f64,
+    y: f64,
+    sigma: f64,
+) -> f64 {
+    let phi =
+        |e: f64| (-0.5 * (e / sigma).powi(2)).exp() / (sigma * (2.0 * std::f64::consts::PI).sqrt());
     let mut breaks: Vec<f64> = signal.breakpoints().iter().map(|b| b - t).collect();
     breaks.sort_by(f64::total_cmp);
     let mut total = 0.0;
@@ -37,7 +47,13 @@ fn brute_log_p<S: Signal, J: JitterModel>(signal: &S, jitter: &J, t: f64, y: f64
             let mut s = 0.0;
             for i in 0..=m {
                 let tau = w[0] + i as f64 * h;
-                let c = if i == 0 || i == m { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+                let c = if i == 0 || i == m {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
                 s += c * jitter.pdf(tau) * phi(y - signal.value(t + tau));
             }
             total += s * h / 3.0;
@@ -74,11 +90,26 @@ fn exact_vs_brute<J: JitterModel + Clone>(jitter: J, sigma: f64, n: usize) -> f6
 fn exact_likelihood_matches_brute_force() {
     // Brute force: Simpson with 20 000 panels per piece, accurate to ~1e-12 here.
     for (name, worst) in [
-        ("uniform n=0", exact_vs_brute(UniformSum::new(0, 0.5).unwrap(), 0.01, 60)),
-        ("uniform n=3", exact_vs_brute(UniformSum::new(3, 0.7).unwrap(), 0.01, 60)),
-        ("gaussian", exact_vs_brute(Gaussian::new(0.17).unwrap(), 0.01, 60)),
-        ("uniform n=0, σ_v = 1e-3", exact_vs_brute(UniformSum::new(0, 0.5).unwrap(), 0.001, 60)),
-        ("two-point", exact_vs_brute(TwoPoint::new(0.3).unwrap(), 0.01, 30)),
+        (
+            "uniform n=0",
+            exact_vs_brute(UniformSum::new(0, 0.5).unwrap(), 0.01, 60),
+        ),
+        (
+            "uniform n=3",
+            exact_vs_brute(UniformSum::new(3, 0.7).unwrap(), 0.01, 60),
+        ),
+        (
+            "gaussian",
+            exact_vs_brute(Gaussian::new(0.17).unwrap(), 0.01, 60),
+        ),
+        (
+            "uniform n=0, σ_v = 1e-3",
+            exact_vs_brute(UniformSum::new(0, 0.5).unwrap(), 0.001, 60),
+        ),
+        (
+            "two-point",
+            exact_vs_brute(TwoPoint::new(0.3).unwrap(), 0.01, 30),
+        ),
     ] {
         println!("{name}: worst |Δ log p| = {worst:e}");
         assert!(worst < 1e-9, "{name}: {worst}");
@@ -111,7 +142,11 @@ fn second_moments_and_dtft_covariance_match_monte_carlo() {
     let reps = 4000;
     let mut rng = StdRng::seed_from_u64(77);
     let ys: Vec<Vec<f64>> = (0..reps)
-        .map(|_| simulate(&signal, &jitter, &grid, sigma, &mut rng).unwrap().y)
+        .map(|_| {
+            simulate(&signal, &jitter, &grid, sigma, &mut rng)
+                .unwrap()
+                .y
+        })
         .collect();
     for k in 0..n {
         let col: Vec<f64> = ys.iter().map(|y| y[k]).collect();
@@ -131,7 +166,10 @@ fn second_moments_and_dtft_covariance_match_monte_carlo() {
         let cov = dtft_covariance(&grid, &mom.variance, &DirichletWindow, &freqs).unwrap();
         let flat = mom.variance.iter().sum::<f64>();
         for a in 0..freqs.len() {
-            assert!((cov.variance(a) - flat).abs() < 1e-12 * flat, "flat noise floor");
+            assert!(
+                (cov.variance(a) - flat).abs() < 1e-12 * flat,
+                "flat noise floor"
+            );
         }
         let real = cov.real();
         let f = freqs.frequencies();
@@ -166,14 +204,21 @@ fn second_moments_and_dtft_covariance_match_monte_carlo() {
                     continue;
                 }
                 let z = (mean - real[i][j]) / (sd / (reps as f64).sqrt());
-                assert!(z.abs() < 4.5, "cov[{i}][{j}]: {mean} vs {}: z = {z}", real[i][j]);
+                assert!(
+                    z.abs() < 4.5,
+                    "cov[{i}][{j}]: {mean} vs {}: z = {z}",
+                    real[i][j]
+                );
             }
         }
     }
 }
 
 /// A JOE structure of the Table 1 system with the gain and pole estimated.
-fn joe_structure<J: JitterModel + Clone>(jitter: J, n: usize) -> ModelStructure<LtiResponse<Zpk>, J> {
+fn joe_structure<J: JitterModel + Clone>(
+    jitter: J,
+    n: usize,
+) -> ModelStructure<LtiResponse<Zpk>, J> {
     ModelStructure::joe(table1_signal(5, n), jitter)
 }
 
@@ -198,8 +243,16 @@ fn second_moment_gradients_match_differences() {
         for k in 0..n {
             let fm = (up.mean[k] - dn.mean[k]) / (2.0 * h);
             let fl = (up.variance[k] - dn.variance[k]) / (2.0 * h);
-            assert!((dm[j][k] - fm).abs() < 1e-6 * (1.0 + fm.abs()), "dm {j} {k}: {} vs {fm}", dm[j][k]);
-            assert!((dl[j][k] - fl).abs() < 1e-6 * (1.0 + fl.abs()), "dλ {j} {k}: {} vs {fl}", dl[j][k]);
+            assert!(
+                (dm[j][k] - fm).abs() < 1e-6 * (1.0 + fm.abs()),
+                "dm {j} {k}: {} vs {fm}",
+                dm[j][k]
+            );
+            assert!(
+                (dl[j][k] - fl).abs() < 1e-6 * (1.0 + fl.abs()),
+                "dλ {j} {k}: {} vs {fl}",
+                dl[j][k]
+            );
         }
     }
 }
@@ -217,7 +270,11 @@ fn check_gradient<O: Objective>(o: &O, theta: &[f64], tol: f64) {
         p[j] -= 2.0 * h;
         let fd = o.cost(&p);
         let num = (fu - fd) / (2.0 * h);
-        assert!((g[j] - num).abs() < tol * scale, "∂/∂θ{j}: {} vs {num} (scale {scale})", g[j]);
+        assert!(
+            (g[j] - num).abs() < tol * scale,
+            "∂/∂θ{j}: {} vs {num} (scale {scale})",
+            g[j]
+        );
     }
 }
 
@@ -267,8 +324,14 @@ fn without_jitter_both_criteria_are_the_gaussian_likelihood() {
     let o = LikelihoodObjective::new(&structure, &QuasiMl, &record);
     let mut theta = likelihood_params(&structure, sigma);
     let quasi = -o.evaluate(&theta).unwrap();
-    assert!((exact - direct).abs() < 1e-10 * direct.abs(), "{exact} vs {direct}");
-    assert!((quasi - direct).abs() < 1e-10 * direct.abs(), "{quasi} vs {direct}");
+    assert!(
+        (exact - direct).abs() < 1e-10 * direct.abs(),
+        "{exact} vs {direct}"
+    );
+    assert!(
+        (quasi - direct).abs() < 1e-10 * direct.abs(),
+        "{quasi} vs {direct}"
+    );
     // And the gradient in the signal's parameters and σ_v agrees between the criteria.
     let e = ExactMl::default();
     let oe = LikelihoodObjective::new(&structure, &e, &record);
@@ -311,7 +374,12 @@ fn exact_ml_is_unbiased_and_its_hessian_predicts_the_spread() {
     let z = (est.mean - 1.0 / 6.0) / est.se();
     assert!(z.abs() < 4.0, "mean {} (z = {z})", est.mean);
     let ratio = est.std() / se.mean;
-    assert!((ratio - 1.0).abs() < 0.45, "MC std {} vs Hessian std {}", est.std(), se.mean);
+    assert!(
+        (ratio - 1.0).abs() < 0.45,
+        "MC std {} vs Hessian std {}",
+        est.std(),
+        se.mean
+    );
 }
 
 #[test]
@@ -355,12 +423,18 @@ fn fisher_information_exact_equals_gaussian_without_jitter() {
     let structure = ModelStructure::oe(sine, NoJitter);
     let exact = exact_fisher(&structure, &grid, 0.05, &FisherOptions::default()).unwrap();
     let gauss = gaussian_fisher(&structure, &grid, 0.05).unwrap();
-    assert_eq!(exact.names, vec!["amplitude", "frequency", "phase", "noise.std"]);
+    assert_eq!(
+        exact.names,
+        vec!["amplitude", "frequency", "phase", "noise.std"]
+    );
     assert!(exact.max_mass_error.unwrap() < 1e-10);
     for i in 0..4 {
         for j in 0..4 {
             let (a, b) = (exact.matrix[i][j], gauss.matrix[i][j]);
-            assert!((a - b).abs() < 1e-7 * (gauss.matrix[i][i] * gauss.matrix[j][j]).sqrt(), "[{i}][{j}] {a} vs {b}");
+            assert!(
+                (a - b).abs() < 1e-7 * (gauss.matrix[i][i] * gauss.matrix[j][j]).sqrt(),
+                "[{i}][{j}] {a} vs {b}"
+            );
         }
     }
     // σ_v block: 2N/σ².
@@ -446,7 +520,9 @@ fn bad_input_gives_typed_errors() {
         ml_estimate(&wide, &record, &exact, &MlOptions::default()),
         ml_estimate(&wide, &record, &QuasiMl, &MlOptions::default()),
     ] {
-        assert!(matches!(res, Err(MlError::ReachExceedsRecord { duration, .. }) if duration == 20.0));
+        assert!(
+            matches!(res, Err(MlError::ReachExceedsRecord { duration, .. }) if duration == 20.0)
+        );
     }
     // Coloured noise with the exact criterion.
     let bj = ModelStructure::bj(signal, jitter, ArmaNoise::new(vec![0.5], vec![]).unwrap());
@@ -461,7 +537,10 @@ fn bad_input_gives_typed_errors() {
     };
     assert!(matches!(
         bad.log_likelihoods(&structure, &record, 0.01),
-        Err(MlError::InvalidArgument { name: "resolution", .. })
+        Err(MlError::InvalidArgument {
+            name: "resolution",
+            ..
+        })
     ));
 }
 
@@ -483,7 +562,10 @@ fn sine_record_too_short_is_an_error() {
     let ls = sine_least_squares(&Record::new(grid, y).unwrap()).unwrap();
     // Noise-free data: the fit is exact to rounding.
     assert!((ls.frequency - 0.3).abs() < 1e-12, "{}", ls.frequency);
-    assert!((ls.amplitude - 1.0).abs() < 1e-10 && (ls.phase - 0.1).abs() < 1e-10, "{ls:?}");
+    assert!(
+        (ls.amplitude - 1.0).abs() < 1e-10 && (ls.phase - 0.1).abs() < 1e-10,
+        "{ls:?}"
+    );
 }
 
 #[test]
@@ -498,11 +580,25 @@ fn sine_aliases_are_told_apart_by_a_known_jitter_and_not_by_an_estimated_one() {
         let data = simulate(&sine, &jitter, &grid, sv, &mut rng).unwrap();
         let record = Record::new(grid, data.y).unwrap();
         let ls = sine_least_squares(&record).unwrap();
-        assert!((ls.frequency - 0.22).abs() < 1e-3, "baseband {}", ls.frequency);
+        assert!(
+            (ls.frequency - 0.22).abs() < 1e-3,
+            "baseband {}",
+            ls.frequency
+        );
         let fits: Vec<SineFit> = [1.78, 0.78]
             .iter()
             .map(|&f| {
-                fit_sine(&record, &ls, f, jitter, false, None, &exact, &MlOptions::default()).unwrap()
+                fit_sine(
+                    &record,
+                    &ls,
+                    f,
+                    jitter,
+                    false,
+                    None,
+                    &exact,
+                    &MlOptions::default(),
+                )
+                .unwrap()
             })
             .collect();
         assert!(fits[0].estimate.converged && fits[1].estimate.converged);
@@ -573,8 +669,18 @@ fn quasi_ml_with_coloured_noise() {
     assert!(fit.converged, "{:?}", fit.termination);
     assert_eq!(fit.names, vec!["noise.c1", "noise.std"]);
     let se = fit.std_errors.unwrap();
-    assert!(((fit.params[0] - 0.5) / se[0]).abs() < 4.0, "c1 = {} ± {}", fit.params[0], se[0]);
-    assert!(((fit.params[1] - 0.02) / se[1]).abs() < 4.0, "σ = {} ± {}", fit.params[1], se[1]);
+    assert!(
+        ((fit.params[0] - 0.5) / se[0]).abs() < 4.0,
+        "c1 = {} ± {}",
+        fit.params[0],
+        se[0]
+    );
+    assert!(
+        ((fit.params[1] - 0.02) / se[1]).abs() < 4.0,
+        "σ = {} ± {}",
+        fit.params[1],
+        se[1]
+    );
 }
 
 /// Rosenbrock's function with its gradient; `+∞` for `x < −1.5` (an infeasible region).
@@ -619,12 +725,18 @@ impl Objective for Parabola {
 fn minimisers_converge_and_respect_infeasible_regions() {
     let r = Bfgs::default().minimize(&Rosen, &[-1.2, 1.0]).unwrap();
     assert!(r.converged, "{:?}", r.termination);
-    assert!((r.params[0] - 1.0).abs() < 1e-5 && (r.params[1] - 1.0).abs() < 1e-5, "{:?}", r.params);
+    assert!(
+        (r.params[0] - 1.0).abs() < 1e-5 && (r.params[1] - 1.0).abs() < 1e-5,
+        "{:?}",
+        r.params
+    );
     let r = Brent::default().minimize(&Parabola, &[5.0]).unwrap();
     assert!(r.converged && (r.params[0] - 2.0).abs() < 1e-7, "{r:?}");
     let r = Brent::default().minimize(&Parabola, &[0.01]).unwrap();
     assert!(r.converged && (r.params[0] - 2.0).abs() < 1e-7, "{r:?}");
-    let r = ArgminNelderMead::default().minimize(&Rosen, &[-1.2, 1.0]).unwrap();
+    let r = ArgminNelderMead::default()
+        .minimize(&Rosen, &[-1.2, 1.0])
+        .unwrap();
     assert!((r.params[0] - 1.0).abs() < 1e-3, "{r:?}");
     assert!(matches!(
         Brent::default().minimize(&Rosen, &[0.0, 0.0]),
@@ -668,7 +780,13 @@ fn timing_sine() {
     let ls = sine_least_squares(&record).unwrap();
     for (name, e) in [
         ("exact", ExactMl::default()),
-        ("serial", ExactMl { parallel: false, ..ExactMl::default() }),
+        (
+            "serial",
+            ExactMl {
+                parallel: false,
+                ..ExactMl::default()
+            },
+        ),
     ] {
         let structure = ModelStructure::oe(sine, jitter).with_estimated(true, false, false);
         let o = LikelihoodObjective::new(&structure, &e, &record);
@@ -682,9 +800,22 @@ fn timing_sine() {
         for _ in 0..5 {
             o.cost_gradient(&theta);
         }
-        println!("{name}: cost+gradient {:.2} ms", t.elapsed().as_secs_f64() * 200.0);
+        println!(
+            "{name}: cost+gradient {:.2} ms",
+            t.elapsed().as_secs_f64() * 200.0
+        );
         let t = std::time::Instant::now();
-        let fit = fit_sine(&record, &ls, 1.78, jitter, false, None, &e, &MlOptions::default()).unwrap();
+        let fit = fit_sine(
+            &record,
+            &ls,
+            1.78,
+            jitter,
+            false,
+            None,
+            &e,
+            &MlOptions::default(),
+        )
+        .unwrap();
         println!(
             "{name}: fit {:.1} ms, {} iterations, {:?}",
             t.elapsed().as_secs_f64() * 1e3,
@@ -721,7 +852,10 @@ fn timing() {
             .with_estimated(false, true, false)
             .with_noise_std(0.01)
             .unwrap();
-        let e = ExactMl { parallel: false, ..ExactMl::default() };
+        let e = ExactMl {
+            parallel: false,
+            ..ExactMl::default()
+        };
         let o = LikelihoodObjective::new(&structure, &e, &record);
         let ev = min_time(&mut || {
             o.cost(&[a]);
@@ -742,7 +876,13 @@ fn timing() {
         .unwrap();
     for (name, e) in [
         ("parallel samples", ExactMl::default()),
-        ("serial samples", ExactMl { parallel: false, ..ExactMl::default() }),
+        (
+            "serial samples",
+            ExactMl {
+                parallel: false,
+                ..ExactMl::default()
+            },
+        ),
     ] {
         let mut n = 0;
         let t = min_time(&mut || {

@@ -100,9 +100,7 @@ fn ode_response(
         // x[0] is the highest-order state: ẋ_0 = −Σ a_{i+1} x_i + u, ẋ_i = x_{i−1}.
         let mut dx = vec![0.0; n];
         dx[0] = uval - (0..n).map(|i| den[i + 1] * x[i]).sum::<f64>();
-        for i in 1..n {
-            dx[i] = x[i - 1];
-        }
+        dx[1..n].copy_from_slice(&x[..n - 1]);
         dx
     };
     let mut x = vec![0.0; n];

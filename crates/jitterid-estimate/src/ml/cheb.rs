@@ -150,8 +150,7 @@ impl PiecewiseCheb {
                         seg_max[c] = seg_max[c].max(vals[c].abs());
                     }
                 }
-                let coefs: Vec<[f64; CHEB_POINTS]> =
-                    node_vals.iter().map(coefficients).collect();
+                let coefs: Vec<[f64; CHEB_POINTS]> = node_vals.iter().map(coefficients).collect();
                 // Largest error relative to the tolerance's scale, over channels and tests.
                 let mut worst = 0.0f64;
                 if depth < MAX_DEPTH {
@@ -161,7 +160,11 @@ impl PiecewiseCheb {
                             let scale = rel_tol * (seg_max[c] + global[c]);
                             let err = (clenshaw(&coefs[c], x) - vals[c]).abs();
                             let r = if err == 0.0 { 0.0 } else { err / scale };
-                            worst = if r.is_nan() { f64::INFINITY } else { worst.max(r) };
+                            worst = if r.is_nan() {
+                                f64::INFINITY
+                            } else {
+                                worst.max(r)
+                            };
                         }
                     }
                 }
@@ -323,7 +326,12 @@ mod tests {
             let seg = table.segment(t).unwrap();
             table.eval_all(seg, t, &mut v);
             f(t, &mut w);
-            assert!((v[0] - w[0]).abs() < 1e-14 * 4.0, "{t}: {} vs {}", v[0], w[0]);
+            assert!(
+                (v[0] - w[0]).abs() < 1e-14 * 4.0,
+                "{t}: {} vs {}",
+                v[0],
+                w[0]
+            );
             assert!((v[1] - w[1]).abs() < 1e-13, "{t}");
             assert_eq!(table.eval0(seg, t), v[0]);
         }
@@ -354,7 +362,10 @@ mod tests {
         for k in 0..=300 {
             let t = k as f64 / 100.0;
             let seg = table.segment(t).unwrap();
-            assert!((table.eval0(seg, t) - (40.0 * t).sin()).abs() < 1e-12, "{t}");
+            assert!(
+                (table.eval0(seg, t) - (40.0 * t).sin()).abs() < 1e-12,
+                "{t}"
+            );
         }
     }
 }

@@ -26,7 +26,9 @@ pub enum MlError {
     /// The model's variance `λ_k = σ_v² + E[s(t_k+τ)²] − m_k²` of sample `index` is zero,
     /// negative or not finite, so the Gaussian quasi-likelihood is not defined (typically
     /// `σ_v = 0` known and a sample where the jittered signal does not vary).
-    #[error("the model variance of sample {index} is {variance}: the quasi-likelihood needs λ_k > 0")]
+    #[error(
+        "the model variance of sample {index} is {variance}: the quasi-likelihood needs λ_k > 0"
+    )]
     VanishingVariance {
         /// Index of the sample.
         index: usize,

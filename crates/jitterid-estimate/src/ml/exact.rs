@@ -414,7 +414,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             taus[i] = mid + half * b.nodes[CHEB_POINTS - 1 - i];
         }
         let mut sv = [0.0; CHEB_POINTS];
-        self.signal.values16(t, &taus, &mut sv, &mut scratch.sig_hint);
+        self.signal
+            .values16(t, &taus, &mut sv, &mut scratch.sig_hint);
         let tv: f64 = sv.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
         if !(tv <= 2.0 * sigma) {
             return None;
@@ -446,7 +447,12 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             scratch.ch.clear();
             scratch.ch.resize(len, 0.0);
             let dot = |v: &[f64; CHEB_POINTS]| -> f64 {
-                coefficients(v).iter().zip(mu).map(|(c, m)| c * m).sum::<f64>() / total
+                coefficients(v)
+                    .iter()
+                    .zip(mu)
+                    .map(|(c, m)| c * m)
+                    .sum::<f64>()
+                    / total
             };
             if ns > 0 {
                 let mut chans = vec![0.0; 1 + self.signal.grad_channels];
@@ -482,7 +488,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         let mut p = [0.0; 16];
         self.jitter.pdf16(&taus, &mut p, &mut scratch.pdf_hint);
         let mut sv = [0.0; 16];
-        self.signal.values16(t, &taus, &mut sv, &mut scratch.sig_hint);
+        self.signal
+            .values16(t, &taus, &mut sv, &mut scratch.sig_hint);
         for i in 0..16 {
             let wi = half * w[i] * p[i];
             if wi > 0.0 {
@@ -508,7 +515,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         let res = self.opts.resolution * self.sigma;
         let reach = self.opts.window * self.sigma;
         let mut sv = [0.0; 16];
-        self.signal.values16(t, nodes, &mut sv, &mut scratch.sig_hint);
+        self.signal
+            .values16(t, nodes, &mut sv, &mut scratch.sig_hint);
         let mut pt = [0.0; 18];
         let mut pv = [0.0; 18];
         pt[1..17].copy_from_slice(nodes);

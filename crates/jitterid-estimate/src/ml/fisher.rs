@@ -8,7 +8,7 @@
 //! * [`exact_fisher`]: the information of the exact model,
 //!   `I = Σ_k ∫ ∇log p(y; θ) ∇log p(y; θ)ᵀ p(y; θ) dy`, by numerical integration over `y`
 //!   (composite 16-point Gauss–Legendre on `[min s − 10σ_v, max s + 10σ_v]` over the jitter's
-//!   reach, 16 nodes per `4σ_v`) with the exact per-sample likelihood of
+//!   reach, 16 nodes per `8σ_v`) with the exact per-sample likelihood of
 //!   [`ExactMl`](super::ExactMl): scores analytic in the signal's parameters and `σ_v`, central
 //!   differences in the jitter's. Its inverse is the Cramér–Rao bound.
 //!
@@ -113,8 +113,8 @@ where
         }
         for i in 0..p {
             for j in 0..p {
-                info[i][j] += dm[i][k] * dm[j][k] / lambda
-                    + 0.5 * dl[i][k] * dl[j][k] / (lambda * lambda);
+                info[i][j] +=
+                    dm[i][k] * dm[j][k] / lambda + 0.5 * dl[i][k] * dl[j][k] / (lambda * lambda);
             }
         }
     }
@@ -130,7 +130,7 @@ where
 pub struct FisherOptions {
     /// The likelihood's quadrature.
     pub quadrature: ExactMl,
-    /// Width, in `σ_v`, of one 16-point sub-interval of the integration over `y`. Default 4.
+    /// Width, in `σ_v`, of one 16-point sub-interval of the integration over `y`. Default 8.
     pub y_step: f64,
     /// Margin, in `σ_v`, beyond the signal's range. Default 10.
     pub y_margin: f64,
@@ -143,7 +143,7 @@ impl Default for FisherOptions {
                 parallel: false,
                 ..ExactMl::default()
             },
-            y_step: 4.0,
+            y_step: 8.0,
             y_margin: 10.0,
         }
     }
@@ -197,7 +197,11 @@ where
     let p = layout.len();
     let signal = &structure.signal;
     let rate = signal.rate();
-    let ns_grad = if layout.ns > 0 { signal.num_params() } else { 0 };
+    let ns_grad = if layout.ns > 0 {
+        signal.num_params()
+    } else {
+        0
+    };
     let table = signal_table(signal, grid, (lo, hi), ns_grad > 0);
     let mut breaks = signal.breakpoints();
     breaks.sort_by(f64::total_cmp);

@@ -2,7 +2,7 @@
 //! [`ml_profile_uniform_sum`], with the covariance of the estimate from the inverse Hessian of
 //! the negative log-likelihood.
 
-use super::criterion::LikelihoodCriterion;
+use super::criterion::{LikelihoodCriterion, LikelihoodData};
 use super::fisher::gaussian_fisher;
 use super::moments::second_moments;
 use super::objective::{LikelihoodObjective, Objective, TransformedObjective};
@@ -117,7 +117,11 @@ pub(crate) fn hessian<O: Objective + ?Sized>(objective: &O, theta: &[f64]) -> Op
         let lo_ok = fd.is_finite() && gd.iter().all(|v| v.is_finite());
         let hi_ok = fu.is_finite() && gu.iter().all(|v| v.is_finite());
         let col: Vec<f64> = match (hi_ok, lo_ok) {
-            (true, true) => gu.iter().zip(&gd).map(|(a, b)| (a - b) / (2.0 * step)).collect(),
+            (true, true) => gu
+                .iter()
+                .zip(&gd)
+                .map(|(a, b)| (a - b) / (2.0 * step))
+                .collect(),
             (true, false) | (false, true) => {
                 let (f0, g0) = objective.cost_gradient(theta);
                 if !f0.is_finite() || g0.iter().any(|v| !v.is_finite()) {
@@ -145,7 +149,9 @@ pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
     let p = m.nrows();
     let llt = m.llt(Side::Lower).ok()?;
     let inv = llt.inverse();
-    let out: Vec<Vec<f64>> = (0..p).map(|i| (0..p).map(|j| inv[(i, j)]).collect()).collect();
+    let out: Vec<Vec<f64>> = (0..p)
+        .map(|i| (0..p).map(|j| inv[(i, j)]).collect())
+        .collect();
     out.iter()
         .flatten()
         .all(|v| v.is_finite())
@@ -167,6 +173,23 @@ pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
 pub fn ml_estimate<S, J, N, C>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
+    criterion: &C,
+    options: &MlOptions,
+) -> Result<MlEstimate, MlError>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: LikelihoodCriterion,
+{
+    ml_estimate_with(structure, record, None, criterion, options)
+}
+
+/// [`ml_estimate`] with optionally prepared data (valid for `structure`'s fixed parts).
+fn ml_estimate_with<S, J, N, C>(
+    structure: &ModelStructure<S, J, N>,
+    record: &Record,
+    data: Option<&LikelihoodData>,
     criterion: &C,
     options: &MlOptions,
 ) -> Result<MlEstimate, MlError>
@@ -201,7 +224,10 @@ where
             .unwrap_or_else(|| noise_start(structure, record)),
     };
     let start = likelihood_params(structure, sigma0);
-    let objective = LikelihoodObjective::new(structure, criterion, record);
+    let objective = match data {
+        Some(d) => LikelihoodObjective::with_data(structure, criterion, d.clone()),
+        None => LikelihoodObjective::new(structure, criterion, record),
+    };
     // The typed reason if the criterion is not defined at the start.
     objective.evaluate(&start)?;
     let transforms = options
@@ -321,11 +347,18 @@ where
         },
         ..options.clone()
     };
+    // The record prepared once for all n, for the widest reach of the profile.
+    let data = ns.iter().max().and_then(|&n| {
+        let a = sigma * (3.0 * (f64::from(n) + 1.0)).sqrt();
+        let mut s = structure.clone();
+        s.jitter = UniformSum::new(n, a).ok()?;
+        Some(criterion.prepare(&s, record))
+    });
     let fit_at = |n: u32, a: f64, opts: &MlOptions| {
         UniformSum::new(n, a).map_err(MlError::from).and_then(|j| {
             let mut s = structure.clone();
             s.jitter = j;
-            ml_estimate(&s, record, criterion, opts)
+            ml_estimate_with(&s, record, data.as_ref(), criterion, opts)
         })
     };
     let mut fits: Vec<(u32, Result<MlEstimate, MlError>)> = ns
@@ -410,9 +443,5 @@ where
             .as_ref()
             .map(|c| (0..theta.len()).map(|i| c[i][i].sqrt()).collect());
     }
-    Ok(MlProfile {
-        n,
-        estimate,
-        costs,
-    })
+    Ok(MlProfile { n, estimate, costs })
 }

@@ -58,6 +58,7 @@
 //! assert!((fit.params[0] - 0.5).abs() < 0.05);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+#![allow(clippy::type_complexity, clippy::needless_range_loop)]
 
 mod cheb;
 mod criterion;
@@ -88,6 +89,4 @@ pub use objective::{LikelihoodObjective, Objective, TransformedObjective};
 pub use optim::{ArgminNelderMead, ArgminObjective, Bfgs, Brent, MlSolver};
 pub use param::{default_transforms, likelihood_param_names, likelihood_params, NOISE_STD_NAME};
 pub use quasi::{noise_autocovariance, QuasiMl};
-pub use sine::{
-    alias_start, attenuation_sigma, fit_sine, sine_least_squares, SineFit, SineLs,
-};
+pub use sine::{alias_start, attenuation_sigma, fit_sine, sine_least_squares, SineFit, SineLs};

@@ -83,6 +83,20 @@ where
         }
     }
 
+    /// Like [`new`](Self::new) with data prepared already (shared between fits of one record).
+    pub(crate) fn with_data(
+        structure: &'a ModelStructure<S, J, N>,
+        criterion: &'a C,
+        data: LikelihoodData,
+    ) -> Self {
+        LikelihoodObjective {
+            structure,
+            criterion,
+            data,
+            layout: Layout::of(structure),
+        }
+    }
+
     /// The criterion's value at `theta`, with the reason when it is not defined.
     ///
     /// # Errors

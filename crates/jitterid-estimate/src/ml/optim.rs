@@ -110,10 +110,7 @@ fn check_start<O: Objective + ?Sized>(objective: &O, start: &[f64]) -> Result<f6
     }
     let f = objective.cost(start);
     if !f.is_finite() {
-        return Err(SolverError::NonFiniteResidual {
-            index: 0,
-            value: f,
-        });
+        return Err(SolverError::NonFiniteResidual { index: 0, value: f });
     }
     Ok(f)
 }
@@ -226,7 +223,8 @@ impl Bfgs {
         let first_scale = |g: &[f64]| self.initial_step / inf_norm(g).max(1e-300);
         let valid_metric = metric.filter(|m| {
             m.len() == n
-                && m.iter().all(|r| r.len() == n && r.iter().all(|v| v.is_finite()))
+                && m.iter()
+                    .all(|r| r.len() == n && r.iter().all(|v| v.is_finite()))
                 && (0..n).all(|i| m[i][i] > 0.0)
         });
         let (mut h, mut updated) = match valid_metric {
@@ -551,9 +549,7 @@ impl ArgminNelderMead {
             ) => Termination::MaxIterations,
             ref other => Termination::Other(format!("{other:?}")),
         };
-        let params = state
-            .take_best_param()
-            .unwrap_or_else(|| start.to_vec());
+        let params = state.take_best_param().unwrap_or_else(|| start.to_vec());
         let cost = objective.cost(&params);
         Ok(SolverReport {
             converged: termination.is_convergence() && cost.is_finite(),

@@ -170,7 +170,9 @@ pub fn sine_least_squares(record: &Record) -> Result<SineLs, MlError> {
     // Zero-padded periodogram on (0, 1/(2T)).
     let pad = 8;
     let m = pad * n / 2;
-    let freqs: Vec<f64> = (1..m).map(|j| j as f64 / (pad as f64 * n as f64 * t)).collect();
+    let freqs: Vec<f64> = (1..m)
+        .map(|j| j as f64 / (pad as f64 * n as f64 * t))
+        .collect();
     let spectrum = jitterid_window::dtft(grid, record.y(), None, &freqs)
         .map_err(|e| MlError::from(crate::EstimateError::from(e)))?;
     let (peak, _) = spectrum
@@ -222,7 +224,11 @@ pub fn sine_least_squares(record: &Record) -> Result<SineLs, MlError> {
 /// The classical amplitude-attenuation estimate of a Gaussian jitter's standard deviation,
 /// `σ = √(−2 ln(Â/A))/(2πf0)`, from the fitted (damped) amplitude `Â` and the true
 /// amplitude `A`; `None` when `Â ≥ A` (no attenuation seen) or an argument is not positive.
-pub fn attenuation_sigma(fitted_amplitude: f64, true_amplitude: f64, frequency: f64) -> Option<f64> {
+pub fn attenuation_sigma(
+    fitted_amplitude: f64,
+    true_amplitude: f64,
+    frequency: f64,
+) -> Option<f64> {
     let r = fitted_amplitude.abs() / true_amplitude.abs();
     if !(r > 0.0 && r < 1.0 && frequency > 0.0) {
         return None;
@@ -314,7 +320,8 @@ where
 {
     let (a, f, phi) = alias_start(ls, frequency, &jitter)?;
     let signal = Sinusoid::new(a, f, phi)?;
-    let mut structure = ModelStructure::oe(signal, jitter).with_estimated(true, estimate_jitter, false);
+    let mut structure =
+        ModelStructure::oe(signal, jitter).with_estimated(true, estimate_jitter, false);
     if let Some(s) = noise_std {
         structure = structure.with_noise_std(s)?;
     }
