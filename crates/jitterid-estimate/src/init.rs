@@ -60,7 +60,6 @@
 //! assert!((fit.params[3] - 0.3).abs() < 0.02);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
-#![allow(clippy::wrong_self_convention)]
 
 use crate::data::Record;
 use crate::noise::NoiseModel;
@@ -153,7 +152,7 @@ pub trait InitialModel: RationalModel {
     fn orders(&self) -> (usize, usize);
 
     /// A model of the same parameterisation (same kinds of roots in the same order) from a fit.
-    fn from_fit(&self, fit: &RationalFit) -> Result<Self, InitError>;
+    fn with_fit(&self, fit: &RationalFit) -> Result<Self, InitError>;
 }
 
 /// A fitted rational function `G(s) = gain · Π(s − z_i) / Π(s − p_i)`, poles stable and
@@ -177,7 +176,7 @@ impl InitialModel for TransferFunction {
         (self.num().len() - 1, self.den().len() - 1)
     }
 
-    fn from_fit(&self, fit: &RationalFit) -> Result<Self, InitError> {
+    fn with_fit(&self, fit: &RationalFit) -> Result<Self, InitError> {
         Ok(TransferFunction::new(&fit.num, &fit.den)?)
     }
 }
@@ -197,7 +196,7 @@ impl InitialModel for Zpk {
         (count(self.zeros()), count(self.poles()))
     }
 
-    fn from_fit(&self, fit: &RationalFit) -> Result<Self, InitError> {
+    fn with_fit(&self, fit: &RationalFit) -> Result<Self, InitError> {
         let zeros = match_kinds(self.zeros(), &fit.zeros);
         let poles = match_kinds(self.poles(), &fit.poles);
         Ok(Zpk::new(fit.gain, zeros, poles)?)
@@ -220,7 +219,7 @@ pub fn initial_model<M: InitialModel>(
 ) -> Result<M, InitError> {
     let (m, n) = template.orders();
     let fit = fit_rational(record, input, jitter, m, n, options)?;
-    template.from_fit(&fit)
+    template.with_fit(&fit)
 }
 
 /// The structure with its signal's model replaced by an initial model fitted to `record` (see
@@ -333,18 +332,24 @@ pub fn fit_rational(
     let mut alpha = lsq.solve_denominator(None)?;
     let mut best = (lsq.output_error(&alpha)?, alpha.clone());
     for _ in 0..options.iterations {
-        let next = lsq.solve_denominator(Some(&alpha))?;
+        // An iteration that fails (a reweighted system that is numerically singular) ends the
+        // iterations; the best iterate so far is kept.
+        let Ok(next) = lsq.solve_denominator(Some(&alpha)) else {
+            break;
+        };
         let change = next
             .iter()
             .zip(&alpha)
             .map(|(a, b)| (a - b).abs() / b.abs().max(1.0))
             .fold(0.0, f64::max);
         alpha = next;
-        let cost = lsq.output_error(&alpha)?;
+        let Ok(cost) = lsq.output_error(&alpha) else {
+            break;
+        };
         if cost < best.0 {
             best = (cost, alpha.clone());
         }
-        if change <= options.tolerance {
+        if !(change > options.tolerance) {
             break;
         }
     }

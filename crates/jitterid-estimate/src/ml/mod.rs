@@ -34,7 +34,7 @@
 //! resolve its frequency ([`MlError::SineRecordTooShort`]). During a search the same
 //! conditions are infinite costs that the minimisers step back from.
 //!
-//! ```
+//! ```no_run
 //! use jitterid_estimate::ml::{ml_estimate, ExactMl, MlOptions};
 //! use jitterid_estimate::{ModelStructure, Record};
 //! use jitterid_jitter::UniformSum;
