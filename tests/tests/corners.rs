@@ -653,7 +653,6 @@ fn inputs_switching_exactly_on_the_sample_grid() {
 /// `m[0]`; the second moment likewise). Fix: `partition_point(|s| s.0 <= t + hi)` (the reach
 /// `(t_k + lo, t_k + hi]`); `rule_from(c)` already keeps an atom at `c`.
 #[test]
-#[ignore = "known bug: a switch exactly at t_k + hi is dropped by LtiResponse::walk; see the doc comment"]
 fn atoms_on_switches_see_the_new_level() {
     let (a, b, grid) = grid_switching_responses();
     let jitters: Vec<Box<dyn JitterModel>> = vec![

@@ -225,7 +225,7 @@ impl<M: RationalModel> LtiResponse<M> {
                 }
                 next_past += 1;
             }
-            let reach_end = next_past + steps[next_past..].partition_point(|s| s.0 < t + hi);
+            let reach_end = next_past + steps[next_past..].partition_point(|s| s.0 <= t + hi);
             visit(k, t, u_past, &x, &y, &steps[next_past..reach_end]);
         }
     }
