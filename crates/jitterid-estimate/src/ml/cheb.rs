@@ -112,6 +112,10 @@ fn chebyshev_to_monomial(c: &[f64]) -> [f64; CHEB_POINTS] {
 /// Largest number of halvings of one input interval.
 const MAX_DEPTH: u32 = 12;
 
+/// Errors up to this multiple of the tolerance that halving no longer reduces are taken as the
+/// function's own rounding noise.
+const NOISE_FLOOR: f64 = 1e5;
+
 impl PiecewiseCheb {
     /// Interpolates `f` (which writes `channels` values at `t`) on each of `intervals`,
     /// halving a segment until the interpolant matches `f` at the test points within
@@ -171,7 +175,9 @@ impl PiecewiseCheb {
                 // Halving an analytic piece divides the error by about 2^16; if it no longer
                 // falls by 4, the error is the function's own rounding noise (for example the
                 // phase of a tone at large t), which no interpolant removes.
-                let ok = worst <= 1.0 || worst > 0.25 * parent_err;
+                // Only near the rounding level (within `NOISE_FLOOR` of the tolerance): an
+                // under-resolved segment has a large error that halving does not yet reduce.
+                let ok = worst <= 1.0 || (worst <= NOISE_FLOOR && worst > 0.25 * parent_err);
                 if ok {
                     for c in 0..channels {
                         global[c] = global[c].max(seg_max[c]);
@@ -339,7 +345,6 @@ mod tests {
     }
 
     #[test]
-    #[ignore = "the Chebyshev table is being reworked for speed; re-enable with the rework (issue 4)"]
     fn batched_horner_matches_clenshaw() {
         let f = |t: f64, out: &mut [f64]| out[0] = (-2.0 * t).exp() * (3.0 * t).cos() + 0.5;
         let table = PiecewiseCheb::build(&[(0.0, 2.0)], 1, 1e-14, f);
@@ -347,16 +352,25 @@ mod tests {
         let ts: [f64; 16] = std::array::from_fn(|i| 0.05 + 0.12 * i as f64);
         let mut out = [0.0; 16];
         let ok = table.eval0_sorted16(&ts, &mut out, &mut hint);
+        // Build tolerance: 1e-14 × (segment max + global max) ≤ 1e-14 × 2 × 1.5 here; the
+        // monomial (Horner) and Chebyshev (Clenshaw) forms agree to a few ulps of the
+        // monomial coefficients' sum (≤ 10 here).
         for i in 0..16 {
             assert!(ok[i]);
             let mut v = [0.0];
             f(ts[i], &mut v);
-            assert!((out[i] - v[0]).abs() < 2e-15, "{i}: {} vs {}", out[i], v[0]);
+            assert!((out[i] - v[0]).abs() < 3e-14, "{i}: {} vs {}", out[i], v[0]);
+            let seg = table.segment(ts[i]).unwrap();
+            let c = table.eval0(seg, ts[i]);
+            assert!(
+                (out[i] - c).abs() < 10.0 * 4.0 * f64::EPSILON,
+                "{i}: {} vs {c}",
+                out[i]
+            );
         }
     }
 
     #[test]
-    #[ignore = "the Chebyshev table is being reworked for speed; re-enable with the rework (issue 4)"]
     fn fast_oscillation_is_refined() {
         let f = |t: f64, out: &mut [f64]| out[0] = (40.0 * t).sin();
         let table = PiecewiseCheb::build(&[(0.0, 3.0)], 1, 1e-13, f);
