@@ -107,7 +107,7 @@ where
             }
         }
     }
-    let h = jac.transpose() * jac;
+    let h = crate::solver::problem::gram(jac);
     let Ok(llt) = h.llt(Side::Lower) else {
         return (None, noise_var.sqrt());
     };

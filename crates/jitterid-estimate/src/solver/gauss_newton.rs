@@ -118,7 +118,7 @@ impl GaussNewtonLineSearch {
         let j = checked_jacobian(problem, theta).ok()?;
         let n = theta.len();
         let g = jt_r(&j, &r);
-        let jtj = j.transpose() * &j;
+        let jtj = super::problem::gram(&j);
         let p = jtj
             .llt(Side::Lower)
             .ok()?

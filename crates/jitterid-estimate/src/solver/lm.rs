@@ -281,7 +281,7 @@ impl LevenbergMarquardt {
 
     /// Stores `JᵀJ` and updates `D` at a new point.
     fn set_jacobian(&mut self, j: &Mat<f64>) {
-        self.jtj = j.transpose() * j;
+        self.jtj = super::problem::gram(j);
         let n = self.jtj.nrows();
         let diag = (0..n).map(|i| self.jtj[(i, i)]);
         self.diag = match self.options.scaling {

@@ -58,7 +58,7 @@ mod gauss_newton;
 pub mod lm;
 mod multistart;
 mod nelder_mead;
-mod problem;
+pub(crate) mod problem;
 mod transform;
 
 pub use error::SolverError;

@@ -117,7 +117,7 @@ impl Solver for NelderMead {
             .map_err(SolverError::from_argmin)?;
         let cost = RelativeCost {
             problem,
-            scale: if v0.is_finite() { 1.0 / v0 } else { 1.0 },
+            scale: 1.0 / v0,
         };
         let result = Executor::new(cost, solver)
             .configure(|state: IterState<Vec<f64>, (), (), (), (), f64>| {

@@ -2,7 +2,7 @@
 
 use super::SolverError;
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
-use faer::{ColRef, Mat};
+use faer::Mat;
 
 /// Default relative step of [`fd_jacobian`]: `ε^{1/3}`, which balances truncation and rounding
 /// error of central differences for smooth residuals of order one.
@@ -195,7 +195,7 @@ pub(crate) fn validate_start<P: LeastSquares + ?Sized>(
     Ok(())
 }
 
-/// Residuals at a validated start, which must be finite.
+/// Residuals at a validated start, which must be finite with a finite sum of squares.
 pub(crate) fn start_residuals<P: LeastSquares + ?Sized>(
     problem: &P,
     start: &[f64],
@@ -203,6 +203,11 @@ pub(crate) fn start_residuals<P: LeastSquares + ?Sized>(
     let r = checked_residuals(problem, start)?;
     if let Some((index, value)) = first_non_finite(&r) {
         return Err(SolverError::NonFiniteResidual { index, value });
+    }
+    if !half_sum_sq(&r).is_finite() {
+        return Err(SolverError::Evaluation(
+            "the sum of squared residuals overflows at the start".to_string(),
+        ));
     }
     Ok(r)
 }
@@ -217,10 +222,39 @@ pub(crate) fn half_sum_sq(r: &[f64]) -> f64 {
     0.5 * r.iter().map(|x| x * x).sum::<f64>()
 }
 
+/// Column `c` of `j` as a slice (a `Mat` stores its columns contiguously).
+fn column(j: &Mat<f64>, c: usize) -> &[f64] {
+    j.col(c)
+        .try_as_col_major()
+        .map_or(&[][..], |col| col.as_slice())
+}
+
+/// `Σ a_i b_i`.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 /// `Jᵀ r` (the gradient of `½‖r‖²`); `j` must have `r.len()` rows.
+///
+/// Plain sequential dot products rather than faer's product: with a handful of columns and up
+/// to millions of rows the parallel kernel spends its time in barriers, and a fixed summation
+/// order keeps Monte Carlo runs bit-identical whatever the thread count.
 pub(crate) fn jt_r(j: &Mat<f64>, r: &[f64]) -> Vec<f64> {
-    let g = j.transpose() * ColRef::from_slice(r);
-    (0..g.nrows()).map(|i| g[i]).collect()
+    (0..j.ncols()).map(|c| dot(column(j, c), r)).collect()
+}
+
+/// `JᵀJ`, sequential for the reasons given at [`jt_r`].
+pub(crate) fn gram(j: &Mat<f64>) -> Mat<f64> {
+    let p = j.ncols();
+    let mut g = Mat::zeros(p, p);
+    for a in 0..p {
+        for b in 0..=a {
+            let v = dot(column(j, a), column(j, b));
+            g[(a, b)] = v;
+            g[(b, a)] = v;
+        }
+    }
+    g
 }
 
 /// A Jacobian entry that is not finite, if any.
