@@ -17,10 +17,10 @@ pub const GL_ORDER: usize = 16;
 
 /// Largest `rate × width` allowed on one sub-interval: with 16 nodes the Gauss–Legendre error
 /// for `e^{zτ}` with `|z|·width ≤ 6` is below `1e-15` relative.
-const MAX_RATE_WIDTH: f64 = 6.0;
+pub const MAX_RATE_WIDTH: f64 = 6.0;
 
 /// Upper bound on the sub-intervals of one piece, so that a huge rate cannot exhaust memory.
-const MAX_SUBDIVISIONS: usize = 4096;
+pub const MAX_SUBDIVISIONS: usize = 4096;
 
 /// Gauss–Legendre nodes and weights on `[-1, 1]` for `n` points, by Newton's method on the
 /// Legendre recurrence.
@@ -56,7 +56,10 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (nodes, weights)
 }
 
-fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
+/// The [`GL_ORDER`]-point Gauss–Legendre rule on `[-1, 1]` (nodes, weights), computed once: for
+/// callers that integrate over the jitter's pieces themselves without building a
+/// [`QuadratureRule`].
+pub fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
     static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
     RULE.get_or_init(|| gauss_legendre(GL_ORDER))
 }

@@ -35,6 +35,7 @@ mod lti;
 pub mod poly;
 mod pulse;
 mod rational;
+mod reach;
 mod signal;
 mod simulate;
 mod sinusoid;

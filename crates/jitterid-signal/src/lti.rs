@@ -2,6 +2,7 @@
 
 use crate::input::Input;
 use crate::rational::{Modal, RationalModel};
+use crate::reach::{InReach, Route, SquaresRule};
 use crate::signal::{Jacobian, Signal, SpectralLine};
 use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
@@ -15,11 +16,15 @@ use std::sync::OnceLock;
 /// `s(t) = Σ_j Δu_j [G(0) + Σ_i (r_i/p_i) e^{p_i (t − t_j)}]` for `t ≥ t_j` (the modal form);
 /// the system is at rest before the first step. For tones the response is the steady state.
 ///
-/// The first moment `m_k = E[s(t_k + τ)]` is computed exactly and in `O(N + J·Q)` for `N`
-/// samples, `J` steps and `Q` quadrature nodes: a step that lies before the jitter's reach of a
-/// sample acts through `E[e^{p_i(τ − lo)}]`, carried from sample to sample by the recursion
-/// `x ← e^{p_i T} x`; only steps inside a sample's reach `[t_k + lo, t_k + hi]` need the
-/// piecewise quadrature of the jitter's [`rule`](JitterModel::rule).
+/// The first moment `m_k = E[s(t_k + τ)]` is computed exactly and in `O(N + J)` for `N`
+/// samples and `J` steps: a step that lies before the jitter's reach of a sample acts through
+/// `E[e^{p_i(τ − lo)}]`, carried from sample to sample by the recursion `x ← e^{p_i T} x`; a
+/// step inside a sample's reach `(t_k + lo, t_k + hi]` acts through expectations over
+/// `τ ≥ t_j − t_k` that depend on `t_j − t_k` only, computed by quadrature over the jitter's
+/// pieces and, for long records, tabulated once per evaluation (piecewise Chebyshev, checked
+/// against the quadrature to `1e-14`). Quadrature is refined only where a modal term `e^{p x}`
+/// has not yet decayed, so the cost does not grow with the jitter's reach or the poles'
+/// moduli.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LtiResponse<M> {
     model: M,
@@ -111,6 +116,11 @@ impl<M: RationalModel> LtiResponse<M> {
     /// Per sample: `C_k = E[Σ_j Δu_j 1{x ≥ 0}]`, and per representative pole
     /// `A_ik = E[Σ_j Δu_j e^{p_i x} 1{x ≥ 0}]`, `B_ik = E[Σ_j Δu_j x e^{p_i x} 1{x ≥ 0}]`, with
     /// `x = t_k + τ − t_j`. `B` only when `with_b`.
+    ///
+    /// Steps past the reach go through the state recursion of [`walk`](Self::walk); a step
+    /// inside it at `c = t_j − t_k` needs `P(τ ≥ c)`, `E[e^{p_i(τ−c)} 1{τ ≥ c}]` and
+    /// `E[(τ−c) e^{p_i(τ−c)} 1{τ ≥ c}]`, functions of `c` alone that [`InReach`] tabulates once
+    /// per evaluation when enough steps ask for them.
     fn modal_expectations(
         &self,
         grid: &SampleGrid,
@@ -122,21 +132,16 @@ impl<M: RationalModel> LtiResponse<M> {
         let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| self.modal().poles[i]).collect();
         let np = poles.len();
         let (lo, hi) = jitter.reach();
-        let rate = self.rate();
-        // E[e^{p(τ − lo)}] and E[(τ − lo) e^{p(τ − lo)}] over the reach: bounded because
-        // Re p < 0 and τ − lo ≥ 0.
-        let full = jitter.rule(&[], rate);
-        let mut m0 = vec![Complex64::new(0.0, 0.0); np];
-        let mut m1 = vec![Complex64::new(0.0, 0.0); np];
-        for (&tau, &w) in full.nodes.iter().zip(&full.weights) {
-            let sigma = tau - lo;
-            for (i, p) in poles.iter().enumerate() {
-                let e = (p * sigma).exp() * w;
-                m0[i] += e;
-                m1[i] += e * sigma;
-            }
-        }
-        let mass: f64 = full.mass();
+        let mut queries = 0;
+        self.walk(grid, lo, hi, &[], false, |_, _, _, _, _, in_reach| {
+            queries += in_reach.len();
+        });
+        let reach = InReach::new(jitter, &poles, with_b, Route::Auto(queries));
+        // E[1], E[e^{p(τ − lo)}] and E[(τ − lo) e^{p(τ − lo)}] over the whole reach: bounded
+        // because Re p < 0 and τ − lo ≥ 0.
+        let start = reach.at_start();
+        let mass = start[0].re;
+        let (m0, m1) = start[1..].split_at(np);
 
         let mut out = ModalExpectations {
             c: vec![0.0; n],
@@ -147,6 +152,7 @@ impl<M: RationalModel> LtiResponse<M> {
                 Vec::new()
             },
         };
+        let mut v = vec![Complex64::new(0.0, 0.0); reach.width()];
         self.walk(
             grid,
             lo,
@@ -161,19 +167,13 @@ impl<M: RationalModel> LtiResponse<M> {
                         out.b[i][k] = y[i] * m0[i] + x[i] * m1[i];
                     }
                 }
-                // Steps inside the reach: quadrature over τ ≥ c = t_j − t_k.
                 for &(tj, du) in in_reach {
-                    let c = tj - t;
-                    let rule = jitter.rule_from(c, &[], rate);
-                    for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
-                        let xj = tau - c;
-                        out.c[k] += w * du;
-                        for (i, p) in poles.iter().enumerate() {
-                            let e = (p * xj).exp() * (w * du);
-                            out.a[i][k] += e;
-                            if with_b {
-                                out.b[i][k] += e * xj;
-                            }
+                    reach.eval(tj - t, &mut v);
+                    out.c[k] += du * v[0].re;
+                    for i in 0..np {
+                        out.a[i][k] += du * v[1 + i];
+                        if with_b {
+                            out.b[i][k] += du * v[1 + np + i];
                         }
                     }
                 }
@@ -232,7 +232,8 @@ impl<M: RationalModel> LtiResponse<M> {
 
     /// `E[s(t_k + τ)²]` for a piecewise-constant input: `s` on each sample's reach is the past
     /// steps' modal state plus the steps inside the reach, evaluated at the jitter's quadrature
-    /// nodes in `O(poles + steps in reach)` per node.
+    /// nodes in `O(poles + steps in reach)` per node. The rules ([`SquaresRule`]) are refined
+    /// only where a transient is alive, after a step or the start of the reach.
     fn piecewise_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
         let m = self.modal();
         let reps = self.representatives();
@@ -242,8 +243,10 @@ impl<M: RationalModel> LtiResponse<M> {
             .map(|&(i, w)| m.residues[i] / m.poles[i] * w)
             .collect();
         let (lo, hi) = jitter.reach();
-        let rate = 2.0 * self.rate();
-        let full = jitter.rule(&[], rate);
+        let rules = SquaresRule::new(jitter, &poles);
+        let (mut full_nodes, mut full_weights) = (Vec::new(), Vec::new());
+        rules.build(&[], &mut full_nodes, &mut full_weights);
+        let (mut cut_nodes, mut cut_weights, mut cuts) = (Vec::new(), Vec::new(), Vec::new());
         let mut out = vec![0.0; grid.len()];
         self.walk(
             grid,
@@ -252,16 +255,16 @@ impl<M: RationalModel> LtiResponse<M> {
             &poles,
             false,
             |k, t, u_past, x, _, in_reach| {
-                let local;
-                let rule = if in_reach.is_empty() {
-                    &full
+                let (nodes, weights) = if in_reach.is_empty() {
+                    (&full_nodes, &full_weights)
                 } else {
-                    let cuts: Vec<f64> = in_reach.iter().map(|s| s.0 - t).collect();
-                    local = jitter.rule(&cuts, rate);
-                    &local
+                    cuts.clear();
+                    cuts.extend(in_reach.iter().map(|s| s.0 - t));
+                    rules.build(&cuts, &mut cut_nodes, &mut cut_weights);
+                    (&cut_nodes, &cut_weights)
                 };
                 let mut acc = 0.0;
-                for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                for (&tau, &w) in nodes.iter().zip(weights) {
                     let mut s = m.dc_gain * u_past;
                     for i in 0..poles.len() {
                         s += (coef[i] * x[i] * (poles[i] * (tau - lo)).exp()).re;
