@@ -107,17 +107,46 @@ where
             }
         }
     }
-    let h = crate::solver::problem::gram(jac);
-    let Ok(llt) = h.llt(Side::Lower) else {
+    let Some(hinv) = inverse_gram(&crate::solver::problem::gram(jac)) else {
         return (None, noise_var.sqrt());
     };
-    let hinv = llt.inverse();
     let cov = &hinv * &meat * &hinv;
     let out: Vec<Vec<f64>> = (0..p)
         .map(|a| (0..p).map(|b| cov[(a, b)]).collect())
         .collect();
     let finite = out.iter().flatten().all(|v| v.is_finite());
     (finite.then_some(out), noise_var.sqrt())
+}
+
+/// Largest 1-norm condition number of `JᵀJ` scaled to unit diagonal that counts as invertible:
+/// beyond it the inverse has fewer than about four correct digits, and a parameter combination
+/// that the data do not determine (an exactly singular `JᵀJ` perturbed by rounding) would
+/// otherwise get a small, meaningless standard error.
+const MAX_CONDITION: f64 = 1e12;
+
+/// `(JᵀJ)⁻¹` through the unit-diagonal scaling `D^{-1/2} JᵀJ D^{-1/2}` (which removes the
+/// parameters' units from the conditioning), or `None` if it is singular, not finite or worse
+/// conditioned than [`MAX_CONDITION`].
+pub(crate) fn inverse_gram(h: &Mat<f64>) -> Option<Mat<f64>> {
+    let p = h.nrows();
+    let mut scale = Vec::with_capacity(p);
+    for i in 0..p {
+        let d = h[(i, i)];
+        if !(d.is_finite() && d > 0.0) {
+            return None;
+        }
+        scale.push(1.0 / d.sqrt());
+    }
+    let scaled = Mat::from_fn(p, p, |i, j| h[(i, j)] * scale[i] * scale[j]);
+    let inv = scaled.llt(Side::Lower).ok()?.inverse();
+    let norm1 = |m: &Mat<f64>| {
+        (0..p)
+            .map(|j| (0..p).map(|i| m[(i, j)].abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    };
+    let condition = norm1(&scaled) * norm1(&inv);
+    (condition.is_finite() && condition <= MAX_CONDITION)
+        .then(|| Mat::from_fn(p, p, |i, j| inv[(i, j)] * scale[i] * scale[j]))
 }
 
 /// `G = Aᵀ√W·J` without the taper `c_k` (applied by the caller), row-major `N × p`:

@@ -92,6 +92,15 @@ pub trait Criterion: fmt::Debug + Send + Sync {
         false
     }
 
+    /// Whether the weighted residuals at the true parameters have the same variance at every
+    /// frequency (white measurement noise for BCLS; the noise model's shape divided out for
+    /// Box–Jenkins), so that [`estimate`](crate::estimate) can check a converged fit with
+    /// [`residual_flatness`](crate::residual_flatness). False by default (naive LS keeps the
+    /// jitter's bias in its residuals; user weights can shape them arbitrarily).
+    fn flat_residuals(&self) -> bool {
+        false
+    }
+
     /// Weights `w_f ≥ 0`, one per frequency of the set.
     fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, noise: &N) -> Vec<f64>;
 
@@ -271,6 +280,9 @@ impl Criterion for Bcls {
     fn models_jitter(&self) -> bool {
         true
     }
+    fn flat_residuals(&self) -> bool {
+        true
+    }
     fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, _: &N) -> Vec<f64> {
         vec![1.0; freqs.len()]
     }
@@ -338,6 +350,9 @@ impl Criterion for BoxJenkins {
         "bj"
     }
     fn models_jitter(&self) -> bool {
+        true
+    }
+    fn flat_residuals(&self) -> bool {
         true
     }
     fn uses_noise_model(&self) -> bool {

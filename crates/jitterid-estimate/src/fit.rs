@@ -65,6 +65,9 @@ impl Default for EstimateOptions {
     }
 }
 
+/// Relative residual size below which a fit is exact to rounding and not checked for flatness.
+const EXACT_FIT: f64 = 1e-9;
+
 /// The result of [`estimate`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Estimate {
@@ -88,6 +91,12 @@ pub struct Estimate {
     pub converged: bool,
     /// Final residuals.
     pub residuals: Vec<f64>,
+    /// [`residual_flatness`](crate::residual_flatness) of the final residuals, for criteria
+    /// whose residuals are flat at the truth ([`Criterion::flat_residuals`]) and frequency
+    /// sets large enough for a verdict: about 1–1.6 at a good fit; above
+    /// [`FLATNESS_LIMIT`](crate::FLATNESS_LIMIT) the fit is reported as not converged.
+    #[serde(default)]
+    pub residual_flatness: Option<f64>,
     /// The measurement-noise standard deviation used for the covariance (known or estimated).
     pub noise_std: f64,
 }
@@ -209,6 +218,22 @@ where
     let std_errors = covariance
         .as_ref()
         .map(|c: &Vec<Vec<f64>>| (0..p).map(|i| c[i][i].max(0.0).sqrt()).collect());
+    // Residuals at the rounding level of the data (noise-free data fitted exactly) carry no
+    // spectrum to judge.
+    let data_power: f64 = data.dtft().iter().map(|y| y.norm_sqr()).sum();
+    let exact = 2.0 * report.cost <= EXACT_FIT * EXACT_FIT * data_power;
+    let residual_flatness = if criterion.flat_residuals() && !exact {
+        crate::residual_flatness(&residuals)
+    } else {
+        None
+    };
+    // A converged fit that leaves a band of frequencies unexplained is not a solution.
+    let (converged, termination) = match residual_flatness {
+        Some(f) if report.converged && f > crate::FLATNESS_LIMIT => {
+            (false, Termination::ResidualNotFlat)
+        }
+        _ => (report.converged, report.termination),
+    };
     Ok(Estimate {
         criterion: criterion.name().to_string(),
         names: structure.param_names(),
@@ -217,9 +242,10 @@ where
         std_errors,
         cost: report.cost,
         iterations: report.iterations,
-        termination: report.termination,
-        converged: report.converged,
+        termination,
+        converged,
         residuals,
         noise_std,
+        residual_flatness,
     })
 }

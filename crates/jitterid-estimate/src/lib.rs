@@ -38,6 +38,7 @@ mod criterion;
 mod data;
 mod error;
 mod fit;
+mod flatness;
 mod init;
 pub mod ml;
 pub mod montecarlo;
@@ -50,6 +51,7 @@ pub use criterion::{Bcls, BoxJenkins, Criterion, FrequencyData, Ls, WeightedBcls
 pub use data::Record;
 pub use error::EstimateError;
 pub use fit::{estimate, Estimate, EstimateOptions, FitProblem, Frequencies};
+pub use flatness::{residual_flatness, FLATNESS_BANDS, FLATNESS_LIMIT, FLATNESS_MIN_PER_BAND};
 pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };

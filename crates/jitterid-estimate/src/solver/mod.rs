@@ -131,6 +131,11 @@ pub enum Termination {
     NonFinite,
     /// The line search found no acceptable step along a non-negligible descent direction.
     LineSearchFailed,
+    /// The solver met a convergence test, but the residual spectrum is far from flat
+    /// ([`residual_flatness`](crate::residual_flatness) above
+    /// [`FLATNESS_LIMIT`](crate::FLATNESS_LIMIT)): a local minimum, or a model that does not
+    /// describe the data. Set by [`estimate`](crate::estimate), not by the solvers.
+    ResidualNotFlat,
     /// Any other reason, described in words.
     Other(String),
 }
@@ -156,6 +161,10 @@ impl fmt::Display for Termination {
                 f.write_str("residuals or Jacobian not finite at every nearby trial point")
             }
             Termination::LineSearchFailed => f.write_str("line search failed"),
+            Termination::ResidualNotFlat => f.write_str(
+                "converged, but the residual spectrum is not flat (a local minimum, or a model \
+                 that does not describe the data)",
+            ),
             Termination::Other(why) => f.write_str(why),
         }
     }
