@@ -49,38 +49,6 @@ const CI_SEED: u64 = 0x6a69_7474_6572;
 // Object-safe stand-ins: one concrete type per trait, so the fuzzer instantiates `estimate`
 // only a few times.
 
-/// Largest jitter reach (s) the harness lets a model take, in construction and in the solver's
-/// trial points (a parameter beyond it is a typed error, which the solvers treat as a rejected
-/// point), and the largest `rate × reach` its quadrature rules are built for.
-///
-/// Both are harness workarounds for one known issue of the library: the exact first moment of
-/// an LTI response builds, for every input step inside a sample's reach, a rule refined to
-/// `rate × width ≤ 6` per sub-interval (at most 4096 sub-intervals of 16 nodes per piece), so its
-/// cost grows like `reach × rate` although only `x ≲ 40/|Re p|` matters for `e^{p x}` and the
-/// constant part needs only the mass. A criterion that drives the jitter's width or a pole's
-/// modulus up (the fuzzer found both: data whose DC term cancels; a pole stepped to −10⁸) then
-/// makes each evaluation take seconds and a few LM iterations take minutes. See
-/// `wide_jitter_first_moment_cost_is_bounded` below (ignored until fixed). Remove both caps
-/// with the fix.
-const MAX_REACH: f64 = 20.0;
-/// See [`MAX_REACH`]: rules are built for at most this `rate × (hi − lo)` (64 sub-intervals over
-/// the whole reach at the library's `rate × width ≤ 6`).
-const MAX_RATE_REACH: f64 = 384.0;
-
-fn capped(j: AnyJitter) -> Result<AnyJitter, JitterError> {
-    let (lo, hi) = j.reach();
-    let reach = hi.abs().max(lo.abs());
-    if reach <= MAX_REACH {
-        Ok(j)
-    } else {
-        Err(JitterError::OutOfRange {
-            name: "reach (fuzz harness cap)",
-            value: reach,
-            range: "[0, 20] s",
-        })
-    }
-}
-
 /// Any jitter family, delegating every method (including the provided ones).
 #[derive(Debug, Clone)]
 enum AnyJitter {
@@ -107,19 +75,6 @@ macro_rules! each {
     };
 }
 
-impl AnyJitter {
-    /// The rate a rule is built for, capped (see [`MAX_RATE_REACH`]).
-    fn harness_rate(&self, rate: f64) -> f64 {
-        let (lo, hi) = self.reach();
-        let width = hi - lo;
-        if width > 0.0 && width.is_finite() {
-            rate.min(MAX_RATE_REACH / width)
-        } else {
-            rate
-        }
-    }
-}
-
 impl JitterModel for AnyJitter {
     fn name(&self) -> &'static str {
         each!(self, j => j.name())
@@ -131,7 +86,7 @@ impl JitterModel for AnyJitter {
         each!(self, j => j.params())
     }
     fn with_params(&self, p: &[f64]) -> Result<Self, JitterError> {
-        capped(match self {
+        Ok(match self {
             AnyJitter::None(j) => AnyJitter::None(j.with_params(p)?),
             AnyJitter::Uniform(j) => AnyJitter::Uniform(j.with_params(p)?),
             AnyJitter::Gauss(j) => AnyJitter::Gauss(j.with_params(p)?),
@@ -172,11 +127,9 @@ impl JitterModel for AnyJitter {
         each!(self, j => j.reach())
     }
     fn rule(&self, breaks: &[f64], rate: f64) -> QuadratureRule {
-        let rate = self.harness_rate(rate);
         each!(self, j => j.rule(breaks, rate))
     }
     fn rule_from(&self, from: f64, breaks: &[f64], rate: f64) -> QuadratureRule {
-        let rate = self.harness_rate(rate);
         each!(self, j => j.rule_from(from, breaks, rate))
     }
 }
@@ -412,9 +365,9 @@ fn jitter() -> impl Strategy<Value = JitterSpec> {
     };
     prop_oneof![
         Just(JitterSpec::None),
-        // n ≤ 12 keeps the CI budget: each rule costs O(n²) per node for the uniform sum's
-        // density and is rebuilt per sample and input step in reach (n up to 50 is a corner
-        // test of its own).
+        // n ≤ 12 keeps the CI budget: the uniform sum's density costs O(n²) per node, and the
+        // second moment's rules are rebuilt for every sample with input steps in reach (n up to
+        // 50 is a corner test of its own).
         (0u32..13, width()).prop_map(|(n, a)| JitterSpec::Uniform(n, a)),
         width().prop_map(JitterSpec::Gauss),
         width().prop_map(JitterSpec::Laplace),
@@ -640,7 +593,7 @@ fn note_error(e: &dyn std::fmt::Display) {
 }
 
 fn build_jitter(spec: &JitterSpec) -> Result<AnyJitter, JitterError> {
-    capped(match *spec {
+    Ok(match *spec {
         JitterSpec::None => AnyJitter::None(NoJitter),
         JitterSpec::Uniform(n, a) => AnyJitter::Uniform(UniformSum::new(n, a)?),
         JitterSpec::Gauss(s) => AnyJitter::Gauss(Gaussian::new(s)?),
@@ -981,17 +934,16 @@ fn estimate_entry_points_never_panic_or_hang() {
     assert!(get(&TALLY.cases) >= cases as usize);
 }
 
-/// Known issue (see [`MAX_REACH`]): the exact first moment of an LTI response costs
-/// `O(reach · rate)` quadrature nodes per input step inside the jitter's reach (capped at
-/// `4096·16` per piece), although only `O(rate/|Re p|)` of them matter (`e^{p x}` is negligible
-/// beyond `x ≈ 40/|Re p|`, and the constant part needs only the mass). With a Gaussian jitter of
-/// σ = 10⁶ s, 49 samples and six steps it takes about 15 s in the dev profile instead of
-/// milliseconds; a pole at −10⁸ rad/s with a 55-term uniform-sum jitter does the same. A
-/// least-squares fit whose criterion pushes the jitter's width or a pole's modulus up then runs
-/// for minutes. Ignored until fixed in `jitterid-signal` (`LtiResponse::modal_expectations` and
-/// `piecewise_squares`).
+/// Regression test: the exact first moment of an LTI response once cost `O(reach · rate)`
+/// quadrature nodes per input step inside the jitter's reach (a rule refined over the whole
+/// reach, capped at `4096·16` nodes per piece), although only `O(|p|/|Re p|)` of them matter
+/// (`e^{p x}` is negligible beyond `x ≈ 50/|Re p|`, and the constant part needs only the mass);
+/// the second moment's rules likewise. With a Gaussian jitter of σ = 10⁶ s, 49 samples and six
+/// steps it took about 15 s in the dev profile; a pole at −10⁸ rad/s with a 55-term uniform-sum
+/// jitter did the same, and a least-squares fit whose criterion pushed the jitter's width or a
+/// pole's modulus up ran for minutes. The cost of the first moment, its gradient and the
+/// second moment must stay within a small multiple of the narrow-jitter case.
 #[test]
-#[ignore = "known issue: first-moment cost grows with the jitter's reach; see the doc comment"]
 fn wide_jitter_first_moment_cost_is_bounded() {
     let u = PiecewiseConstant::new(
         vec![-31.66, -29.66, -29.657, -29.653, -5.58, 19.0, 19.06],
@@ -1001,31 +953,56 @@ fn wide_jitter_first_moment_cost_is_bounded() {
     let g = Zpk::new(-2.5, vec![], vec![Root::Real(-0.222), Root::Real(-0.396)]).unwrap();
     let s = LtiResponse::new(g, u);
     let grid = SampleGrid::new(-1.875, 1.664, 49).unwrap();
-    let narrow = Instant::now();
-    let _ = s.expected_values(&grid, &Gaussian::new(0.03).unwrap());
-    let narrow = narrow.elapsed().as_secs_f64();
-    for sigma in [1e2, 1e4, 1e6] {
+    // Seconds for m_k, ∂m_k/∂θ and E[s²], all finite.
+    let cost = |s: &LtiResponse<Zpk>, j: &dyn JitterModel| {
         let t = Instant::now();
-        let m = s.expected_values(&grid, &Gaussian::new(sigma).unwrap());
+        let m = s.expected_values(&grid, j);
+        let d = s.expected_values_gradient(&grid, j);
+        let q = s.expected_squares(&grid, j);
         let secs = t.elapsed().as_secs_f64();
-        assert!(m.iter().all(|v| v.is_finite()));
+        assert!(m
+            .iter()
+            .chain(d.iter().flatten())
+            .chain(&q)
+            .all(|v| v.is_finite()));
+        secs
+    };
+    let narrow = cost(&s, &Gaussian::new(0.03).unwrap());
+    for sigma in [1e2, 1e4, 1e6] {
+        let secs = cost(&s, &Gaussian::new(sigma).unwrap());
         assert!(
             secs < 0.05 + 50.0 * narrow,
             "σ = {sigma:e}: {secs:.2} s against {narrow:.4} s for σ = 0.03"
         );
     }
-    // A fast pole: e^{p x} vanishes after 40/|p| = 0.4 µs, yet the rules are refined over the
-    // whole reach of every step inside it.
-    let fast = Zpk::new(1e8, vec![], vec![Root::Real(-1e8), Root::Real(-0.5)]).unwrap();
-    let s = LtiResponse::new(fast, s.input().clone());
-    let t = Instant::now();
-    let m = s.expected_values(&grid, &UniformSum::new(54, 0.5).unwrap());
-    let secs = t.elapsed().as_secs_f64();
-    assert!(m.iter().all(|v| v.is_finite()));
-    assert!(
-        secs < 0.05 + 50.0 * narrow,
-        "pole −1e8: {secs:.2} s against {narrow:.4} s"
-    );
+    // Fast poles: e^{p x} vanishes after 50/|p| = 0.5 µs, so only that stretch after each step
+    // needs refined quadrature; and a lightly damped one (found by the fuzzer: |p| = 10¹²,
+    // Re p = −0.79) that would need |p|/|Re p| sub-intervals even there.
+    for (poles, jitter) in [
+        (
+            vec![Root::Real(-1e8), Root::Real(-0.5)],
+            Box::new(UniformSum::new(54, 0.5).unwrap()) as Box<dyn JitterModel>,
+        ),
+        (
+            vec![
+                Root::Pair {
+                    re: -0.79,
+                    im: 1e12,
+                },
+                Root::Real(-25.0),
+            ],
+            Box::new(ExponentialDelay::new(0.15).unwrap()),
+        ),
+    ] {
+        let fast = Zpk::new(1e8, vec![], poles).unwrap();
+        let s = LtiResponse::new(fast, s.input().clone());
+        let secs = cost(&s, jitter.as_ref());
+        assert!(
+            secs < 0.05 + 50.0 * narrow,
+            "{:?}: {secs:.2} s against {narrow:.4} s",
+            s.model()
+        );
+    }
 }
 
 /// Regression test: a start where `½ Σ r²` overflows (residuals of

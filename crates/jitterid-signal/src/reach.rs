@@ -26,11 +26,15 @@
 //! Quadrature is 16-point Gauss–Legendre on sub-intervals of width at most `6/rate`, as in the
 //! jitter crate's rules, but the rate is applied only where a modal term is alive: `e^{p_i x}`
 //! has fallen below `e^{−DECAY}` once `x ≥ DECAY/|Re p_i|`, and beyond that distance only the
-//! mass is needed, which the density's pieces resolve unrefined. The cost of a query is then
-//! `O(|p|/|Re p|)` nodes at most instead of `O(|p| × reach)`.
+//! mass is needed, which the density's pieces resolve unrefined. Where even that window would
+//! need many sub-intervals (a fast, lightly damped pole: `|p|/|Re p|` of them), Filon's method
+//! integrates the density's degree-15 interpolant against `e^{p x}` exactly. A query then costs
+//! `O(16 × knots in the window)` density evaluations whatever `|p|` and the reach, instead of
+//! `O(|p| × reach)`.
 //!
 //! [`SquaresRule`] applies the same windowed refinement to the quadrature rules of the second
-//! moment `E[s(t_k + τ)²]`.
+//! moment `E[s(t_k + τ)²]`, and tells when they would still be too large (the response then
+//! expands the square and uses [`InReach`] at sums of poles).
 
 use jitterid_jitter::rule::{gl16, GL_ORDER, MAX_RATE_WIDTH, MAX_SUBDIVISIONS};
 use jitterid_jitter::JitterModel;
@@ -117,6 +121,87 @@ fn quadrature(
         }
     }
     n * GL_ORDER
+}
+
+/// A zone needing more Gauss–Legendre sub-intervals than this is integrated by Filon's method
+/// (16 density evaluations whatever the rate); below it the plain rule is as cheap and needs
+/// nothing of the density beyond the pieces' contract.
+const FILON_PARTS: usize = 4;
+
+/// `(2k+1)/2 · w_j · P_k(s_j)` at the Gauss–Legendre nodes: the Legendre coefficients of the
+/// degree-15 interpolant through 16 values at the nodes.
+struct Legendre {
+    coef: [[f64; GL_ORDER]; GL_ORDER],
+}
+
+fn legendre() -> &'static Legendre {
+    static L: OnceLock<Legendre> = OnceLock::new();
+    L.get_or_init(|| {
+        let (s, w) = gl16();
+        let mut coef = [[0.0; GL_ORDER]; GL_ORDER];
+        for (j, (&x, &wj)) in s.iter().zip(w).enumerate() {
+            let (mut p0, mut p1) = (1.0, x);
+            for (k, row) in coef.iter_mut().enumerate() {
+                let pk = if k == 0 { p0 } else { p1 };
+                row[j] = (2 * k + 1) as f64 / 2.0 * wj * pk;
+                if k >= 1 {
+                    let p2 = ((2 * k + 1) as f64 * x * p1 - k as f64 * p0) / (k + 1) as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+            }
+        }
+        Legendre { coef }
+    })
+}
+
+/// `N_k = ∫_{−1}^{1} P_k(s) e^{ω(s+1)} ds` for `k = 0..=16`, `Re ω ≤ 0`, `|ω| > 3`.
+///
+/// Integrating `(2k+1) P_k = P'_{k+1} − P'_{k−1}` by parts gives
+/// `N_{k+1} = N_{k−1} − (2k+1) N_k / ω`. Forward from `N_0 = (e^{2ω} − 1)/ω` it is stable while
+/// `k ≲ |ω|`; below, `N_k` is the recurrence's minimal solution, computed backward (Miller)
+/// from well beyond `k = 16` and normalised by the Legendre series of `e^{ω(s+1)}` at `s = −1`,
+/// `Σ (2k+1)/2 (−1)^k N_k = 1`.
+fn exp_legendre_moments(omega: Complex64, n: &mut [Complex64; GL_ORDER + 1]) {
+    let r = omega.norm();
+    if r >= (GL_ORDER + 1) as f64 {
+        let e2 = cexp(2.0 * omega);
+        let inv = omega.inv();
+        n[0] = (e2 - 1.0) * inv;
+        n[1] = (e2 + 1.0 - n[0]) * inv;
+        for k in 1..GL_ORDER {
+            n[k + 1] = n[k - 1] - n[k] * inv * (2 * k + 1) as f64;
+        }
+        return;
+    }
+    // The minimal solution falls like |ω|^k/(2k+1)!!: from this start its truncation error is
+    // far below rounding at k ≤ 16.
+    let top = 2 * GL_ORDER + 2 * (r.ceil() as usize) + 16;
+    let inv = omega.inv();
+    let (mut above, mut cur) = (ZERO, Complex64::new(1.0, 0.0));
+    let sign = |k: usize| if k % 2 == 0 { 1.0 } else { -1.0 };
+    let mut norm = cur * ((2 * top + 1) as f64 / 2.0 * sign(top));
+    n.fill(ZERO);
+    for k in (1..=top).rev() {
+        let below = above + cur * inv * (2 * k + 1) as f64;
+        above = cur;
+        cur = below;
+        if k - 1 <= GL_ORDER {
+            n[k - 1] = cur;
+        }
+        norm += cur * ((2 * k - 1) as f64 / 2.0 * sign(k - 1));
+        if cur.norm() > 1e100 {
+            // The recurrence is linear; keep the moduli far from overflow (also of |z|² in
+            // complex division).
+            above *= 1e-100;
+            cur *= 1e-100;
+            norm *= 1e-100;
+            n.iter_mut().for_each(|x| *x *= 1e-100);
+        }
+    }
+    let m = norm.norm();
+    let unit = (norm / m).conj() / m;
+    n.iter_mut().for_each(|x| *x *= unit);
 }
 
 /// Refinement zones after an origin (a step, or the start of the reach): `(x_end, rate)` with
@@ -308,26 +393,21 @@ impl<'a> InReach<'a> {
     /// only; atoms sit on knots and are added with the knot states), for `[c, c + len]` inside
     /// one knot interval. Returns the number of density evaluations.
     fn integrate(&self, c: f64, len: f64, out: &mut [Complex64]) -> usize {
-        let np = self.poles.len();
         let mut count = 0;
         let mut start = 0.0;
-        let mut node = |x: f64, w: f64| {
-            out[0] += w;
-            for (i, p) in self.poles.iter().enumerate() {
-                let e = cexp(p * x) * w;
-                out[1 + i] += e;
-                if self.with_b {
-                    out[1 + np + i] += e * x;
-                }
-            }
-        };
         for &(x_end, rate) in &self.zones {
             if start >= len {
                 break;
             }
             let end = x_end.min(len);
             if end > start {
-                count += quadrature(self.jitter, c, start, end, rate, &mut node);
+                count += if parts(rate, end - start) > FILON_PARTS {
+                    self.filon(c, start, end, out)
+                } else {
+                    quadrature(self.jitter, c, start, end, rate, |x, w| {
+                        self.add_node(x, w, out)
+                    })
+                };
                 start = end;
             }
         }
@@ -336,6 +416,82 @@ impl<'a> InReach<'a> {
             count += quadrature(self.jitter, c, start, len, 0.0, |_, w| out[0] += w);
         }
         count
+    }
+
+    /// Adds one quadrature node `(x, w)` to `(P, A_i…, B_i…)`.
+    #[inline]
+    fn add_node(&self, x: f64, w: f64, out: &mut [Complex64]) {
+        let np = self.poles.len();
+        out[0] += w;
+        for (i, p) in self.poles.iter().enumerate() {
+            let e = cexp(p * x) * w;
+            out[1 + i] += e;
+            if self.with_b {
+                out[1 + np + i] += e * x;
+            }
+        }
+    }
+
+    /// Adds the integrals over `x ∈ [xa, xb]` (inside one knot interval) by Filon's method: the
+    /// density is replaced by its degree-15 interpolant at the 16 Gauss–Legendre nodes, which
+    /// is integrated against `e^{p x}` exactly, so that the cost does not grow with
+    /// `|p|·(xb − xa)` (a lightly damped fast pole would otherwise need `|p|/|Re p|`
+    /// sub-intervals). The mass is the plain Gauss–Legendre sum, as everywhere.
+    ///
+    /// This asks a little more of the density than the pieces' contract (that 16 nodes
+    /// integrate it times smooth factors): that its degree-15 interpolant on a piece be close to
+    /// it. For every family of the jitter crate the difference is far below rounding where
+    /// the density matters (pieces narrower than a standard deviation, polynomial pieces of
+    /// degree ≤ 15 exact); the property test checks the result against fully refined rules.
+    fn filon(&self, c: f64, xa: f64, xb: f64, out: &mut [Complex64]) -> usize {
+        let np = self.poles.len();
+        let (s, w) = gl16();
+        let h = 0.5 * (xb - xa);
+        let xm = xa + h;
+        let mut f = [0.0; GL_ORDER];
+        for (fj, sj) in f.iter_mut().zip(s) {
+            *fj = self.jitter.pdf(c + (xm + h * sj));
+        }
+        out[0] += h * f.iter().zip(w).map(|(f, w)| f * w).sum::<f64>();
+        // Legendre coefficients of the interpolant.
+        let mut fk = [0.0; GL_ORDER];
+        for (fk, row) in fk.iter_mut().zip(&legendre().coef) {
+            *fk = row.iter().zip(&f).map(|(a, b)| a * b).sum();
+        }
+        let mut n = [ZERO; GL_ORDER + 1];
+        for (i, p) in self.poles.iter().enumerate() {
+            let omega = p * h;
+            // `∫ e^{px} p(τ) dx = h e^{p xa} ∫ e^{ω(s+1)} f(s) ds` with `|e^{ω(s+1)}| ≤ 1`, and
+            // the same with `x = xa + h(s+1)` for `B`.
+            let (a, m) = if omega.norm() <= 3.0 {
+                // Resolved by the nodes themselves (as in `quadrature`).
+                let mut a = ZERO;
+                let mut m = ZERO;
+                for ((sj, wj), fj) in s.iter().zip(w).zip(&f) {
+                    let e = cexp(omega * (sj + 1.0)) * (wj * fj);
+                    a += e;
+                    m += e * (sj + 1.0);
+                }
+                (a, m)
+            } else {
+                exp_legendre_moments(omega, &mut n);
+                let mut a = ZERO;
+                let mut m = ZERO;
+                for (k, &c) in fk.iter().enumerate() {
+                    a += c * n[k];
+                    // (s + 1) P_k = ((k+1) P_{k+1} + k P_{k−1})/(2k+1) + P_k.
+                    let below = if k > 0 { n[k - 1] * k as f64 } else { ZERO };
+                    m += c * ((n[k + 1] * (k + 1) as f64 + below) / (2 * k + 1) as f64 + n[k]);
+                }
+                (a, m)
+            };
+            let scale = cexp(p * xa) * h;
+            out[1 + i] += scale * a;
+            if self.with_b {
+                out[1 + np + i] += scale * (a * xa + m * h);
+            }
+        }
+        2 * GL_ORDER
     }
 
     /// Adds `T(δ) src` to `out`: the values at `c` of what lies at `c + δ` and beyond.
@@ -405,7 +561,8 @@ impl<'a> InReach<'a> {
             }
             let end = x_end.min(len);
             if end > start {
-                n += parts(rate, end - start) * GL_ORDER;
+                let k = parts(rate, end - start);
+                n += if k > FILON_PARTS { 2 } else { k } * GL_ORDER;
                 start = end;
             }
         }
@@ -453,10 +610,16 @@ impl<'a> InReach<'a> {
                     // Distance from the anchor, computed from the segment's own geometry so
                     // that it carries no rounding error of `c` (the functions vary at `|p|`).
                     let (c, delta) = match i.checked_sub(n) {
-                        None => (b - half * (1.0 - basis.nodes[i]), half * (1.0 - basis.nodes[i])),
+                        None => (
+                            b - half * (1.0 - basis.nodes[i]),
+                            half * (1.0 - basis.nodes[i]),
+                        ),
                         Some(0) => (b, 0.0),
                         Some(l) if l == n => (a, b - a),
-                        Some(l) => (b - half * (1.0 - basis.tests[l]), half * (1.0 - basis.tests[l])),
+                        Some(l) => (
+                            b - half * (1.0 - basis.tests[l]),
+                            half * (1.0 - basis.tests[l]),
+                        ),
                     };
                     v.fill(ZERO);
                     if dense {
@@ -609,6 +772,10 @@ impl Table {
     }
 }
 
+/// Largest number of Gauss–Legendre sub-intervals per knot interval in a rule of
+/// [`SquaresRule`]; beyond it the second moment is computed by expanding the square.
+const SQUARES_MAX_PARTS: usize = 32;
+
 /// Quadrature rules for `E[h(τ)]` with `h(τ) = s(t_k + τ)²` of an LTI response: `h` is analytic
 /// between the steps inside the reach (the cuts), and after each cut (and after the start of the
 /// reach, where the earlier steps' transients are seen from) it varies at twice the poles'
@@ -628,6 +795,27 @@ impl<'a> SquaresRule<'a> {
             support: Support::new(jitter),
             zones: zones(poles, 2.0),
         }
+    }
+
+    /// Whether the rules stay small: at most [`SQUARES_MAX_PARTS`] sub-intervals on any knot
+    /// interval, seen from a step at its start (the worst place).
+    pub(crate) fn affordable(&self) -> bool {
+        self.support.knots.windows(2).all(|w| {
+            let len = w[1] - w[0];
+            let mut start = 0.0;
+            let mut total = 0;
+            for &(x_end, rate) in &self.zones {
+                if start >= len {
+                    break;
+                }
+                let end = x_end.min(len);
+                if end > start {
+                    total += parts(rate, end - start);
+                    start = end;
+                }
+            }
+            total <= SQUARES_MAX_PARTS
+        })
     }
 
     /// The rule for the sorted `cuts` (in jitter time, inside the reach) into `nodes` and
@@ -651,7 +839,11 @@ impl<'a> SquaresRule<'a> {
                 while next < cuts.len() && cuts[next] <= a {
                     next += 1;
                 }
-                let origin = if next > 0 { cuts[next - 1].max(k[0]) } else { k[0] };
+                let origin = if next > 0 {
+                    cuts[next - 1].max(k[0])
+                } else {
+                    k[0]
+                };
                 let b = match cuts.get(next) {
                     Some(&c) if c < k1 => c,
                     _ => k1,
@@ -724,9 +916,9 @@ mod tests {
     fn jitter_strategy() -> impl Strategy<Value = Box<dyn JitterModel>> {
         let scale = -3.0f64..1.0; // log10 of the width parameter
         prop_oneof![
-            (0u32..=50, scale.clone())
-                .prop_map(|(n, s)| Box::new(UniformSum::new(n, 10f64.powf(s)).unwrap())
-                    as Box<dyn JitterModel>),
+            (0u32..=50, scale.clone()).prop_map(|(n, s)| Box::new(
+                UniformSum::new(n, 10f64.powf(s)).unwrap()
+            ) as Box<dyn JitterModel>),
             scale
                 .clone()
                 .prop_map(|s| Box::new(Gaussian::new(10f64.powf(s)).unwrap()) as _),
@@ -750,20 +942,18 @@ mod tests {
     /// from 0.01 to 1 (the reference rule refines at most 4096 × 6 / |p| per piece, so the
     /// modulus stays where it is exact).
     fn poles_strategy() -> impl Strategy<Value = Vec<(f64, f64)>> {
-        prop::collection::vec((-3.0f64..3.5, -2.0f64..0.0, any::<bool>()), 1..=3).prop_map(
-            |v| {
-                v.into_iter()
-                    .map(|(m, z, real)| {
-                        let (modulus, zeta) = (10f64.powf(m), 10f64.powf(z));
-                        if real {
-                            (modulus, 1.0)
-                        } else {
-                            (modulus, zeta)
-                        }
-                    })
-                    .collect()
-            },
-        )
+        prop::collection::vec((-3.0f64..3.5, -2.0f64..0.0, any::<bool>()), 1..=3).prop_map(|v| {
+            v.into_iter()
+                .map(|(m, z, real)| {
+                    let (modulus, zeta) = (10f64.powf(m), 10f64.powf(z));
+                    if real {
+                        (modulus, 1.0)
+                    } else {
+                        (modulus, zeta)
+                    }
+                })
+                .collect()
+        })
     }
 
     fn poles_for(j: &dyn JitterModel, spec: &[(f64, f64)]) -> Vec<Complex64> {
@@ -781,9 +971,9 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig {
-            cases: 1000,
+            cases: 64,
             failure_persistence: None,
-            rng_seed: proptest::test_runner::RngSeed::Fixed(12345),
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0072_6561_6368),
             ..ProptestConfig::default()
         })]
 
@@ -866,22 +1056,54 @@ mod tests {
                         got_d[f], want[f], scale[f]);
                 }
             }
-            if std::env::var("DBG_RATIO").is_ok() {
-                let mut wt = 0.0f64; let mut wd = 0.0f64;
-                for &c in &points {
-                    reference(j, &poles, c, &mut want, &mut l1);
-                    table.eval(c, &mut got_t);
-                    direct.eval(c, &mut got_d);
-                    for f in 0..nf { wt = wt.max((got_t[f]-got_d[f]).norm()/scale[f]); wd = wd.max((got_d[f]-want[f]).norm()/scale[f]); }
-                }
-                eprintln!("RATIO table {wt:.2e} direct {wd:.2e} floor {floor:.1e} segs {} {} {:?}", table.table.as_ref().unwrap().len(), j.name(), poles.iter().map(|p| (p.norm()*(hi-lo), -p.re/p.norm())).collect::<Vec<_>>());
-            }
             // The start of the reach, atoms there included, is the full expectation.
             reference(j, &poles, lo, &mut want, &mut l1);
             for f in 0..nf {
                 prop_assert!(
                     (table.at_start()[f] - want[f]).norm() <= (1e-13 + floor) * scale[f]
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn exp_legendre_moments_match_refined_quadrature() {
+        // Against Gauss–Legendre on sub-intervals of width ≤ 1/|ω| (exact to ~1e-16 there);
+        // the moduli of the integrands are at most 1, so the error bound is absolute.
+        let (s, w) = gl16();
+        for r in [3.01, 5.0, 11.0, 16.99, 17.0, 30.0, 300.0, 3000.0] {
+            for angle in [0.5, 0.55, 0.7, 0.9, 1.0] {
+                let omega = Complex64::from_polar(r, angle * PI);
+                let mut n = [ZERO; GL_ORDER + 1];
+                exp_legendre_moments(omega, &mut n);
+                let parts = (2.0 * r).ceil() as usize;
+                let h = 1.0 / parts as f64;
+                let mut want = [ZERO; GL_ORDER + 1];
+                for q in 0..parts {
+                    let mid = -1.0 + (2 * q + 1) as f64 * h;
+                    for (x, wx) in s.iter().zip(w) {
+                        let t = mid + h * x;
+                        let e = cexp(omega * (t + 1.0)) * (h * wx);
+                        let (mut p0, mut p1) = (1.0, t);
+                        for (k, m) in want.iter_mut().enumerate() {
+                            *m += e * if k == 0 { p0 } else { p1 };
+                            if k >= 1 {
+                                let p2 =
+                                    ((2 * k + 1) as f64 * t * p1 - k as f64 * p0) / (k + 1) as f64;
+                                p0 = p1;
+                                p1 = p2;
+                            }
+                        }
+                    }
+                }
+                for k in 0..=GL_ORDER {
+                    assert!(
+                        (n[k] - want[k]).norm() < 1e-14,
+                        "ω = {omega}, k = {k}: {} vs {}",
+                        n[k],
+                        want[k]
+                    );
+                }
             }
         }
     }
@@ -918,7 +1140,11 @@ mod tests {
             };
             let got: f64 = nodes.iter().zip(&weights).map(|(&t, &w)| w * h(t)).sum();
             let want = j.rule(&[c], 2.0 * p.norm()).expect(h);
-            assert!((got - want).abs() < 1e-14 * want.abs(), "{}: {got} vs {want}", j.name());
+            assert!(
+                (got - want).abs() < 1e-14 * want.abs(),
+                "{}: {got} vs {want}",
+                j.name()
+            );
         }
     }
 }
