@@ -1,5 +1,9 @@
 //! Command-line arguments (clap) and dispatch.
 
+// The doc comments here are clap's help texts, written for a terminal (`<stem>`,
+// `[estimate]`), not rustdoc markup.
+#![allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
+
 use crate::commands::{self, FitOptions, MonteCarloOptions, Shard, SimulateOptions, DEFAULT_SEED};
 use crate::error::CliResult;
 use crate::experiment::Method;

@@ -152,7 +152,7 @@ impl Rational {
 
 /// A proper, stable, continuous-time rational model with parameters `θ`.
 ///
-/// Implementors build a [`Rational`] at construction (which validates stability, properness
+/// Implementors build a `Rational` at construction (which validates stability, properness
 /// and distinct poles); everything else is provided.
 pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
     /// Names of the parameters.
