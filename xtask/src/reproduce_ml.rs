@@ -547,7 +547,20 @@ fn sine_record(record: &Record) -> Option<SineRec> {
         (Some(a), Some(b)) => Some((a.estimate.neg_log_likelihood, b.estimate.neg_log_likelihood)),
         _ => None,
     };
-    let free = match (fit(SINE_F0, start, true), fit(SINE_ALIAS, start, true)) {
+    // Each alias from its own classical start: the attenuation Â/A = γ(f) read at that
+    // frequency.
+    let start_at = |f0: f64| {
+        Gaussian::new(
+            attenuation_sigma(ls.amplitude, SINE_A, f0)
+                .unwrap_or(0.03)
+                .clamp(0.005, 0.2),
+        )
+        .ok()
+    };
+    let free = match (
+        fit(SINE_F0, start, true),
+        start_at(SINE_ALIAS).and_then(|j| fit(SINE_ALIAS, j, true)),
+    ) {
         (Some(a), Some(b)) => Some((
             a.estimate.neg_log_likelihood,
             b.estimate.neg_log_likelihood,

@@ -279,11 +279,13 @@ pub fn alias_start<J: JitterModel + ?Sized>(
 /// A maximum-likelihood sine fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SineFit {
-    /// Amplitude `Â`.
+    /// Amplitude `Â ≥ 0`.
     pub amplitude: f64,
     /// Frequency `f̂0` (Hz).
     pub frequency: f64,
-    /// Phase `φ̂` (rad).
+    /// Phase `φ̂` (rad) in `(−π, π]`. `A sin(ωt + φ)` is the same tone for `φ + 2πk` and for
+    /// `(−A, φ + π)`; the search may end on any of these, and `estimate.params` keeps the
+    /// value it ended on.
     pub phase: f64,
     /// The jitter's parameters at the estimate (estimated or known).
     pub jitter_params: Vec<f64>,
@@ -293,6 +295,18 @@ pub struct SineFit {
     pub noise_std: f64,
     /// The full estimate (names, covariance, termination).
     pub estimate: MlEstimate,
+}
+
+/// The representative of `(A, φ)` with `A ≥ 0` and `φ ∈ (−π, π]` (the same tone).
+fn canonical_amplitude_phase(amplitude: f64, phase: f64) -> (f64, f64) {
+    let (a, phi) = if amplitude < 0.0 {
+        (-amplitude, phase + PI)
+    } else {
+        (amplitude, phase)
+    };
+    // rem_euclid gives [0, 2π); shift so that π maps to π and −π to π.
+    let wrapped = PI - (PI - phi).rem_euclid(TAU);
+    (a, wrapped)
 }
 
 /// Fits `A, f0, φ`, the jitter's parameters (if `estimate_jitter`) and `σ_v` (unless
@@ -332,13 +346,40 @@ where
     let estimate = ml_estimate(&structure, record, criterion, &opts)?;
     let (model, sigma) = super::param::split(&structure, &estimate.params)?;
     let p = model.signal.params();
+    let (amplitude, phase) = canonical_amplitude_phase(p[0], p[2]);
     Ok(SineFit {
-        amplitude: p[0],
+        amplitude,
         frequency: p[1],
-        phase: p[2],
+        phase,
         jitter_params: model.jitter.params(),
         jitter_std: model.jitter.std_dev(),
         noise_std: sigma,
         estimate,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::canonical_amplitude_phase;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn amplitude_and_phase_are_canonical_and_the_same_tone() {
+        for (a, phi) in [
+            (1.0, 0.3),
+            (1.0, 0.3 + 2.0 * PI),
+            (-1.0, 0.3 - PI),
+            (2.0, -7.0),
+            (1.0, PI),
+            (1.0, -PI),
+        ] {
+            let (b, psi) = canonical_amplitude_phase(a, phi);
+            assert!(b >= 0.0 && psi > -PI && psi <= PI, "{a} {phi} -> {b} {psi}");
+            for t in [0.0, 0.37, 1.9] {
+                let x = a * (3.0 * t + phi).sin();
+                let y = b * (3.0 * t + psi).sin();
+                assert!((x - y).abs() < 1e-14, "{a} {phi}: {x} vs {y}");
+            }
+        }
+    }
 }
