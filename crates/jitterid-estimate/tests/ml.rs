@@ -413,6 +413,51 @@ fn uniform_sum_profile_finds_sigma() {
     }
 }
 
+/// The staged profile (every `n` fitted loosely, only those within [`PROFILE_MARGIN`] of the
+/// best refined) chooses the same `n` and reaches the same likelihood as refining every `n`.
+#[test]
+fn staged_profile_equals_full_refinement() {
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let full = MlOptions {
+        solver: MlSolver::Brent(Brent {
+            bracket_step: 0.01,
+            ..Brent::default()
+        }),
+        ..MlOptions::default()
+    };
+    for (r, truth) in [
+        (0u64, UniformSum::new(0, 0.5).unwrap()),
+        (1, UniformSum::new(2, 0.5).unwrap()),
+        (2, UniformSum::new(1, 0.3).unwrap()),
+        (3, UniformSum::new(5, 0.6).unwrap()),
+    ] {
+        let signal = table1_signal(70 + r, 200);
+        let mut rng = StdRng::seed_from_u64(80 + r);
+        let data = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap();
+        let record = Record::new(grid, data.y).unwrap();
+        let structure = ModelStructure::oe(signal, UniformSum::new(0, 0.45).unwrap())
+            .with_estimated(false, true, false)
+            .with_noise_std(0.01)
+            .unwrap();
+        let e = ExactMl::default();
+        let staged =
+            ml_profile_uniform_sum(&structure, &record, &e, &MlOptions::default(), 0..=9).unwrap();
+        let every = ml_profile_uniform_sum(&structure, &record, &e, &full, 0..=9).unwrap();
+        assert_eq!(
+            staged.n, every.n,
+            "record {r}: {:?} vs {:?}",
+            staged.costs, every.costs
+        );
+        // Both refined with Brent's default tolerance on ln a: the minima agree to its
+        // quadratic error, far below 1e-4 in −log L.
+        let (a, b) = (
+            staged.estimate.neg_log_likelihood,
+            every.estimate.neg_log_likelihood,
+        );
+        assert!((a - b).abs() < 1e-4, "record {r}: {a} vs {b}");
+    }
+}
+
 #[test]
 fn fisher_information_exact_equals_gaussian_without_jitter() {
     // Without jitter the samples are Gaussian, so the exact information (integrated over y)
