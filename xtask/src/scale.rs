@@ -137,8 +137,7 @@ pub fn speedup() -> Result<(), String> {
     // The study takes a tenth of a second: alternate the two pools and keep the fastest of
     // REPEATS runs of each, so that a moment of load elsewhere does not decide the ratio.
     const REPEATS: usize = 7;
-    let pools = [1, 2]
-        .map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build());
+    let pools = [1, 2].map(|threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build());
     let mut times = [f64::INFINITY; 2];
     let mut results: [Vec<_>; 2] = [Vec::new(), Vec::new()];
     for _ in 0..REPEATS {
@@ -150,7 +149,10 @@ pub fn speedup() -> Result<(), String> {
             if results[i].is_empty() {
                 results[i] = r;
             } else if results[i] != r {
-                return Err(format!("{} thread(s): estimates differ between runs", i + 1));
+                return Err(format!(
+                    "{} thread(s): estimates differ between runs",
+                    i + 1
+                ));
             }
         }
     }
