@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Cases per property (each property below runs this many inputs); `JITTERID_FUZZ_CASES`
-/// overrides it for a longer run.
+/// overrides it for a longer run, and `JITTERID_FUZZ_SEED` (an integer) draws other inputs.
 const CASES: u32 = 300;
 
 fn config() -> ProptestConfig {
@@ -16,6 +16,14 @@ fn config() -> ProptestConfig {
             .and_then(|s| s.parse().ok())
             .unwrap_or(CASES),
         failure_persistence: None,
+        // Fixed by default so that CI runs the same inputs every time; JITTERID_FUZZ_SEED picks
+        // other inputs for a long run.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(
+            std::env::var("JITTERID_FUZZ_SEED")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(0x636c_69),
+        ),
         ..ProptestConfig::default()
     }
 }

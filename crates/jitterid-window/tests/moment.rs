@@ -387,7 +387,13 @@ fn routes_agree_on_the_table_2_case() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(8))]
+    // Fixed seed and no persistence: the same cases on every run (CI must not depend on luck).
+    #![proptest_config(ProptestConfig {
+        cases: 8,
+        failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x6d6f6d65),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn routes_agree_on_random_pulses(
