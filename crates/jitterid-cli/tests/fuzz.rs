@@ -22,7 +22,7 @@ fn config() -> ProptestConfig {
             std::env::var("JITTERID_FUZZ_SEED")
                 .ok()
                 .and_then(|s| s.parse().ok())
-                .unwrap_or(0x636c_69),
+                .unwrap_or(0x0063_6c69),
         ),
         ..ProptestConfig::default()
     }
