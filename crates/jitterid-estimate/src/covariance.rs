@@ -118,13 +118,16 @@ where
     (finite.then_some(out), noise_var.sqrt())
 }
 
-/// Largest 1-norm condition number of `JᵀJ` scaled to unit diagonal that counts as invertible:
+/// Largest 1-norm condition number of a symmetric positive definite matrix (`JᵀJ` here, the
+/// likelihood's Hessian or Fisher matrix in `ml`) scaled to unit diagonal that counts as
+/// invertible:
 /// beyond it the inverse has fewer than about four correct digits, and a parameter combination
 /// that the data do not determine (an exactly singular `JᵀJ` perturbed by rounding) would
 /// otherwise get a small, meaningless standard error.
 const MAX_CONDITION: f64 = 1e12;
 
-/// `(JᵀJ)⁻¹` through the unit-diagonal scaling `D^{-1/2} JᵀJ D^{-1/2}` (which removes the
+/// `H⁻¹` for a symmetric positive definite `H` (here `JᵀJ`), through the unit-diagonal scaling
+/// `D^{-1/2} H D^{-1/2}` (which removes the
 /// parameters' units from the conditioning), or `None` if it is singular, not finite or worse
 /// conditioned than [`MAX_CONDITION`].
 pub(crate) fn inverse_gram(h: &Mat<f64>) -> Option<Mat<f64>> {

@@ -9,13 +9,13 @@ use super::objective::{LikelihoodObjective, Objective, TransformedObjective};
 use super::optim::{Brent, MlSolver};
 use super::param::{default_transforms, likelihood_param_names, likelihood_params, Layout};
 use super::MlError;
+use crate::covariance::inverse_gram;
 use crate::data::Record;
 use crate::noise::NoiseModel;
 use crate::solver::{Termination, Transform};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
-use faer::linalg::solvers::DenseSolveCore;
-use faer::{Mat, Side};
+use faer::Mat;
 use jitterid_jitter::{JitterModel, UniformSum};
 use jitterid_signal::Signal;
 use rayon::prelude::*;
@@ -143,12 +143,12 @@ pub(crate) fn hessian<O: Objective + ?Sized>(objective: &O, theta: &[f64]) -> Op
     Some(sym)
 }
 
-/// The inverse of a symmetric matrix by Cholesky, if it is positive definite and the result
-/// finite.
+/// The inverse of a symmetric matrix (a Hessian or a Fisher matrix), if it is positive
+/// definite, well enough conditioned to invert ([`inverse_gram`]) and the result finite with
+/// a positive diagonal.
 pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
     let p = m.nrows();
-    let llt = m.llt(Side::Lower).ok()?;
-    let inv = llt.inverse();
+    let inv = inverse_gram(m)?;
     let out: Vec<Vec<f64>> = (0..p)
         .map(|i| (0..p).map(|j| inv[(i, j)]).collect())
         .collect();
