@@ -22,7 +22,8 @@ use crate::Options;
 use jitterid::estimate::montecarlo::run as mc_run;
 use jitterid::estimate::solver::{LevenbergMarquardt, MultiStart, Solver};
 use jitterid::estimate::{
-    estimate, initialize, Bcls, EstimateOptions, Frequencies, InitOptions, ModelStructure, Record,
+    estimate, initialize, residual_flatness, Bcls, EstimateOptions, Frequencies, InitOptions,
+    ModelStructure, Record, FLATNESS_BANDS, FLATNESS_LIMIT,
 };
 use jitterid::prelude::*;
 use jitterid::window::DirichletWindow;
@@ -60,33 +61,9 @@ struct Outcome {
     cost: f64,
     params: Vec<f64>,
     termination: String,
-    /// Residual-flatness ratio, see [`flatness`].
+    /// The library's residual-flatness ratio ([`residual_flatness`]), computed for every fit
+    /// (the estimate itself only checks converged BCLS fits that are not exact).
     flatness: f64,
-}
-
-/// Bins `1..=LOW_BINS` form the low band of the residual-flatness diagnostic.
-const LOW_BINS: usize = 25;
-/// A residual-flatness ratio above this flags a fit as not at the global minimum.
-const FLATNESS_LIMIT: f64 = 3.0;
-
-/// Residual-flatness diagnostic: the mean `|Y − μ_Y|²` over the low band (bins `1..=LOW_BINS`,
-/// where the input has its power) over the mean of the bins above it (without Nyquist). The
-/// data's noise floor is flat (`Var Y(f) = Σ λ_k` at every `f`, `conventions.md`), so at the
-/// global minimum the ratio is an F-like statistic near 1 (`F(50, 148)` if the bins were
-/// independent: above 3 with probability about 1e-7); a model stuck elsewhere leaves its misfit
-/// where the input excites it, at low frequencies.
-fn flatness(residuals: &[f64]) -> f64 {
-    let power: Vec<f64> = residuals
-        .chunks(2)
-        .map(|c| c[0] * c[0] + c.get(1).map_or(0.0, |x| x * x))
-        .collect();
-    let bins = power.len();
-    if bins < LOW_BINS + 3 {
-        return f64::NAN;
-    }
-    let low = power[1..=LOW_BINS].iter().sum::<f64>() / LOW_BINS as f64;
-    let high = &power[LOW_BINS + 1..bins - 1];
-    low / (high.iter().sum::<f64>() / high.len() as f64)
 }
 
 impl Outcome {
@@ -114,7 +91,7 @@ fn fit<V: Solver>(structure: &Structure, record: &Record, solver: V) -> Outcome 
         Ok(e) => Outcome {
             converged: e.converged,
             cost: e.cost,
-            flatness: flatness(&e.residuals),
+            flatness: residual_flatness(&e.residuals).unwrap_or(f64::NAN),
             params: e.params,
             termination: e.termination.to_string(),
         },
@@ -310,8 +287,8 @@ pub fn starts(o: &Options) -> Result<(), String> {
         .count();
     let _ = writeln!(
         md,
-        "\nResidual-flatness diagnostic (mean |Y − μ_Y|² over bins 1–{LOW_BINS} over that of the bins \
-         above; the noise floor is flat, so ≈ 1 at the global minimum): largest {max_global:.2} over \
+        "\nResidual flatness (`residual_flatness`: the largest mean |Y − μ_Y|² of {FLATNESS_BANDS} bands \
+         over the mean of the others; the noise floor is flat, so ≈ 1 at the global minimum): largest {max_global:.2} over \
          the {} fits at the global minimum ({flagged_global} above {FLATNESS_LIMIT}); {} of the {} \
          fits that converged elsewhere are above {FLATNESS_LIMIT} (values {}).",
         flat_global.len(),
