@@ -53,48 +53,4 @@ pub enum JitterError {
     },
 }
 
-/// Checks that `value` is finite; the error names the parameter.
-pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(JitterError::NotFinite { name, value })
-    }
-}
-
-/// Checks that `value` is finite and strictly positive.
-pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if finite(name, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(JitterError::NotPositive { name, value })
-    }
-}
-
-/// Checks that `value` is finite and not negative.
-// No built-in family has a parameter that may be 0; kept for the next one that does.
-#[allow(dead_code)]
-pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if finite(name, value)? >= 0.0 {
-        Ok(value)
-    } else {
-        Err(JitterError::Negative { name, value })
-    }
-}
-
-/// Checks the length of a parameter vector given to `with_params`.
-pub(crate) fn param_count(
-    model: &'static str,
-    expected: usize,
-    params: &[f64],
-) -> Result<(), JitterError> {
-    if params.len() == expected {
-        Ok(())
-    } else {
-        Err(JitterError::WrongParamCount {
-            model,
-            expected,
-            got: params.len(),
-        })
-    }
-}
+pub(crate) use crate::kernels::validate::{finite, param_count, positive};

@@ -38,6 +38,7 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod kernels;
 mod model;
 pub mod rule;
 pub mod testing;

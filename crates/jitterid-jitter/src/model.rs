@@ -1,3 +1,4 @@
+pub(crate) use crate::kernels::complex::{cexp, phasor};
 use crate::rule::{build_rule, build_rule_from, QuadratureRule};
 use crate::JitterError;
 use num_complex::Complex64;
@@ -120,30 +121,4 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
 /// Draws `n` jitter values.
 pub fn sample_n<J: JitterModel + ?Sized>(jitter: &J, n: usize, rng: &mut dyn RngCore) -> Vec<f64> {
     (0..n).map(|_| jitter.sample(rng)).collect()
-}
-
-/// `e^{-i2πx}`, with `x` reduced modulo 1 first so that large `x` keeps the phase accuracy of
-/// `x` itself. A double with `|x| ≥ 2^52` is an integer (or infinite), so its phase is 0: the
-/// result is then 1 instead of a NaN from `sin(∞)`.
-pub(crate) fn phasor(x: f64) -> Complex64 {
-    // Exact: x - round(x) is a multiple of ulp(x) no larger than 1/2.
-    let r = if x.abs() < 4_503_599_627_370_496.0 {
-        x - x.round()
-    } else if x.is_nan() {
-        x
-    } else {
-        0.0
-    };
-    let (s, c) = (2.0 * std::f64::consts::PI * r).sin_cos();
-    Complex64::new(c, -s)
-}
-
-/// Complex exponential that returns an exactly real result for a real argument, so that an
-/// overflow gives `+∞` rather than `∞ · sin(0) = NaN` in the imaginary part.
-pub(crate) fn cexp(w: Complex64) -> Complex64 {
-    if w.im == 0.0 {
-        Complex64::new(w.re.exp(), 0.0)
-    } else {
-        w.exp()
-    }
 }
