@@ -32,7 +32,7 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
     fn name(&self) -> &'static str;
 
     /// Names of the continuous parameters `θ`, in the order of [`params`](Self::params).
-    fn param_names(&self) -> Vec<&'static str>;
+    fn param_names(&self) -> Vec<String>;
 
     /// The current continuous parameters `θ`.
     fn params(&self) -> Vec<f64>;
@@ -46,9 +46,9 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
     /// Characteristic function `γ(f) = E[e^{-i2πfτ}]`.
     fn cf(&self, f: f64) -> Complex64;
 
-    /// `∂γ(f)/∂θ_j` for every parameter, written into `grad` (length
+    /// `∂γ(f)/∂θ_j` for every parameter, in the order of [`params`](Self::params) (length
     /// [`num_params`](Self::num_params)).
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]);
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64>;
 
     /// Moment-generating function `M(z) = E[e^{zτ}]` at a complex `z`, or `None` where the
     /// expectation diverges.
