@@ -67,6 +67,8 @@ pub use model::{sample_n, Atom, JitterModel, TAIL_MASS};
 pub use num_complex;
 pub use periodic::Periodic;
 pub use rule::QuadratureRule;
+/// Re-exported: spec tables ([`registry::Spec`]) are `serde_json` maps.
+pub use serde_json;
 pub use shifted::Shifted;
 pub use sum::Sum;
 pub use two_point::TwoPoint;
