@@ -152,7 +152,7 @@ fn mixture() -> Family {
                 "",
                 "true or false",
             )
-            .with_default(0.0),
+            .boolean(false),
         ],
         |r, registry| {
             let terms = r.terms(registry, 2)?;
@@ -185,7 +185,7 @@ pub(super) fn registry() -> JitterRegistry {
         ),
         one_scale(
             "laplace",
-            "zero-mean Laplace (double exponential), density e^{-|τ|/b}/(2b)",
+            "zero-mean Laplace (double exponential) of scale b",
             "scale",
             "scale b (standard deviation b√2)",
             Laplace::new,

@@ -213,3 +213,24 @@ fn errors_inside_a_term_name_the_term() {
         Err(JitterError::NoStdDevForm { .. })
     ));
 }
+
+#[test]
+fn the_docs_table_of_families_is_the_registry_s() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
+    let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
+    let header = "| family | key | unit | accepts | default | meaning |";
+    let start = text
+        .find(header)
+        .expect("docs/experiments.md has the table of jitter families");
+    let table: String = text[start..]
+        .lines()
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let expected = JitterRegistry::builtin().markdown_table();
+    assert!(
+        table == expected,
+        "the [jitter] families table of docs/experiments.md differs from the registry; \
+         replace it with:\n\n{expected}"
+    );
+}
