@@ -82,7 +82,9 @@ pub fn check_contract<J: JitterModel + Clone>(model: &J, seed: u64) -> Result<()
 /// * pieces are sorted, non-empty and disjoint; atoms have masses in `(0, 1]`; the density is
 ///   finite and non-negative;
 /// * the rule `model.rule(&[], 0.0)` has mass 1, mean `mean()` and variance `variance()`
-///   within `1e-12` (relative to the spread), also when cut at extra breakpoints;
+///   within `1e-12` (relative to the spread), also when cut at extra breakpoints, and so has
+///   the rule built from `pdf`, `pieces` and `atoms` alone (which a family that overrides
+///   `rule` must keep consistent: other crates integrate the density directly);
 /// * the rule at rate `2π|f|` reproduces `γ(f)` within `1e-10` for `2πfs` up to 30: this is
 ///   the check that the pieces are fine enough;
 /// * `cf_gradient` has one entry per parameter and matches central differences of `cf`
@@ -327,34 +329,44 @@ fn check_rule<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<String
     let var_tol = EXACT_TOL * (var + mean.abs() * sd);
     let (lo, hi) = model.reach();
     let breaks_sets: [Vec<f64>; 2] = [Vec::new(), vec![mean, lo + 0.3 * (hi - lo), hi + 1.0]];
-    for breaks in &breaks_sets {
-        let rule = model.rule(breaks, 0.0);
+    // The family's own rule, and the rule built from its density, pieces and atoms alone (the
+    // route of callers that integrate the density themselves): a family that overrides `rule`
+    // must keep the two consistent.
+    let rules = breaks_sets
+        .iter()
+        .map(|b| (b, "rule", model.rule(b, 0.0)))
+        .chain(
+            breaks_sets
+                .iter()
+                .map(|b| (b, "density rule", crate::rule::build_rule(model, b, 0.0))),
+        );
+    for (breaks, which, rule) in rules {
         let bad =
             rule.nodes.iter().zip(&rule.weights).any(|(&t, &w)| {
                 !(t.is_finite() && t >= lo && t <= hi && w >= 0.0 && w.is_finite())
             });
         if bad {
             fails.push(format!(
-                "rule(breaks = {breaks:?}) has a node outside [{lo}, {hi}] or a negative weight"
+                "{which}(breaks = {breaks:?}) has a node outside [{lo}, {hi}] or a negative weight"
             ));
         }
         // Mass of the density over the pieces plus the atoms.
         let mass = rule.mass();
         if (mass - 1.0).abs() > EXACT_TOL {
             fails.push(format!(
-                "continuous mass plus atoms = {mass} (breaks {breaks:?}), not 1"
+                "{which}: continuous mass plus atoms = {mass} (breaks {breaks:?}), not 1"
             ));
         }
         let m = rule.expect(|t| t);
         if (m - mean).abs() > mean_tol {
             fails.push(format!(
-                "rule mean {m} but mean() = {mean} (breaks {breaks:?})"
+                "{which} mean {m} but mean() = {mean} (breaks {breaks:?})"
             ));
         }
         let v = rule.expect(|t| (t - mean) * (t - mean));
         if (v - var).abs() > var_tol {
             fails.push(format!(
-                "rule variance {v} but variance() = {var} (breaks {breaks:?})"
+                "{which} variance {v} but variance() = {var} (breaks {breaks:?})"
             ));
         }
     }
