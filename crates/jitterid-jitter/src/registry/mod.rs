@@ -146,7 +146,9 @@ impl JitterRegistry {
     }
 
     /// Builds the model a spec table describes: `"family"`, the family's keys, and optionally
-    /// `"offset"`. Every key is checked; an error names the key.
+    /// `"offset"`. Every key is checked, and a key the family does not take is an error, so a
+    /// front end removes its own keys (such as an experiment file's `estimate`) first; an
+    /// error names the key.
     pub fn build(&self, spec: &Spec) -> Result<AnyJitter, JitterError> {
         let name = family_name(spec)?;
         let family = self.lookup(name)?;
@@ -157,7 +159,8 @@ impl JitterRegistry {
 
     /// The member of family `name` with standard deviation `sigma` (s); `spec` holds the
     /// family's structural keys (such as the uniform sum's integer `n`) and optionally
-    /// `"offset"`, but not the keys `sigma` determines. The family `"none"` ignores `sigma`.
+    /// `"offset"`, but not the keys `sigma` determines. The family `"none"` ignores `sigma`
+    /// (which may then be 0).
     pub fn from_std_dev(
         &self,
         name: &str,
@@ -165,7 +168,10 @@ impl JitterRegistry {
         spec: &Spec,
     ) -> Result<AnyJitter, JitterError> {
         let family = self.lookup(name)?;
-        crate::kernels::validate::positive("sigma", sigma)?;
+        // A family without keys (`none`) has no spread to set: any σ, even 0, gives it.
+        if !family.params().is_empty() || family.takes_terms() {
+            crate::kernels::validate::positive("sigma", sigma)?;
+        }
         let reader = SpecReader::new(family, spec)?;
         let model = family.std_dev_member(sigma, &reader, self)?;
         shift(model, &reader)
