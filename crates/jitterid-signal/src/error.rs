@@ -102,6 +102,12 @@ pub enum SignalError {
         /// How many were given.
         got: usize,
     },
+    /// A denominator that must be monic (leading coefficient 1) was not.
+    #[error("the denominator must be monic (leading coefficient 1), got {lead}")]
+    NotMonic {
+        /// The leading coefficient given.
+        lead: f64,
+    },
     /// The roots of a polynomial could not be found to the required accuracy.
     #[error("could not find the roots of `{name}`")]
     Roots {

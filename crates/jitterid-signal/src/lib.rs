@@ -39,13 +39,16 @@ mod reach;
 mod signal;
 mod simulate;
 mod sinusoid;
+mod spectrum;
+pub mod testing;
 
 pub use error::SignalError;
 pub use grid::SampleGrid;
 pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone};
-pub use lti::LtiResponse;
+pub use lti::{LtiResponse, ModalState};
 pub use pulse::PulseResponse;
 pub use rational::{Modal, RationalModel, Root, TransferFunction, Zpk};
-pub use signal::{local_breaks, Jacobian, Signal, SpectralLine};
+pub use signal::{local_breaks, Jacobian, Signal};
 pub use simulate::{simulate, Simulation};
 pub use sinusoid::Sinusoid;
+pub use spectrum::{SpectralLine, Spectrum};

@@ -7,7 +7,7 @@ use crate::dtft::CompensatedSum;
 use crate::phase::{cis_cycles, frac_prod};
 use crate::{FrequencySet, Window, WindowError};
 use jitterid_jitter::JitterModel;
-use jitterid_signal::{SampleGrid, Signal};
+use jitterid_signal::{SampleGrid, Spectrum};
 use num_complex::Complex64;
 
 /// Aliases per side summed before the first tail estimate.
@@ -110,7 +110,7 @@ struct Folded<'a, S: ?Sized> {
     max_neg: Vec<f64>,
 }
 
-impl<S: Signal + ?Sized> Folded<'_, S> {
+impl<S: Spectrum + ?Sized> Folded<'_, S> {
     /// `G(ψ) = S_c(ψ) γ(-ψ) e^{i2πψ t0}`.
     fn integrand(&self, psi: f64) -> Complex64 {
         self.signal.density(psi) * self.jitter.cf(-psi) * cis_cycles(frac_prod(psi, self.t0))
@@ -242,7 +242,7 @@ struct Evaluation {
     rounding: Vec<f64>,
 }
 
-fn evaluate<S: Signal + ?Sized, W: Window + ?Sized>(
+fn evaluate<S: Spectrum + ?Sized, W: Window + ?Sized>(
     folded: &Folded<'_, S>,
     grid: &SampleGrid,
     window: &W,
@@ -289,7 +289,7 @@ fn evaluate<S: Signal + ?Sized, W: Window + ?Sized>(
 /// `∫ S_c(ψ) γ(-ψ) e^{i2πψ t0} K(f-ψ) dψ + Σ_l c_l γ(-f_l) e^{i2πf_l t0} K(f-f_l)`, with an error
 /// bound per frequency.
 ///
-/// Uses only the signal's [`density`](Signal::density) and [`lines`](Signal::lines), the
+/// Uses only the signal's [`density`](Spectrum::density) and [`lines`](Spectrum::lines), the
 /// jitter's [`cf`](JitterModel::cf) and the window's [`kernel`](Window::kernel). The infinite
 /// range is folded onto one period `1/T` by summing aliases, cut where an extrapolated tail
 /// estimate meets a quarter of the target; the folded periodic integrand is integrated by the
@@ -312,7 +312,7 @@ pub fn first_moment_integral<S, W>(
     options: &IntegralOptions,
 ) -> Result<IntegralMoment, WindowError>
 where
-    S: Signal + ?Sized,
+    S: Spectrum + ?Sized,
     W: Window + ?Sized,
 {
     options.validate()?;
