@@ -37,8 +37,11 @@
 //! windows and estimators take any `JitterModel`. See `docs/extending.md`.
 #![warn(missing_docs)]
 
+mod any;
 mod error;
+pub mod kernels;
 mod model;
+pub mod registry;
 pub mod rule;
 pub mod testing;
 
@@ -46,19 +49,26 @@ mod dirac;
 mod exponential;
 mod gaussian;
 mod laplace;
+mod mixture;
+mod periodic;
 mod shifted;
+mod sum;
 mod two_point;
 mod uniform_sum;
 
+pub use any::AnyJitter;
 pub use dirac::NoJitter;
 pub use error::JitterError;
 pub use exponential::ExponentialDelay;
 pub use gaussian::Gaussian;
 pub use laplace::Laplace;
+pub use mixture::Mixture;
 pub use model::{sample_n, Atom, JitterModel, TAIL_MASS};
 pub use num_complex;
+pub use periodic::Periodic;
 pub use rule::QuadratureRule;
 pub use shifted::Shifted;
+pub use sum::Sum;
 pub use two_point::TwoPoint;
 pub use uniform_sum::UniformSum;
 
