@@ -208,6 +208,9 @@ impl Multisine {
     }
 }
 
+/// The largest expected number of switches of one [`RandomBinary::generate`] call.
+pub const MAX_SWITCHES: f64 = 1e8;
+
 /// The random binary input of the paper's section 4: it switches between `low` and `high` after
 /// exponentially distributed dwell times of mean `mean_dwell`, at any time (not on the sample
 /// grid).
@@ -249,7 +252,8 @@ impl RandomBinary {
     }
 
     /// One realisation on `[start, end)`: the first level is `low` or `high` with equal
-    /// probability, then levels alternate. Needs `end > start`.
+    /// probability, then levels alternate. Needs `end > start` and at most [`MAX_SWITCHES`]
+    /// expected switches (`(end − start)/mean_dwell`).
     pub fn generate(
         &self,
         start: f64,
@@ -266,7 +270,15 @@ impl RandomBinary {
                 previous: start,
             });
         }
-        // `mean_dwell` is validated positive, but a subnormal one overflows the rate.
+        // About `(end − start)/mean_dwell` switches: refuse a span that would hold more than an
+        // input can usefully have (and a subnormal dwell, whose rate overflows).
+        let expected = (end - start) / self.mean_dwell;
+        if !(expected <= MAX_SWITCHES) {
+            return Err(SignalError::TooManySwitches {
+                expected,
+                max: MAX_SWITCHES,
+            });
+        }
         let dwell = Exp::new(1.0 / self.mean_dwell).map_err(|_| SignalError::NotFinite {
             name: "1/mean_dwell",
             value: 1.0 / self.mean_dwell,

@@ -22,7 +22,11 @@ const KERNEL_NORM_MARGIN: f64 = 1.1;
 const MIN_DECAY: f64 = 1.25;
 
 /// Accuracy target and limits of [`first_moment_integral`].
+///
+/// Deserializes through the same validation as [`first_moment_integral`] applies, so options
+/// read from a file are valid.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "OptionFields")]
 pub struct IntegralOptions {
     /// Relative target, relative to `max_f |μ_Y(f)|` over the requested set. Default `1e-10`.
     /// Finite and `≥ 0`; `rel_tol` and `abs_tol` must not both be zero.
@@ -68,6 +72,28 @@ impl IntegralOptions {
             });
         }
         Ok(())
+    }
+}
+
+/// The serialized form of [`IntegralOptions`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct OptionFields {
+    rel_tol: f64,
+    abs_tol: f64,
+    max_aliases: usize,
+    max_refinements: usize,
+}
+
+impl TryFrom<OptionFields> for IntegralOptions {
+    type Error = WindowError;
+    fn try_from(o: OptionFields) -> Result<Self, WindowError> {
+        let options = IntegralOptions {
+            rel_tol: o.rel_tol,
+            abs_tol: o.abs_tol,
+            max_aliases: o.max_aliases,
+            max_refinements: o.max_refinements,
+        };
+        options.validate().map(|()| options)
     }
 }
 
