@@ -61,8 +61,8 @@ const REFERENCE_TOL: f64 = 1e-14;
 /// Deepest bisection of a jitter piece: `2^-60` of its width is below the resolution of `f64`.
 const REFERENCE_DEPTH: u32 = 60;
 
-/// Instants checked by Monte Carlo (the first ones of the grid) and draws per instant.
-const MC_INSTANTS: usize = 8;
+/// Instants checked by Monte Carlo: the first ones of the grid.
+pub const MC_INSTANTS: usize = 8;
 /// Draws per instant of the Monte Carlo check.
 pub const MC_DRAWS: usize = 4_000;
 /// Width of the Monte Carlo acceptance band, in standard errors: a correct signal lands outside
