@@ -3,27 +3,18 @@
 use jitterid::jitter::{
     ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
 };
-use jitterid::signal::{LtiResponse, PiecewiseConstant, RandomBinary, Root, Zpk};
+use jitterid::signal::{testing, LtiResponse, PiecewiseConstant, Root, Zpk};
 use proptest::prelude::*;
-use rand::SeedableRng;
 use std::sync::Arc;
 
-/// The paper's eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)`.
+/// The paper's eq. (17) system `k0 (s + z) / ((s − pr)² + pi²)` (valid arguments only).
 pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Zpk {
-    Zpk::new(
-        k0,
-        vec![Root::Real(-z)],
-        vec![Root::Pair { re: pr, im: pi }],
-    )
-    .expect("valid")
+    testing::eq17(k0, z, pr, pi).expect("valid")
 }
 
-/// A random binary input on `[start, end)` from a seed.
+/// A random binary input on `[start, end)` from a seed (valid arguments only).
 pub fn binary(seed: u64, dwell: f64, start: f64, end: f64) -> PiecewiseConstant {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    RandomBinary::new(dwell, 0.0, 1.0)
-        .and_then(|b| b.generate(start, end, &mut rng))
-        .expect("valid")
+    testing::binary(seed, dwell, start, end).expect("valid")
 }
 
 /// A stable zero–pole–gain model with distinct poles.

@@ -14,7 +14,7 @@ use jitterid::jitter::{
 use jitterid::num_complex::Complex64;
 use jitterid::rand::RngCore;
 use jitterid::signal::{
-    Jacobian, LtiResponse, SampleGrid, Signal, SignalError, Sinusoid, SpectralLine,
+    Jacobian, LtiResponse, SampleGrid, Signal, SignalError, Sinusoid, SpectralLine, Spectrum,
     TransferFunction, Zpk,
 };
 
@@ -59,18 +59,6 @@ impl Signal for AnySignal {
     fn value_gradient(&self, t: f64, grad: &mut [f64]) {
         each_signal!(self, s => s.value_gradient(t, grad))
     }
-    fn density(&self, f: f64) -> Complex64 {
-        each_signal!(self, s => s.density(f))
-    }
-    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
-        each_signal!(self, s => s.density_gradient(f, grad))
-    }
-    fn lines(&self) -> Vec<SpectralLine> {
-        each_signal!(self, s => s.lines())
-    }
-    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
-        each_signal!(self, s => s.lines_gradient())
-    }
     fn breakpoints(&self) -> Vec<f64> {
         each_signal!(self, s => s.breakpoints())
     }
@@ -88,6 +76,21 @@ impl Signal for AnySignal {
     }
     fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
         each_signal!(self, s => s.expected_squares(grid, jitter))
+    }
+}
+
+impl Spectrum for AnySignal {
+    fn density(&self, f: f64) -> Complex64 {
+        each_signal!(self, s => s.density(f))
+    }
+    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        each_signal!(self, s => s.density_gradient(f, grad))
+    }
+    fn lines(&self) -> Vec<SpectralLine> {
+        each_signal!(self, s => s.lines())
+    }
+    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
+        each_signal!(self, s => s.lines_gradient())
     }
 }
 

@@ -102,12 +102,87 @@ pub enum SignalError {
         /// How many were given.
         got: usize,
     },
+    /// A denominator that must be monic (leading coefficient 1) was not.
+    #[error("the denominator must be monic (leading coefficient 1), got {lead}")]
+    NotMonic {
+        /// The leading coefficient given.
+        lead: f64,
+    },
+    /// A random input would switch more often than an input can usefully hold.
+    #[error("the input would switch about {expected:e} times (at most {max:e}): the span is too long for the mean dwell")]
+    TooManySwitches {
+        /// The expected number of switches.
+        expected: f64,
+        /// The largest allowed.
+        max: f64,
+    },
+    /// A spec table names no registered kind.
+    #[error("unknown signal kind `{kind}` (known: {known})")]
+    UnknownKind {
+        /// The name given.
+        kind: String,
+        /// The registered names, written for a reader.
+        known: String,
+    },
+    /// A spec table lacks a key that the kind needs.
+    #[error("signal kind `{kind}` needs the key `{key}`")]
+    MissingKey {
+        /// The kind (empty when the kind itself is missing).
+        kind: String,
+        /// The missing key.
+        key: String,
+    },
+    /// A spec table holds a key that the kind does not take.
+    #[error("signal kind `{kind}` does not take the key `{key}` (it takes: {known})")]
+    UnexpectedKey {
+        /// The kind.
+        kind: String,
+        /// The unexpected key.
+        key: String,
+        /// The keys the kind takes.
+        known: String,
+    },
+    /// A key's value is not acceptable.
+    #[error("`{key}` of signal kind `{kind}`: {message}")]
+    InvalidKey {
+        /// The kind.
+        kind: String,
+        /// The offending key.
+        key: String,
+        /// What is wrong, for a reader.
+        message: String,
+    },
+    /// A kind driven by an input was built without one.
+    #[error("signal kind `{kind}` is driven by an input, but none was given")]
+    MissingInput {
+        /// The kind.
+        kind: String,
+    },
+    /// A kind was registered twice.
+    #[error("signal kind `{kind}` is already registered")]
+    DuplicateKind {
+        /// The kind.
+        kind: String,
+    },
     /// The roots of a polynomial could not be found to the required accuracy.
     #[error("could not find the roots of `{name}`")]
     Roots {
         /// Which polynomial.
         name: &'static str,
     },
+}
+
+impl SignalError {
+    /// The spec-table key this error is about, for front ends that point at it.
+    pub fn key(&self) -> Option<&str> {
+        match self {
+            SignalError::MissingKey { key, .. }
+            | SignalError::UnexpectedKey { key, .. }
+            | SignalError::InvalidKey { key, .. } => Some(key),
+            SignalError::UnknownKind { .. } | SignalError::MissingInput { .. } => Some("kind"),
+            _ => None,
+        }
+    }
 }
 
 pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SignalError> {

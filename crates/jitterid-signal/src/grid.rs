@@ -1,7 +1,10 @@
 use crate::error::{finite, positive, SignalError};
 
 /// The requested sampling instants `t_k = t0 + kT`, `k = 0..N-1`.
+///
+/// Deserializes through [`SampleGrid::new`], so a grid read from a file is valid too.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "GridFields")]
 pub struct SampleGrid {
     start: f64,
     interval: f64,
@@ -61,5 +64,20 @@ impl SampleGrid {
     /// Duration `N·T` of the record.
     pub fn duration(&self) -> f64 {
         self.len as f64 * self.interval
+    }
+}
+
+/// The serialized form of a [`SampleGrid`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct GridFields {
+    start: f64,
+    interval: f64,
+    len: usize,
+}
+
+impl TryFrom<GridFields> for SampleGrid {
+    type Error = SignalError;
+    fn try_from(g: GridFields) -> Result<Self, SignalError> {
+        Self::new(g.start, g.interval, g.len)
     }
 }

@@ -42,7 +42,10 @@ impl From<Multisine> for Input {
 /// Zero outside a finite span keeps `S_c` a density: `U(f)` is entire. Put the first edge
 /// before the record (a warm-up) and the last one after it to model an input that is on for the
 /// whole record.
+///
+/// Deserializes through [`PiecewiseConstant::new`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "PiecewiseFields")]
 pub struct PiecewiseConstant {
     edges: Vec<f64>,
     levels: Vec<f64>,
@@ -150,7 +153,10 @@ pub struct Tone {
 
 /// A sum of tones `u(t) = Σ A_l sin(2πf_l t + φ_l)`, on for all time (the response is the
 /// steady state).
+///
+/// Deserializes through [`Multisine::new`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "MultisineFields")]
 pub struct Multisine {
     tones: Vec<Tone>,
 }
@@ -202,10 +208,16 @@ impl Multisine {
     }
 }
 
+/// The largest expected number of switches of one [`RandomBinary::generate`] call.
+pub const MAX_SWITCHES: f64 = 1e8;
+
 /// The random binary input of the paper's section 4: it switches between `low` and `high` after
 /// exponentially distributed dwell times of mean `mean_dwell`, at any time (not on the sample
 /// grid).
+///
+/// Deserializes through [`RandomBinary::new`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "RandomBinaryFields")]
 pub struct RandomBinary {
     mean_dwell: f64,
     low: f64,
@@ -240,7 +252,8 @@ impl RandomBinary {
     }
 
     /// One realisation on `[start, end)`: the first level is `low` or `high` with equal
-    /// probability, then levels alternate. Needs `end > start`.
+    /// probability, then levels alternate. Needs `end > start` and at most [`MAX_SWITCHES`]
+    /// expected switches (`(end − start)/mean_dwell`).
     pub fn generate(
         &self,
         start: f64,
@@ -257,7 +270,19 @@ impl RandomBinary {
                 previous: start,
             });
         }
-        let dwell = Exp::new(1.0 / self.mean_dwell).expect("rate validated positive");
+        // About `(end − start)/mean_dwell` switches: refuse a span that would hold more than an
+        // input can usefully have (and a subnormal dwell, whose rate overflows).
+        let expected = (end - start) / self.mean_dwell;
+        if !(expected <= MAX_SWITCHES) {
+            return Err(SignalError::TooManySwitches {
+                expected,
+                max: MAX_SWITCHES,
+            });
+        }
+        let dwell = Exp::new(1.0 / self.mean_dwell).map_err(|_| SignalError::NotFinite {
+            name: "1/mean_dwell",
+            value: 1.0 / self.mean_dwell,
+        })?;
         let mut high = rng.random::<bool>();
         let mut edges = vec![start];
         let mut levels = Vec::new();
@@ -279,5 +304,47 @@ impl RandomBinary {
             }
         }
         PiecewiseConstant::new(edges, levels)
+    }
+}
+
+/// The serialized form of a [`PiecewiseConstant`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct PiecewiseFields {
+    edges: Vec<f64>,
+    levels: Vec<f64>,
+}
+
+impl TryFrom<PiecewiseFields> for PiecewiseConstant {
+    type Error = SignalError;
+    fn try_from(p: PiecewiseFields) -> Result<Self, SignalError> {
+        Self::new(p.edges, p.levels)
+    }
+}
+
+/// The serialized form of a [`Multisine`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct MultisineFields {
+    tones: Vec<Tone>,
+}
+
+impl TryFrom<MultisineFields> for Multisine {
+    type Error = SignalError;
+    fn try_from(m: MultisineFields) -> Result<Self, SignalError> {
+        Self::new(m.tones)
+    }
+}
+
+/// The serialized form of a [`RandomBinary`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct RandomBinaryFields {
+    mean_dwell: f64,
+    low: f64,
+    high: f64,
+}
+
+impl TryFrom<RandomBinaryFields> for RandomBinary {
+    type Error = SignalError;
+    fn try_from(r: RandomBinaryFields) -> Result<Self, SignalError> {
+        Self::new(r.mean_dwell, r.low, r.high)
     }
 }

@@ -28,6 +28,7 @@
 //! The exact jittered simulator [`simulate`] draws `y_k = s(t_k + τ_k) + v_k`.
 #![warn(missing_docs)]
 
+mod any;
 mod error;
 mod grid;
 mod input;
@@ -36,16 +37,21 @@ pub mod poly;
 mod pulse;
 mod rational;
 mod reach;
+pub mod registry;
 mod signal;
 mod simulate;
 mod sinusoid;
+mod spectrum;
+pub mod testing;
 
+pub use any::AnySignal;
 pub use error::SignalError;
 pub use grid::SampleGrid;
-pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone};
-pub use lti::LtiResponse;
+pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone, MAX_SWITCHES};
+pub use lti::{LtiResponse, ModalState};
 pub use pulse::PulseResponse;
-pub use rational::{Modal, RationalModel, Root, TransferFunction, Zpk};
-pub use signal::{local_breaks, Jacobian, Signal, SpectralLine};
+pub use rational::{Modal, Rational, RationalModel, Root, TransferFunction, Zpk};
+pub use signal::{local_breaks, Jacobian, Signal};
 pub use simulate::{simulate, Simulation};
 pub use sinusoid::Sinusoid;
+pub use spectrum::{SpectralLine, Spectrum};

@@ -3,7 +3,8 @@
 use crate::input::Input;
 use crate::rational::{Modal, RationalModel};
 use crate::reach::{InReach, Route, SquaresRule};
-use crate::signal::{Jacobian, Signal, SpectralLine};
+use crate::signal::{Jacobian, Signal};
+use crate::spectrum::{SpectralLine, Spectrum};
 use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
 use num_complex::Complex64;
@@ -25,16 +26,25 @@ use std::sync::OnceLock;
 /// against the quadrature to `1e-14`). Quadrature is refined only where a modal term `e^{p x}`
 /// has not yet decayed, so the cost does not grow with the jitter's reach or the poles'
 /// moduli.
+///
+/// Serializes as `{model, input}`; deserializes through [`LtiResponse::new`] (the model and the
+/// input through their own validating constructors).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(
+    try_from = "LtiFields<M>",
+    into = "LtiFields<M>",
+    bound(
+        serialize = "M: RationalModel + serde::Serialize",
+        deserialize = "M: RationalModel + serde::Deserialize<'de>"
+    )
+)]
 pub struct LtiResponse<M> {
     model: M,
     input: Input,
     steps: Vec<(f64, f64)>,
-    /// Right after step `j`: the input level `Σ_{l≤j} Δu_l` and, per representative pole,
-    /// `X_ij = Σ_{l≤j} Δu_l e^{p_i (t_j − t_l)}` (row-major), so that `s(t)` costs
-    /// `O(log J + poles)`. Built on the first evaluation of `s(t)`: estimation never needs it.
-    #[serde(skip)]
-    prefix: OnceLock<(Vec<f64>, Vec<Complex64>)>,
+    /// The modal state right after every step, so that `s(t)` and its gradient cost
+    /// `O(log J + poles)`. Built on the first evaluation in time: estimation never needs it.
+    prefix: OnceLock<Prefix>,
 }
 
 impl<M: RationalModel> LtiResponse<M> {
@@ -53,30 +63,109 @@ impl<M: RationalModel> LtiResponse<M> {
         }
     }
 
-    fn prefix_states(&self) -> (Vec<f64>, Vec<Complex64>) {
+    fn prefix_states(&self) -> Prefix {
         let poles: Vec<Complex64> = self
             .representatives()
             .iter()
             .map(|&(i, _)| self.modal().poles[i])
             .collect();
-        let mut level = 0.0;
-        let mut x = vec![Complex64::new(0.0, 0.0); poles.len()];
+        let np = poles.len();
+        let zero = Complex64::new(0.0, 0.0);
+        let (mut level, mut x, mut y) = (0.0, vec![zero; np], vec![zero; np]);
         let mut prev = f64::NEG_INFINITY;
-        let mut levels = Vec::with_capacity(self.steps.len());
-        let mut states = Vec::with_capacity(self.steps.len() * poles.len());
+        let mut out = Prefix {
+            levels: Vec::with_capacity(self.steps.len()),
+            x: Vec::with_capacity(self.steps.len() * np),
+            y: Vec::with_capacity(self.steps.len() * np),
+        };
         for &(tj, du) in &self.steps {
-            for (xi, p) in x.iter_mut().zip(&poles) {
+            for i in 0..np {
                 if prev.is_finite() {
-                    *xi *= (p * (tj - prev)).exp();
+                    // X ← e^{pδ} X, Y ← e^{pδ} (Y + δ X): both sums move to the new origin t_j.
+                    let delta = tj - prev;
+                    let e = (poles[i] * delta).exp();
+                    y[i] = e * (y[i] + delta * x[i]);
+                    x[i] *= e;
                 }
-                *xi += du;
+                x[i] += du;
             }
             level += du;
             prev = tj;
-            levels.push(level);
-            states.extend_from_slice(&x);
+            out.levels.push(level);
+            out.x.extend_from_slice(&x);
+            out.y.extend_from_slice(&y);
         }
-        (levels, states)
+        out
+    }
+
+    /// The state of the linear response at `t`, for a piecewise-constant input: the input
+    /// level `u(t)` and, per representative pole `p_i` (one of each conjugate pair, in the order
+    /// of [`Modal::poles`] restricted to `Im p ≥ 0`), `x_i(t) = Σ_{t_j ≤ t} Δu_j e^{p_i(t − t_j)}`
+    /// and `y_i(t) = Σ_{t_j ≤ t} Δu_j (t − t_j) e^{p_i(t − t_j)} = ∂x_i/∂p_i`. Then
+    /// `s(t) = G(0) u(t) + Σ_i w_i Re((r_i/p_i) x_i(t))` (`w_i = 2` for a pair, 1 for a real pole).
+    ///
+    /// `O(log J + poles)` per instant, from states tabulated once per model at the input's
+    /// steps. `None` for a tone input (whose response is a closed form in `t`).
+    pub fn state(&self, t: f64) -> Option<ModalState> {
+        let Input::Piecewise(_) = self.input else {
+            return None;
+        };
+        let reps = self.representatives();
+        let np = reps.len();
+        let zero = Complex64::new(0.0, 0.0);
+        let j = self.steps.partition_point(|s| s.0 <= t);
+        if j == 0 {
+            return Some(ModalState {
+                level: 0.0,
+                x: vec![zero; np],
+                y: vec![zero; np],
+            });
+        }
+        let prefix = self.prefix.get_or_init(|| self.prefix_states());
+        let dt = t - self.steps[j - 1].0;
+        let range = (j - 1) * np..j * np;
+        let (x0, y0) = (&prefix.x[range.clone()], &prefix.y[range]);
+        let mut state = ModalState {
+            level: prefix.levels[j - 1],
+            x: Vec::with_capacity(np),
+            y: Vec::with_capacity(np),
+        };
+        for (k, &(i, _)) in reps.iter().enumerate() {
+            let e = (self.modal().poles[i] * dt).exp();
+            state.x.push(e * x0[k]);
+            state.y.push(e * (y0[k] + dt * x0[k]));
+        }
+        Some(state)
+    }
+
+    /// `s(t)` and `∂s(t)/∂θ_j` (into `grad`) together, in `O(log J + poles × params)` for a
+    /// piecewise-constant input: what a composite model (a static nonlinearity of this response)
+    /// needs at each instant.
+    pub fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
+        let Some(state) = self.state(t) else {
+            self.value_gradient(t, grad);
+            return self.value(t);
+        };
+        let m = self.modal();
+        let reps = self.representatives();
+        let mut s = m.dc_gain * state.level;
+        for (&(i, w), x) in reps.iter().zip(&state.x) {
+            s += w * (m.residues[i] / m.poles[i] * x).re;
+        }
+        for (j, g) in grad.iter_mut().enumerate() {
+            // ∂/∂θ_j of G(0)·u + Re Σ (r/p) x, with ∂x/∂θ_j = y ∂p/∂θ_j.
+            let mut d = m.d_dc_gain.get(j).copied().unwrap_or(0.0) * state.level;
+            for ((&(i, w), x), y) in reps.iter().zip(&state.x).zip(&state.y) {
+                let (p, r) = (m.poles[i], m.residues[i]);
+                let (Some(&dp), Some(&dr)) = (m.d_poles[i].get(j), m.d_residues[i].get(j)) else {
+                    continue;
+                };
+                let d_rp = dr / p - r * dp / (p * p);
+                d += w * (d_rp * x + r / p * y * dp).re;
+            }
+            *g = d;
+        }
+        s
     }
 
     /// The model `G`.
@@ -462,6 +551,48 @@ impl<M: RationalModel> LtiResponse<M> {
     }
 }
 
+/// The linear response's state at one instant; see [`LtiResponse::state`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModalState {
+    /// The input level `u(t)`.
+    pub level: f64,
+    /// `x_i(t) = Σ_{t_j ≤ t} Δu_j e^{p_i(t − t_j)}` per representative pole.
+    pub x: Vec<Complex64>,
+    /// `y_i(t) = Σ_{t_j ≤ t} Δu_j (t − t_j) e^{p_i(t − t_j)}` per representative pole.
+    pub y: Vec<Complex64>,
+}
+
+/// The serialized form of an [`LtiResponse`].
+#[derive(serde::Serialize, serde::Deserialize)]
+struct LtiFields<M> {
+    model: M,
+    input: Input,
+}
+
+impl<M: RationalModel> TryFrom<LtiFields<M>> for LtiResponse<M> {
+    type Error = SignalError;
+    fn try_from(f: LtiFields<M>) -> Result<Self, SignalError> {
+        Ok(Self::new(f.model, f.input))
+    }
+}
+
+impl<M: RationalModel> From<LtiResponse<M>> for LtiFields<M> {
+    fn from(r: LtiResponse<M>) -> Self {
+        Self {
+            model: r.model,
+            input: r.input,
+        }
+    }
+}
+
+/// [`ModalState`] right after each input step (row-major over representative poles).
+#[derive(Debug, Clone, PartialEq, Default)]
+struct Prefix {
+    levels: Vec<f64>,
+    x: Vec<Complex64>,
+    y: Vec<Complex64>,
+}
+
 struct ModalExpectations {
     c: Vec<f64>,
     a: Vec<Vec<Complex64>>,
@@ -503,10 +634,10 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                 }
                 let m = self.modal();
                 let reps = self.representatives();
-                let (levels, states) = self.prefix.get_or_init(|| self.prefix_states());
-                let x = &states[(j - 1) * reps.len()..j * reps.len()];
+                let prefix = self.prefix.get_or_init(|| self.prefix_states());
+                let x = &prefix.x[(j - 1) * reps.len()..j * reps.len()];
                 let dt = t - self.steps[j - 1].0;
-                let mut s = m.dc_gain * levels[j - 1];
+                let mut s = m.dc_gain * prefix.levels[j - 1];
                 for (&(i, w), xi) in reps.iter().zip(x) {
                     let (p, r) = (m.poles[i], m.residues[i]);
                     s += w * (r / p * xi * (p * dt).exp()).re;
@@ -531,81 +662,9 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                 }
             }
             Input::Piecewise(_) => {
-                let m = self.modal();
-                let reps = self.representatives();
-                for &(tj, du) in self.steps.iter().take_while(|(tj, _)| *tj <= t) {
-                    let x = t - tj;
-                    for (j, g) in grad.iter_mut().enumerate() {
-                        let mut d = m.d_dc_gain[j];
-                        for &(i, w) in &reps {
-                            let (p, r) = (m.poles[i], m.residues[i]);
-                            let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
-                            let e = (p * x).exp();
-                            let d_rp = dr / p - r * dp / (p * p);
-                            d += w * (d_rp * e + r / p * x * e * dp).re;
-                        }
-                        *g += du * d;
-                    }
-                }
+                self.value_and_gradient(t, grad);
             }
         }
-    }
-
-    fn density(&self, f: f64) -> Complex64 {
-        match &self.input {
-            Input::Piecewise(p) => self.model.frequency_response(f) * p.spectrum(f),
-            Input::Tones(_) => Complex64::new(0.0, 0.0),
-        }
-    }
-
-    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
-        match &self.input {
-            Input::Piecewise(p) => {
-                let s = Complex64::new(0.0, TAU * f);
-                self.model.rational().response_gradient(s, grad);
-                let u = p.spectrum(f);
-                grad.iter_mut().for_each(|g| *g *= u);
-            }
-            Input::Tones(_) => grad.iter_mut().for_each(|g| *g = Complex64::new(0.0, 0.0)),
-        }
-    }
-
-    fn lines(&self) -> Vec<SpectralLine> {
-        let Input::Tones(m) = &self.input else {
-            return Vec::new();
-        };
-        let mut out = Vec::with_capacity(2 * m.tones().len());
-        for c in m.tones() {
-            // A sin(θ) = (A e^{iθ} − A e^{−iθ}) / (2i), each side scaled by G at its frequency.
-            let g = self.model.frequency_response(c.frequency);
-            let pos = g * Complex64::from_polar(c.amplitude, c.phase) / Complex64::new(0.0, 2.0);
-            out.push(SpectralLine {
-                frequency: c.frequency,
-                coefficient: pos,
-            });
-            out.push(SpectralLine {
-                frequency: -c.frequency,
-                coefficient: pos.conj(),
-            });
-        }
-        out
-    }
-
-    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
-        let Input::Tones(m) = &self.input else {
-            return Vec::new();
-        };
-        let np = self.model.params().len();
-        let mut dg = vec![Complex64::new(0.0, 0.0); np];
-        let mut out = Vec::new();
-        for c in m.tones() {
-            let s = Complex64::new(0.0, TAU * c.frequency);
-            self.model.rational().response_gradient(s, &mut dg);
-            let k = Complex64::from_polar(c.amplitude, c.phase) / Complex64::new(0.0, 2.0);
-            out.push(dg.iter().map(|d| (d * k, 0.0)).collect());
-            out.push(dg.iter().map(|d| ((d * k).conj(), 0.0)).collect());
-        }
-        out
     }
 
     fn breakpoints(&self) -> Vec<f64> {
@@ -686,6 +745,65 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                     .collect()
             })
             .collect()
+    }
+}
+
+impl<M: RationalModel> Spectrum for LtiResponse<M> {
+    fn density(&self, f: f64) -> Complex64 {
+        match &self.input {
+            Input::Piecewise(p) => self.model.frequency_response(f) * p.spectrum(f),
+            Input::Tones(_) => Complex64::new(0.0, 0.0),
+        }
+    }
+
+    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        match &self.input {
+            Input::Piecewise(p) => {
+                let s = Complex64::new(0.0, TAU * f);
+                self.model.rational().response_gradient(s, grad);
+                let u = p.spectrum(f);
+                grad.iter_mut().for_each(|g| *g *= u);
+            }
+            Input::Tones(_) => grad.iter_mut().for_each(|g| *g = Complex64::new(0.0, 0.0)),
+        }
+    }
+
+    fn lines(&self) -> Vec<SpectralLine> {
+        let Input::Tones(m) = &self.input else {
+            return Vec::new();
+        };
+        let mut out = Vec::with_capacity(2 * m.tones().len());
+        for c in m.tones() {
+            // A sin(θ) = (A e^{iθ} − A e^{−iθ}) / (2i), each side scaled by G at its frequency.
+            let g = self.model.frequency_response(c.frequency);
+            let pos = g * Complex64::from_polar(c.amplitude, c.phase) / Complex64::new(0.0, 2.0);
+            out.push(SpectralLine {
+                frequency: c.frequency,
+                coefficient: pos,
+            });
+            out.push(SpectralLine {
+                frequency: -c.frequency,
+                coefficient: pos.conj(),
+            });
+        }
+        out
+    }
+
+    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
+        let Input::Tones(m) = &self.input else {
+            return Vec::new();
+        };
+        let np = self.model.params().len();
+        let mut dg = vec![Complex64::new(0.0, 0.0); np];
+        let mut out = Vec::new();
+        for c in m.tones() {
+            let s = Complex64::new(0.0, TAU * c.frequency);
+            self.model.rational().response_gradient(s, &mut dg);
+            let k = Complex64::from_polar(c.amplitude, c.phase) / Complex64::new(0.0, 2.0);
+            out.push(dg.iter().map(|d| (d * k, 0.0)).collect());
+            out.push(dg.iter().map(|d| ((d * k).conj(), 0.0)).collect());
+        }
+        out
     }
 }
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! input: `s(t) = Σ_l h_l u(t − l·T_s)`, itself piecewise constant.
 
 use crate::error::{all_finite, positive, SignalError};
-use crate::{Jacobian, PiecewiseConstant, SampleGrid, Signal};
+use crate::{Jacobian, PiecewiseConstant, SampleGrid, Signal, Spectrum};
 use jitterid_jitter::{JitterModel, QuadratureRule};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -14,7 +14,10 @@ use std::f64::consts::TAU;
 /// `S_c(f) = H(f) U(f)` with `H(f) = Σ_l h_l e^{-i2πf l T_s}`; `s` is linear in `θ`. Because
 /// `s` is piecewise constant, its jittered mean is exact in the jitter's distribution function:
 /// `E[u(t + τ)] = Σ_j Δu_j P(τ ≥ t_j − t)` over the input's steps `(t_j, Δu_j)`.
+///
+/// Deserializes through [`PulseResponse::new`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "PulseFields")]
 pub struct PulseResponse {
     coefficients: Vec<f64>,
     interval: f64,
@@ -119,6 +122,21 @@ impl PulseResponse {
     }
 }
 
+/// The serialized form of a [`PulseResponse`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct PulseFields {
+    coefficients: Vec<f64>,
+    interval: f64,
+    input: PiecewiseConstant,
+}
+
+impl TryFrom<PulseFields> for PulseResponse {
+    type Error = SignalError;
+    fn try_from(p: PulseFields) -> Result<Self, SignalError> {
+        Self::new(p.coefficients, p.interval, p.input)
+    }
+}
+
 /// Upper-tail masses `P(τ ≥ c)` of a quadrature rule, for `c` among the rule's cuts.
 struct Tail {
     /// Nodes in increasing order.
@@ -188,23 +206,6 @@ impl Signal for PulseResponse {
         }
     }
 
-    fn density(&self, f: f64) -> Complex64 {
-        let h: Complex64 = self
-            .coefficients
-            .iter()
-            .enumerate()
-            .map(|(l, &h)| Complex64::from_polar(h, -TAU * f * self.shift(l)))
-            .sum();
-        h * self.input.spectrum(f)
-    }
-
-    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
-        let u = self.input.spectrum(f);
-        for (l, g) in grad.iter_mut().enumerate().take(self.coefficients.len()) {
-            *g = Complex64::cis(-TAU * f * self.shift(l)) * u;
-        }
-    }
-
     fn breakpoints(&self) -> Vec<f64> {
         let edges = self.input.edges();
         let mut out: Vec<f64> = (0..self.coefficients.len())
@@ -234,6 +235,25 @@ impl Signal for PulseResponse {
         (0..self.coefficients.len())
             .map(|l| rows.iter().map(|row| row[l]).collect())
             .collect()
+    }
+}
+
+impl Spectrum for PulseResponse {
+    fn density(&self, f: f64) -> Complex64 {
+        let h: Complex64 = self
+            .coefficients
+            .iter()
+            .enumerate()
+            .map(|(l, &h)| Complex64::from_polar(h, -TAU * f * self.shift(l)))
+            .sum();
+        h * self.input.spectrum(f)
+    }
+
+    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        let u = self.input.spectrum(f);
+        for (l, g) in grad.iter_mut().enumerate().take(self.coefficients.len()) {
+            *g = Complex64::cis(-TAU * f * self.shift(l)) * u;
+        }
     }
 }
 

@@ -11,7 +11,9 @@ const REPEATED_POLE_TOL: f64 = 1e-9;
 
 /// The modal form `G(s) = D + Σ_i r_i / (s − p_i)` over all poles (conjugate pairs appear as
 /// two entries), with derivatives of `D`, `p_i`, `r_i` and `G(0)` with respect to each parameter.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+///
+/// Derived from a [`Rational`] (serialized, not deserialized: read the rational model instead).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Modal {
     /// Direct feed-through `D = G(∞)`.
     pub direct: f64,
@@ -29,8 +31,15 @@ pub struct Modal {
     pub d_dc_gain: Vec<f64>,
 }
 
-/// `N(s)/A(s)` with `A` monic, the coefficient derivatives, and the modal form.
+/// `N(s)/A(s)` with `A` monic, the coefficient derivatives, and the modal form: the validated
+/// core of every [`RationalModel`].
+///
+/// A parameterisation outside this crate builds one with [`Rational::new`] from its
+/// coefficients and their derivatives with respect to its parameters, and returns it from
+/// [`RationalModel::rational`]. Serializes as those coefficients; deserializes through
+/// [`Rational::new`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "RationalFields", into = "RationalFields")]
 pub struct Rational {
     num: Vec<f64>,
     den: Vec<f64>,
@@ -40,9 +49,75 @@ pub struct Rational {
 }
 
 impl Rational {
+    /// `N(s)/A(s)` from coefficients in decreasing powers, with `A` monic (leading
+    /// coefficient exactly 1) and of degree at least 1, `N` of degree at most that of `A`;
+    /// `d_num[j]`, `d_den[j]` are the derivatives of the coefficients with respect to parameter
+    /// `j` (one pair per parameter, each no longer than its polynomial, right-aligned: a
+    /// shorter row is padded with leading zeros; `A` stays monic, so a row of `d_den` as long
+    /// as `A` has a leading 0). The poles are the roots of `A`, which must be stable and distinct.
+    pub fn new(
+        num: Vec<f64>,
+        den: Vec<f64>,
+        d_num: Vec<Vec<f64>>,
+        d_den: Vec<Vec<f64>>,
+    ) -> Result<Self, SignalError> {
+        all_finite("num", &num)?;
+        all_finite("den", &den)?;
+        if num.is_empty() {
+            return Err(SignalError::TooFew {
+                name: "num",
+                min: 1,
+                value: 0,
+            });
+        }
+        if den.len() < 2 {
+            return Err(SignalError::TooFew {
+                name: "den",
+                min: 2,
+                value: den.len(),
+            });
+        }
+        if den[0] != 1.0 {
+            return Err(SignalError::NotMonic { lead: den[0] });
+        }
+        let degree = num
+            .iter()
+            .position(|&c| c != 0.0)
+            .map_or(0, |i| num.len() - 1 - i);
+        if degree > den.len() - 1 {
+            return Err(SignalError::Improper {
+                zeros: degree,
+                poles: den.len() - 1,
+            });
+        }
+        if d_num.len() != d_den.len() {
+            return Err(SignalError::WrongLength {
+                name: "d_den",
+                expected: d_num.len(),
+                got: d_den.len(),
+            });
+        }
+        for (d, len, name) in [(&d_num, num.len(), "d_num"), (&d_den, den.len(), "d_den")] {
+            for row in d.iter() {
+                all_finite(name, row)?;
+                if row.len() > len {
+                    return Err(SignalError::WrongLength {
+                        name,
+                        expected: len,
+                        got: row.len(),
+                    });
+                }
+            }
+        }
+        let num = poly::pad(&num[num.len() - 1 - degree..], den.len());
+        let poles = poly::roots(&den).ok_or(SignalError::Roots { name: "den" })?;
+        Self::with_poles(num, den, poles, d_num, d_den)
+    }
+
     /// Builds and validates: `num` padded to `den`'s length, `den` monic, `poles` the roots of
-    /// `den`; `d_num[j]`, `d_den[j]` are the coefficient derivatives for parameter `j`.
-    fn new(
+    /// `den` (known exactly by the caller); `d_num[j]`, `d_den[j]` are the coefficient
+    /// derivatives for parameter `j`.
+    fn with_poles(
         num: Vec<f64>,
         den: Vec<f64>,
         poles: Vec<Complex64>,
@@ -148,12 +223,44 @@ impl Rational {
     pub fn den(&self) -> &[f64] {
         &self.den
     }
+
+    /// Number of parameters the derivatives are taken for.
+    pub fn num_params(&self) -> usize {
+        self.d_num.len()
+    }
+}
+
+/// The serialized form of a [`Rational`]: coefficients and their derivatives.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct RationalFields {
+    num: Vec<f64>,
+    den: Vec<f64>,
+    d_num: Vec<Vec<f64>>,
+    d_den: Vec<Vec<f64>>,
+}
+
+impl TryFrom<RationalFields> for Rational {
+    type Error = SignalError;
+    fn try_from(r: RationalFields) -> Result<Self, SignalError> {
+        Self::new(r.num, r.den, r.d_num, r.d_den)
+    }
+}
+
+impl From<Rational> for RationalFields {
+    fn from(r: Rational) -> Self {
+        Self {
+            num: r.num,
+            den: r.den,
+            d_num: r.d_num,
+            d_den: r.d_den,
+        }
+    }
 }
 
 /// A proper, stable, continuous-time rational model with parameters `θ`.
 ///
-/// Implementors build a `Rational` at construction (which validates stability, properness
-/// and distinct poles); everything else is provided.
+/// Implementors build a [`Rational`] at construction ([`Rational::new`] validates stability,
+/// properness and distinct poles); everything else is provided.
 pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
     /// Names of the parameters.
     fn param_names(&self) -> Vec<String>;
@@ -184,7 +291,10 @@ pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
 ///
 /// Parameters: the numerator coefficients (highest power first), then the denominator's
 /// without its leading 1 (a denominator given with another leading coefficient is normalised).
+///
+/// Serializes as `{num, den}`; deserializes through [`TransferFunction::new`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "TfFields", into = "TfFields")]
 pub struct TransferFunction {
     rational: Rational,
     num_len: usize,
@@ -246,7 +356,7 @@ impl TransferFunction {
         }
         let num_len = num.len();
         Ok(Self {
-            rational: Rational::new(num, den, poles, d_num, d_den)?,
+            rational: Rational::with_poles(num, den, poles, d_num, d_den)?,
             num_len,
         })
     }
@@ -362,7 +472,10 @@ impl Root {
 /// two (real part, then imaginary part). The paper's eq. (17),
 /// `G(s) = k0 (s + z) / ((s − pr − i·pi)(s − pr + i·pi))`, is
 /// `Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }])`.
+///
+/// Serializes as `{gain, zeros, poles}`; deserializes through [`Zpk::new`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "ZpkFields", into = "ZpkFields")]
 pub struct Zpk {
     gain: f64,
     zeros: Vec<Root>,
@@ -425,7 +538,7 @@ impl Zpk {
             d_den.push(dp);
         }
         let pole_values = poles.iter().flat_map(Root::values).collect();
-        let rational = Rational::new(num, den, pole_values, d_num, d_den)?;
+        let rational = Rational::with_poles(num, den, pole_values, d_num, d_den)?;
         Ok(Self {
             gain,
             zeros,
@@ -515,6 +628,54 @@ impl RationalModel for Zpk {
 
     fn rational(&self) -> &Rational {
         &self.rational
+    }
+}
+
+/// The serialized form of a [`TransferFunction`].
+#[derive(serde::Serialize, serde::Deserialize)]
+struct TfFields {
+    num: Vec<f64>,
+    den: Vec<f64>,
+}
+
+impl TryFrom<TfFields> for TransferFunction {
+    type Error = SignalError;
+    fn try_from(t: TfFields) -> Result<Self, SignalError> {
+        Self::new(&t.num, &t.den)
+    }
+}
+
+impl From<TransferFunction> for TfFields {
+    fn from(t: TransferFunction) -> Self {
+        Self {
+            num: t.num().to_vec(),
+            den: t.den().to_vec(),
+        }
+    }
+}
+
+/// The serialized form of a [`Zpk`].
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ZpkFields {
+    gain: f64,
+    zeros: Vec<Root>,
+    poles: Vec<Root>,
+}
+
+impl TryFrom<ZpkFields> for Zpk {
+    type Error = SignalError;
+    fn try_from(z: ZpkFields) -> Result<Self, SignalError> {
+        Self::new(z.gain, z.zeros, z.poles)
+    }
+}
+
+impl From<Zpk> for ZpkFields {
+    fn from(z: Zpk) -> Self {
+        Self {
+            gain: z.gain,
+            zeros: z.zeros,
+            poles: z.poles,
+        }
     }
 }
 

@@ -1,32 +1,25 @@
 use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
-use num_complex::Complex64;
 use std::fmt;
-
-/// A spectral line of a signal: the term `coefficient · e^{i2π·frequency·t}` of `s(t)`.
-///
-/// A real sinusoid `A sin(2πf0 t + φ)` is the pair of lines at `±f0` with coefficients
-/// `A e^{±iφ} / (±2i)`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SpectralLine {
-    /// Frequency `f_l` in Hz.
-    pub frequency: f64,
-    /// Complex amplitude `c_l`.
-    pub coefficient: Complex64,
-}
 
 /// Derivatives of a vector quantity with respect to the parameters: `columns[j][k] = ∂x_k/∂θ_j`.
 pub type Jacobian = Vec<Vec<f64>>;
 
-/// A continuous-time signal model `s(t; θ)`.
+/// A continuous-time signal model `s(t; θ)`, known in the time domain.
 ///
-/// Its Fourier transform `S_c(f) = ∫ s(t) e^{-i2πft} dt` is a density part
-/// [`density`](Self::density) plus spectral [`lines`](Self::lines): a finite-duration response
-/// has a density only, a sinusoid lines only.
+/// Required: the parameters, `s(t)` and its gradient, and the fastest local rate. Provided:
+/// the breakpoints (none), and the jitter expectations `m_k = E[s(t_k + τ)]`, its gradient and
+/// `E[s(t_k + τ)²]` by the jitter's quadrature rule, which a model overrides with a faster
+/// exact route where it has one (the LTI response does). This is all that simulation and
+/// estimation need; the closed-form spectrum, used only by the frequency-integral reference
+/// route, is the separate [`Spectrum`](crate::Spectrum) trait.
 ///
-/// Required: the parameters, `s(t)` and its gradient, and `S_c`. Provided: the jitter
-/// expectations `m_k = E[s(t_k + τ)]` and `E[s(t_k + τ)²]` by quadrature over the jitter,
-/// which a model overrides with a faster exact route where it has one (the LTI response does).
+/// The provided expectations use [`JitterModel::rule`] rather than a general-purpose adaptive
+/// quadrature: the jitter law may have atoms (two-point, no jitter) and densities with kinks at
+/// known points (uniform sums), which the rule places exactly, and the rule is cut at this
+/// signal's [`breakpoints`](Self::breakpoints) inside each sample's reach, so every node
+/// interval holds an integrand that is analytic. A forgotten breakpoint therefore costs
+/// accuracy; `testing::check_contract` catches it.
 pub trait Signal: fmt::Debug + Send + Sync {
     /// Names of the parameters `θ`, in order.
     fn param_names(&self) -> Vec<String>;
@@ -44,23 +37,6 @@ pub trait Signal: fmt::Debug + Send + Sync {
 
     /// `∂s(t)/∂θ_j` for every parameter, into `grad`.
     fn value_gradient(&self, t: f64, grad: &mut [f64]);
-
-    /// The density part of `S_c(f)`.
-    fn density(&self, f: f64) -> Complex64;
-
-    /// `∂S_c(f)/∂θ_j` of the density part, into `grad`.
-    fn density_gradient(&self, f: f64, grad: &mut [Complex64]);
-
-    /// Spectral lines of `s` (none by default).
-    fn lines(&self) -> Vec<SpectralLine> {
-        Vec::new()
-    }
-
-    /// Gradient of the spectral lines' coefficients and frequencies:
-    /// `(∂c_l/∂θ_j, ∂f_l/∂θ_j)` as `[l][j]`. Empty by default, like [`lines`](Self::lines).
-    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
-        Vec::new()
-    }
 
     /// Times where `s` is not analytic (input switches, start and end of the response), in
     /// increasing order.

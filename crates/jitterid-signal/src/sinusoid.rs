@@ -2,7 +2,7 @@
 //! jitter's characteristic function.
 
 use crate::error::{finite, SignalError};
-use crate::{Jacobian, SampleGrid, Signal, SpectralLine};
+use crate::{Jacobian, SampleGrid, Signal, SpectralLine, Spectrum};
 use jitterid_jitter::JitterModel;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -18,7 +18,10 @@ use std::f64::consts::TAU;
 ///
 /// which [`Signal::expected_values`] and [`Signal::expected_squares`] use instead of
 /// quadrature.
+///
+/// Deserializes through [`Sinusoid::new`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "SinusoidFields")]
 pub struct Sinusoid {
     amplitude: f64,
     frequency: f64,
@@ -106,39 +109,6 @@ impl Signal for Sinusoid {
         }
     }
 
-    fn density(&self, _f: f64) -> Complex64 {
-        Complex64::new(0.0, 0.0)
-    }
-
-    fn density_gradient(&self, _f: f64, grad: &mut [Complex64]) {
-        grad.fill(Complex64::new(0.0, 0.0));
-    }
-
-    fn lines(&self) -> Vec<SpectralLine> {
-        let c = self.positive_coefficient();
-        vec![
-            SpectralLine {
-                frequency: self.frequency,
-                coefficient: c,
-            },
-            SpectralLine {
-                frequency: -self.frequency,
-                coefficient: c.conj(),
-            },
-        ]
-    }
-
-    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
-        let zero = Complex64::new(0.0, 0.0);
-        // c = A e^{iφ}/(2i): ∂c/∂A = e^{iφ}/(2i), ∂c/∂φ = i c; the frequency moves the line only.
-        let dc_da = Complex64::cis(self.phase) * Complex64::new(0.0, -0.5);
-        let dc_dphi = Complex64::i() * self.positive_coefficient();
-        vec![
-            vec![(dc_da, 0.0), (zero, 1.0), (dc_dphi, 0.0)],
-            vec![(dc_da.conj(), 0.0), (zero, -1.0), (dc_dphi.conj(), 0.0)],
-        ]
-    }
-
     fn rate(&self) -> f64 {
         TAU * self.frequency
     }
@@ -181,6 +151,56 @@ impl Signal for Sinusoid {
         grid.times()
             .map(|t| half_power * (1.0 - (Complex64::cis(2.0 * self.angle(t)) * g2).re))
             .collect()
+    }
+}
+
+impl Spectrum for Sinusoid {
+    fn density(&self, _f: f64) -> Complex64 {
+        Complex64::new(0.0, 0.0)
+    }
+
+    fn density_gradient(&self, _f: f64, grad: &mut [Complex64]) {
+        grad.fill(Complex64::new(0.0, 0.0));
+    }
+
+    fn lines(&self) -> Vec<SpectralLine> {
+        let c = self.positive_coefficient();
+        vec![
+            SpectralLine {
+                frequency: self.frequency,
+                coefficient: c,
+            },
+            SpectralLine {
+                frequency: -self.frequency,
+                coefficient: c.conj(),
+            },
+        ]
+    }
+
+    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
+        let zero = Complex64::new(0.0, 0.0);
+        // c = A e^{iφ}/(2i): ∂c/∂A = e^{iφ}/(2i), ∂c/∂φ = i c; the frequency moves the line only.
+        let dc_da = Complex64::cis(self.phase) * Complex64::new(0.0, -0.5);
+        let dc_dphi = Complex64::i() * self.positive_coefficient();
+        vec![
+            vec![(dc_da, 0.0), (zero, 1.0), (dc_dphi, 0.0)],
+            vec![(dc_da.conj(), 0.0), (zero, -1.0), (dc_dphi.conj(), 0.0)],
+        ]
+    }
+}
+
+/// The serialized form of a [`Sinusoid`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct SinusoidFields {
+    amplitude: f64,
+    frequency: f64,
+    phase: f64,
+}
+
+impl TryFrom<SinusoidFields> for Sinusoid {
+    type Error = SignalError;
+    fn try_from(s: SinusoidFields) -> Result<Self, SignalError> {
+        Self::new(s.amplitude, s.frequency, s.phase)
     }
 }
 

@@ -4,53 +4,13 @@
 use jitterid_jitter::{
     ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, TwoPoint, UniformSum,
 };
+use jitterid_signal::testing::Plain;
 use jitterid_signal::{
     simulate, PiecewiseConstant, PulseResponse, RandomBinary, SampleGrid, Signal, SignalError,
-    Sinusoid, SpectralLine,
+    Sinusoid,
 };
-use num_complex::Complex64;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
-
-/// Delegates the model but keeps the trait's provided (quadrature) expectations.
-#[derive(Debug, Clone)]
-struct Plain<S>(S);
-
-impl<S: Signal + Clone> Signal for Plain<S> {
-    fn param_names(&self) -> Vec<String> {
-        self.0.param_names()
-    }
-    fn params(&self) -> Vec<f64> {
-        self.0.params()
-    }
-    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        self.0.with_params(params).map(Plain)
-    }
-    fn value(&self, t: f64) -> f64 {
-        self.0.value(t)
-    }
-    fn value_gradient(&self, t: f64, grad: &mut [f64]) {
-        self.0.value_gradient(t, grad)
-    }
-    fn density(&self, f: f64) -> Complex64 {
-        self.0.density(f)
-    }
-    fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
-        self.0.density_gradient(f, grad)
-    }
-    fn lines(&self) -> Vec<SpectralLine> {
-        self.0.lines()
-    }
-    fn lines_gradient(&self) -> Vec<Vec<(Complex64, f64)>> {
-        self.0.lines_gradient()
-    }
-    fn breakpoints(&self) -> Vec<f64> {
-        self.0.breakpoints()
-    }
-    fn rate(&self) -> f64 {
-        self.0.rate()
-    }
-}
 
 /// Symmetric, one-sided, atomic and heavy-ish families: an asymmetric one catches a
 /// `γ(f0)`/`γ(-f0)` mix-up.

@@ -107,4 +107,4 @@ pub use window::{dirichlet, DirichletWindow, HannWindow, Window};
 #[doc(no_inline)]
 pub use jitterid_jitter::JitterModel;
 #[doc(no_inline)]
-pub use jitterid_signal::{SampleGrid, Signal};
+pub use jitterid_signal::{SampleGrid, Signal, Spectrum};

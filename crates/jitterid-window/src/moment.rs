@@ -10,7 +10,7 @@
 //! * **Frequency domain (route a, reference)**, [`first_moment_integral`]: the literal
 //!   eq. (14b) with the window kernel `K` in place of `Γ_N` (no `1/2π`, `f` in Hz),
 //!   `μ_Y(f) = ∫ S_c(ψ) γ(-ψ) e^{i2πψ t0} K(f-ψ) dψ + Σ_l c_l γ(-f_l) e^{i2πf_l t0} K(f-f_l)`,
-//!   using only [`Signal::density`], [`Signal::lines`] and [`JitterModel::cf`]. How the
+//!   using only [`Spectrum::density`](jitterid_signal::Spectrum::density), [`Spectrum::lines`](jitterid_signal::Spectrum::lines) and [`JitterModel::cf`]. How the
 //!   infinite range and the oscillation are handled is described [below](#route-a-in-detail).
 //!
 //! The factor `e^{i2πψ t0}`: `s(t) = ∫ S_c(ψ) e^{i2πψt} dψ`, so
@@ -26,7 +26,7 @@
 //! `G(ψ) = S_c(ψ) γ(-ψ) e^{i2πψ t0}` (density part of the signal's spectrum, damped by the jitter,
 //! phase-referred to the record's first instant) and `K(ν) = Σ_k w_k e^{-i2πνkT}` the window
 //! kernel (the Dirichlet kernel `Γ_N` for the rectangular window). The line part is a closed
-//! form. Only [`Signal::density`], [`Signal::lines`] and [`JitterModel::cf`] are used.
+//! form. Only [`Spectrum::density`](jitterid_signal::Spectrum::density), [`Spectrum::lines`](jitterid_signal::Spectrum::lines) and [`JitterModel::cf`] are used.
 //!
 //! ## The infinite range: folding onto one period
 //!

@@ -174,3 +174,26 @@ proptest! {
         prop_assert!((a - c).norm() <= 1e-12 * n as f64);
     }
 }
+
+/// Options read with serde go through the same validation as `first_moment_integral`, and no
+/// JSON value makes a read of a window-crate type panic.
+#[test]
+fn deserialized_options_are_validated() {
+    use jitterid_window::{DirichletWindow, HannWindow, IntegralOptions};
+    let ok = serde_json::json!({"rel_tol": 1e-10, "abs_tol": 0.0, "max_aliases": 8, "max_refinements": 2});
+    assert!(serde_json::from_value::<IntegralOptions>(ok).is_ok());
+    for bad in [
+        serde_json::json!({"rel_tol": -1.0, "abs_tol": 0.0, "max_aliases": 8, "max_refinements": 2}),
+        serde_json::json!({"rel_tol": 0.0, "abs_tol": 0.0, "max_aliases": 8, "max_refinements": 2}),
+        serde_json::json!({"rel_tol": 1e-10, "abs_tol": 0.0, "max_aliases": 0, "max_refinements": 2}),
+        serde_json::json!({"rel_tol": "x"}),
+        serde_json::json!([1, 2]),
+    ] {
+        assert!(
+            serde_json::from_value::<IntegralOptions>(bad.clone()).is_err(),
+            "{bad}"
+        );
+        let _ = serde_json::from_value::<DirichletWindow>(bad.clone());
+        let _ = serde_json::from_value::<HannWindow>(bad);
+    }
+}

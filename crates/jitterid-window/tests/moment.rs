@@ -5,7 +5,9 @@ mod common;
 
 use common::{ExpPulse, GaussPulse, Sum, Tones};
 use jitterid_jitter::{Gaussian, JitterModel, NoJitter, Shifted, UniformSum};
-use jitterid_signal::{LtiResponse, PiecewiseConstant, SampleGrid, Signal, TransferFunction};
+use jitterid_signal::{
+    LtiResponse, PiecewiseConstant, SampleGrid, Signal, Spectrum, TransferFunction,
+};
 use jitterid_window::{
     dtft, first_moment, first_moment_integral, DirichletWindow, FrequencySet, HannWindow,
     IntegralOptions, Window, WindowError,
@@ -14,7 +16,7 @@ use proptest::prelude::*;
 
 /// Checks |a − b| ≤ bound_a + 1e-13·scale at every frequency (the second term is route (b)'s
 /// own quadrature and rounding error) and returns the largest |a − b| / scale.
-fn compare<S: Signal + ?Sized>(
+fn compare<S: Spectrum + ?Sized>(
     label: &str,
     signal: &S,
     jitter: &dyn JitterModel,

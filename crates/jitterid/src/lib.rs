@@ -59,7 +59,7 @@ pub mod prelude {
     };
     pub use crate::signal::{
         simulate, Input, LtiResponse, Multisine, PiecewiseConstant, RandomBinary, RationalModel,
-        Root, SampleGrid, Signal, Simulation, Sinusoid, TransferFunction, Zpk,
+        Root, SampleGrid, Signal, Simulation, Sinusoid, Spectrum, TransferFunction, Zpk,
     };
     pub use num_complex::Complex64;
 }

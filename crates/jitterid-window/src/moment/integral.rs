@@ -7,7 +7,7 @@ use crate::dtft::CompensatedSum;
 use crate::phase::{cis_cycles, frac_prod};
 use crate::{FrequencySet, Window, WindowError};
 use jitterid_jitter::JitterModel;
-use jitterid_signal::{SampleGrid, Signal};
+use jitterid_signal::{SampleGrid, Spectrum};
 use num_complex::Complex64;
 
 /// Aliases per side summed before the first tail estimate.
@@ -22,7 +22,11 @@ const KERNEL_NORM_MARGIN: f64 = 1.1;
 const MIN_DECAY: f64 = 1.25;
 
 /// Accuracy target and limits of [`first_moment_integral`].
+///
+/// Deserializes through the same validation as [`first_moment_integral`] applies, so options
+/// read from a file are valid.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "OptionFields")]
 pub struct IntegralOptions {
     /// Relative target, relative to `max_f |μ_Y(f)|` over the requested set. Default `1e-10`.
     /// Finite and `≥ 0`; `rel_tol` and `abs_tol` must not both be zero.
@@ -71,6 +75,28 @@ impl IntegralOptions {
     }
 }
 
+/// The serialized form of [`IntegralOptions`], validated on the way in.
+#[derive(serde::Deserialize)]
+struct OptionFields {
+    rel_tol: f64,
+    abs_tol: f64,
+    max_aliases: usize,
+    max_refinements: usize,
+}
+
+impl TryFrom<OptionFields> for IntegralOptions {
+    type Error = WindowError;
+    fn try_from(o: OptionFields) -> Result<Self, WindowError> {
+        let options = IntegralOptions {
+            rel_tol: o.rel_tol,
+            abs_tol: o.abs_tol,
+            max_aliases: o.max_aliases,
+            max_refinements: o.max_refinements,
+        };
+        options.validate().map(|()| options)
+    }
+}
+
 /// The result of [`first_moment_integral`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct IntegralMoment {
@@ -110,7 +136,7 @@ struct Folded<'a, S: ?Sized> {
     max_neg: Vec<f64>,
 }
 
-impl<S: Signal + ?Sized> Folded<'_, S> {
+impl<S: Spectrum + ?Sized> Folded<'_, S> {
     /// `G(ψ) = S_c(ψ) γ(-ψ) e^{i2πψ t0}`.
     fn integrand(&self, psi: f64) -> Complex64 {
         self.signal.density(psi) * self.jitter.cf(-psi) * cis_cycles(frac_prod(psi, self.t0))
@@ -242,7 +268,7 @@ struct Evaluation {
     rounding: Vec<f64>,
 }
 
-fn evaluate<S: Signal + ?Sized, W: Window + ?Sized>(
+fn evaluate<S: Spectrum + ?Sized, W: Window + ?Sized>(
     folded: &Folded<'_, S>,
     grid: &SampleGrid,
     window: &W,
@@ -289,7 +315,7 @@ fn evaluate<S: Signal + ?Sized, W: Window + ?Sized>(
 /// `∫ S_c(ψ) γ(-ψ) e^{i2πψ t0} K(f-ψ) dψ + Σ_l c_l γ(-f_l) e^{i2πf_l t0} K(f-f_l)`, with an error
 /// bound per frequency.
 ///
-/// Uses only the signal's [`density`](Signal::density) and [`lines`](Signal::lines), the
+/// Uses only the signal's [`density`](Spectrum::density) and [`lines`](Spectrum::lines), the
 /// jitter's [`cf`](JitterModel::cf) and the window's [`kernel`](Window::kernel). The infinite
 /// range is folded onto one period `1/T` by summing aliases, cut where an extrapolated tail
 /// estimate meets a quarter of the target; the folded periodic integrand is integrated by the
@@ -312,7 +338,7 @@ pub fn first_moment_integral<S, W>(
     options: &IntegralOptions,
 ) -> Result<IntegralMoment, WindowError>
 where
-    S: Signal + ?Sized,
+    S: Spectrum + ?Sized,
     W: Window + ?Sized,
 {
     options.validate()?;

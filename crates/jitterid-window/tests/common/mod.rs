@@ -1,7 +1,7 @@
 //! Test-local signals with closed-form spectra, and a compensated reference DTFT.
 #![allow(dead_code)]
 
-use jitterid_signal::{Signal, SignalError, SpectralLine};
+use jitterid_signal::{Signal, SignalError, SpectralLine, Spectrum};
 use num_complex::Complex64;
 use std::f64::consts::{PI, TAU};
 
@@ -59,6 +59,15 @@ impl Signal for ExpPulse {
             0.0
         };
     }
+    fn breakpoints(&self) -> Vec<f64> {
+        vec![self.start, self.start + self.len]
+    }
+    fn rate(&self) -> f64 {
+        self.alpha
+    }
+}
+
+impl Spectrum for ExpPulse {
     fn density(&self, f: f64) -> Complex64 {
         let z = self.z(f);
         let shift = Complex64::from_polar(1.0, -TAU * f * self.start);
@@ -69,12 +78,6 @@ impl Signal for ExpPulse {
         let e = (-z * self.len).exp();
         let shift = Complex64::from_polar(1.0, -TAU * f * self.start);
         grad[0] = shift * (self.len * e * z - (1.0 - e)) / (z * z);
-    }
-    fn breakpoints(&self) -> Vec<f64> {
-        vec![self.start, self.start + self.len]
-    }
-    fn rate(&self) -> f64 {
-        self.alpha
     }
 }
 
@@ -114,6 +117,12 @@ impl Signal for GaussPulse {
         let x = (t - self.centre) / self.width;
         grad[0] = (-0.5 * x * x).exp();
     }
+    fn rate(&self) -> f64 {
+        3.0 / self.width
+    }
+}
+
+impl Spectrum for GaussPulse {
     fn density(&self, f: f64) -> Complex64 {
         let w = self.width;
         let mag = self.amplitude * w * (2.0 * PI).sqrt() * (-2.0 * PI * PI * w * w * f * f).exp();
@@ -121,9 +130,6 @@ impl Signal for GaussPulse {
     }
     fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
         grad[0] = self.density(f) / self.amplitude;
-    }
-    fn rate(&self) -> f64 {
-        3.0 / self.width
     }
 }
 
@@ -158,6 +164,14 @@ impl Signal for Tones {
             .sum()
     }
     fn value_gradient(&self, _t: f64, _grad: &mut [f64]) {}
+    fn rate(&self) -> f64 {
+        self.tones
+            .iter()
+            .fold(0.0, |r, &(_, f, _)| r.max(TAU * f.abs()))
+    }
+}
+
+impl Spectrum for Tones {
     fn density(&self, _f: f64) -> Complex64 {
         Complex64::new(0.0, 0.0)
     }
@@ -180,11 +194,6 @@ impl Signal for Tones {
             })
             .collect()
     }
-    fn rate(&self) -> f64 {
-        self.tones
-            .iter()
-            .fold(0.0, |r, &(_, f, _)| r.max(TAU * f.abs()))
-    }
 }
 
 /// The sum of two signals (parameters are not exposed).
@@ -205,15 +214,6 @@ impl<A: Signal + Clone, B: Signal + Clone> Signal for Sum<A, B> {
         self.0.value(t) + self.1.value(t)
     }
     fn value_gradient(&self, _t: f64, _grad: &mut [f64]) {}
-    fn density(&self, f: f64) -> Complex64 {
-        self.0.density(f) + self.1.density(f)
-    }
-    fn density_gradient(&self, _f: f64, _grad: &mut [Complex64]) {}
-    fn lines(&self) -> Vec<SpectralLine> {
-        let mut l = self.0.lines();
-        l.extend(self.1.lines());
-        l
-    }
     fn breakpoints(&self) -> Vec<f64> {
         let mut b = self.0.breakpoints();
         b.extend(self.1.breakpoints());
@@ -223,6 +223,18 @@ impl<A: Signal + Clone, B: Signal + Clone> Signal for Sum<A, B> {
     }
     fn rate(&self) -> f64 {
         self.0.rate().max(self.1.rate())
+    }
+}
+
+impl<A: Spectrum + Clone, B: Spectrum + Clone> Spectrum for Sum<A, B> {
+    fn density(&self, f: f64) -> Complex64 {
+        self.0.density(f) + self.1.density(f)
+    }
+    fn density_gradient(&self, _f: f64, _grad: &mut [Complex64]) {}
+    fn lines(&self) -> Vec<SpectralLine> {
+        let mut l = self.0.lines();
+        l.extend(self.1.lines());
+        l
     }
 }
 
