@@ -8,7 +8,7 @@ use crate::fit::{estimate, EstimateOptions, Frequencies};
 use crate::ml::{ml_estimate, ml_profile, ExactMl, MlError, MlOptions, QuasiMl};
 use crate::noise::NoiseModel;
 use crate::profile::{profile, Profile};
-use crate::registry::{number, numbers, Entry, ParamSpec, Registry, RegistryError};
+use crate::registry::{number, numbers, real, Entry, Registry, RegistryError};
 use crate::result::Fit;
 use crate::solver::AnySolver;
 use crate::structure::ModelStructure;
@@ -274,14 +274,14 @@ impl Registry<AnyCriterion> {
     pub fn builtin() -> Self {
         let exact = ExactMl::default();
         let exact_keys = vec![
-            ParamSpec::real(
+            real(
                 "resolution",
                 "signal range of one refined quadrature sub-interval",
                 "σ_v",
                 "> 0, finite",
                 Some(exact.resolution),
             ),
-            ParamSpec::real(
+            real(
                 "window",
                 "distance from y_k beyond which sub-intervals share one rule",
                 "σ_v",
@@ -304,7 +304,7 @@ impl Registry<AnyCriterion> {
             Entry::new(
                 "weighted-bcls",
                 "BCLS with one weight per frequency of the set",
-                vec![ParamSpec::real(
+                vec![real(
                     "weights",
                     "one weight per frequency of the set",
                     "",
@@ -357,7 +357,7 @@ impl Registry<AnyCriterion> {
                 },
             ),
         ];
-        let mut r = Registry::empty(CRITERION_KEY, "criterion", &[], None);
+        let mut r = Registry::empty(CRITERION_KEY, "criterion", Vec::new(), None);
         for e in entries {
             r.insert(e);
         }

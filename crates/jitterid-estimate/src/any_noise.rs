@@ -1,7 +1,7 @@
 //! The one run-time noise type, [`AnyNoise`], and the registry of noise models by name.
 
 use crate::noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
-use crate::registry::{number, numbers, Entry, ParamSpec, Registry, RegistryError};
+use crate::registry::{number, numbers, real, Entry, ParamSpec, Registry, RegistryError};
 use crate::EstimateError;
 use std::fmt;
 use std::sync::Arc;
@@ -89,13 +89,16 @@ pub type NoiseEntry = Entry<AnyNoise>;
 /// Noise models by name: `"white"` and `"arma"` (keys `c`, `d`, optional `floor`).
 pub type NoiseRegistry = Registry<AnyNoise>;
 
-const FLOOR: ParamSpec = ParamSpec::real(
-    "floor",
-    "flat floor ρ added to the shape, |H|² + ρ (estimated through ln ρ); absent: no floor",
-    "",
-    "> 0, finite",
-    None,
-);
+/// The optional `floor` key of the ARMA entry.
+fn floor_spec() -> ParamSpec {
+    real(
+        "floor",
+        "flat floor ρ added to the shape, |H|² + ρ (estimated through ln ρ); absent: no floor",
+        "",
+        "> 0, finite",
+        None,
+    )
+}
 
 impl Registry<AnyNoise> {
     /// The noise models of this crate.
@@ -122,21 +125,21 @@ impl Registry<AnyNoise> {
             "arma",
             "ARMA shape H = C(z)/D(z), monic, roots inside the unit circle (BJ and JBJ)",
             vec![
-                ParamSpec::real(
+                real(
                     "c",
                     "MA coefficients c₁…c_q of C(z) = 1 + c₁z⁻¹ + …",
                     "",
                     "a list; roots of C inside the unit circle",
                     None,
                 ),
-                ParamSpec::real(
+                real(
                     "d",
                     "AR coefficients d₁…d_p of D(z) = 1 + d₁z⁻¹ + …",
                     "",
                     "a list; roots of D inside the unit circle",
                     None,
                 ),
-                FLOOR,
+                floor_spec(),
             ],
             |t| {
                 let c = numbers(t, "c")?;
@@ -144,8 +147,8 @@ impl Registry<AnyNoise> {
                 // Each polynomial checked alone, so that the error names its key.
                 ArmaNoise::new(c.clone(), Vec::new()).map_err(|e| RegistryError::bad("c", e))?;
                 let arma = ArmaNoise::new(c, d).map_err(|e| RegistryError::bad("d", e))?;
-                if t.contains_key(FLOOR.key) {
-                    let floor = number(t, &FLOOR, "arma")?;
+                if t.contains_key("floor") {
+                    let floor = number(t, &floor_spec(), "arma")?;
                     let with =
                         WithFloor::new(arma, floor).map_err(|e| RegistryError::bad("floor", e))?;
                     Ok(AnyNoise::new(with))
@@ -154,7 +157,7 @@ impl Registry<AnyNoise> {
                 }
             },
         );
-        let mut r = Registry::empty(NOISE_KEY, "noise model", &[], None);
+        let mut r = Registry::empty(NOISE_KEY, "noise model", Vec::new(), None);
         for e in [white, arma] {
             r.insert(e);
         }

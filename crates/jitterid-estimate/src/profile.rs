@@ -31,11 +31,12 @@ pub struct Profile<J> {
     pub costs: Vec<(i64, Option<f64>)>,
 }
 
+/// The outcome of [`best_of`]: the winner (value and fit), the cost of every value, the first
+/// error.
+type Best<E> = (Option<(i64, Fit)>, Vec<(i64, Option<f64>)>, Option<E>);
+
 /// The best of the fits of a profile: converged beats not converged, then the lower cost.
-/// Returns the winner, the cost of every value and the first error.
-pub(crate) fn best_of<E>(
-    fits: Vec<(i64, Result<Fit, E>)>,
-) -> (Option<(i64, Fit)>, Vec<(i64, Option<f64>)>, Option<E>) {
+pub(crate) fn best_of<E>(fits: Vec<(i64, Result<Fit, E>)>) -> Best<E> {
     let mut best: Option<(i64, Fit)> = None;
     let mut costs = Vec::new();
     let mut first_error = None;

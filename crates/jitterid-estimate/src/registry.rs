@@ -14,58 +14,26 @@ use thiserror::Error;
 /// A spec table: key/value construction input.
 pub type SpecTable = Map<String, Value>;
 
-/// What a key of a registry entry means.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct ParamSpec {
-    /// The key in a spec table.
-    pub key: &'static str,
-    /// What it is.
-    pub meaning: &'static str,
-    /// Its unit (`""` for a pure number).
-    pub unit: &'static str,
-    /// The values it accepts, in words.
-    pub constraint: &'static str,
-    /// Whether it takes whole numbers only.
-    pub integer: bool,
-    /// Its value when absent (`None`: required).
-    pub default: Option<f64>,
+pub use jitterid_jitter::registry::ParamSpec;
+
+/// A real-valued key, required when `default` is `None`.
+pub(crate) fn real(
+    key: &str,
+    meaning: &str,
+    unit: &str,
+    constraint: &str,
+    default: Option<f64>,
+) -> ParamSpec {
+    let spec = ParamSpec::new(key, meaning, unit, constraint);
+    match default {
+        Some(v) => spec.with_default(v),
+        None => spec,
+    }
 }
 
-impl ParamSpec {
-    /// A real-valued key.
-    pub const fn real(
-        key: &'static str,
-        meaning: &'static str,
-        unit: &'static str,
-        constraint: &'static str,
-        default: Option<f64>,
-    ) -> Self {
-        ParamSpec {
-            key,
-            meaning,
-            unit,
-            constraint,
-            integer: false,
-            default,
-        }
-    }
-
-    /// A whole-number key.
-    pub const fn integer(
-        key: &'static str,
-        meaning: &'static str,
-        constraint: &'static str,
-        default: Option<f64>,
-    ) -> Self {
-        ParamSpec {
-            key,
-            meaning,
-            unit: "",
-            constraint,
-            integer: true,
-            default,
-        }
-    }
+/// A whole-number key, required when `default` is `None`.
+pub(crate) fn whole(key: &str, meaning: &str, constraint: &str, default: Option<f64>) -> ParamSpec {
+    real(key, meaning, "", constraint, default).integer()
 }
 
 /// Why a registry could not build from a spec table. Each variant names the offending key.
@@ -199,7 +167,7 @@ impl<T> Entry<T> {
 pub struct Registry<T> {
     key: &'static str,
     kind: &'static str,
-    reserved: &'static [ParamSpec],
+    reserved: Vec<ParamSpec>,
     wrap: Option<Wrap<T>>,
     entries: Vec<Entry<T>>,
 }
@@ -207,8 +175,11 @@ pub struct Registry<T> {
 impl<T> Clone for Registry<T> {
     fn clone(&self) -> Self {
         Registry {
+            key: self.key,
+            kind: self.kind,
+            reserved: self.reserved.clone(),
+            wrap: self.wrap,
             entries: self.entries.clone(),
-            ..*self
         }
     }
 }
@@ -228,7 +199,7 @@ impl<T> Registry<T> {
     pub(crate) fn empty(
         key: &'static str,
         kind: &'static str,
-        reserved: &'static [ParamSpec],
+        reserved: Vec<ParamSpec>,
         wrap: Option<Wrap<T>>,
     ) -> Self {
         Registry {
@@ -246,8 +217,8 @@ impl<T> Registry<T> {
     }
 
     /// Keys every entry takes besides its own (the solvers' multi-start keys).
-    pub fn common_keys(&self) -> &'static [ParamSpec] {
-        self.reserved
+    pub fn common_keys(&self) -> &[ParamSpec] {
+        &self.reserved
     }
 
     /// Adds an entry of the crate's own (names known to be distinct).
@@ -293,7 +264,7 @@ impl<T> Registry<T> {
             unknown(self.key, self.kind, name, &names)
         })?;
         let mut reserved = vec![self.key];
-        reserved.extend(self.reserved.iter().map(|s| s.key));
+        reserved.extend(self.reserved.iter().map(|s| s.key.as_str()));
         check_keys(table, entry.name, &reserved, &entry.params)?;
         let value = (entry.build)(table)?;
         match self.wrap {
@@ -326,11 +297,15 @@ pub(crate) fn check_keys(
     specs: &[ParamSpec],
 ) -> Result<(), RegistryError> {
     for key in table.keys() {
-        if !reserved.contains(&key.as_str()) && !specs.iter().any(|s| s.key == key) {
+        if !reserved.contains(&key.as_str()) && !specs.iter().any(|s| s.key == *key) {
             return Err(RegistryError::UnknownKey {
                 key: key.clone(),
                 entry: entry.to_string(),
-                known: specs.iter().map(|s| s.key).collect::<Vec<_>>().join(", "),
+                known: specs
+                    .iter()
+                    .map(|s| s.key.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
             });
         }
     }
@@ -343,21 +318,22 @@ pub(crate) fn number(
     spec: &ParamSpec,
     entry: &str,
 ) -> Result<f64, RegistryError> {
-    match table.get(spec.key) {
+    let key = spec.key.as_str();
+    match table.get(key) {
         Some(v) => {
-            let x = v.as_f64().ok_or_else(|| {
-                RegistryError::bad(spec.key, format!("expected a number, got {v}"))
-            })?;
+            let x = v
+                .as_f64()
+                .ok_or_else(|| RegistryError::bad(key, format!("expected a number, got {v}")))?;
             if spec.integer && x.fract() != 0.0 {
                 return Err(RegistryError::bad(
-                    spec.key,
+                    key,
                     format!("expected a whole number, got {x}"),
                 ));
             }
             Ok(x)
         }
         None => spec.default.ok_or_else(|| RegistryError::MissingKey {
-            key: spec.key.to_string(),
+            key: key.to_string(),
             entry: entry.to_string(),
         }),
     }
@@ -372,7 +348,7 @@ pub(crate) fn count(
     let x = number(table, spec, entry)?;
     if !(x >= 0.0 && x <= u64::MAX as f64) {
         return Err(RegistryError::bad(
-            spec.key,
+            &spec.key,
             format!("expected a whole number >= 0, got {x}"),
         ));
     }

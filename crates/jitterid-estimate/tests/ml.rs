@@ -413,7 +413,7 @@ fn uniform_sum_profile_finds_sigma() {
                 &record,
                 &ExactMl::default(),
                 &opts,
-                0..=(4),
+                0..=4,
                 keep_std_dev(&structure.jitter),
             )
         } else {
@@ -422,7 +422,7 @@ fn uniform_sum_profile_finds_sigma() {
                 &record,
                 &QuasiMl,
                 &opts,
-                0..=(4),
+                0..=4,
                 keep_std_dev(&structure.jitter),
             )
         }
@@ -465,7 +465,7 @@ fn staged_profile_equals_full_refinement() {
             &record,
             &e,
             &MlOptions::default(),
-            0..=(9),
+            0..=9,
             keep_std_dev(&structure.jitter),
         )
         .unwrap();
@@ -474,7 +474,7 @@ fn staged_profile_equals_full_refinement() {
             &record,
             &e,
             &full,
-            0..=(9),
+            0..=9,
             keep_std_dev(&structure.jitter),
         )
         .unwrap();
@@ -968,7 +968,7 @@ fn timing() {
                 &record,
                 &e,
                 &MlOptions::default(),
-                0..=(9),
+                0..=9,
                 keep_std_dev(&structure.jitter),
             )
             .unwrap()
@@ -1008,7 +1008,7 @@ fn diag_uniform_bias() {
             &record,
             &ExactMl::default(),
             &MlOptions::default(),
-            0..=(9),
+            0..=9,
             keep_std_dev(&s.jitter),
         )
         .unwrap();

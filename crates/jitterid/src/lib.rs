@@ -52,8 +52,10 @@ pub use rand;
 
 /// The commonly used types and traits.
 pub mod prelude {
+    pub use crate::jitter::registry::{JitterRegistry, ParamSpec};
     pub use crate::jitter::{
-        ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
+        AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, Mixture,
+        NoJitter, Periodic, Shifted, Sum, TwoPoint, UniformSum,
     };
     pub use crate::signal::{
         simulate, Input, LtiResponse, Multisine, PiecewiseConstant, RandomBinary, RationalModel,
@@ -66,8 +68,3 @@ pub mod prelude {
 #[cfg(doctest)]
 #[doc = include_str!("../../../README.md")]
 struct ReadmeDoctests;
-
-// The extension guide's examples (family, criterion) compiled and run against the facade.
-#[cfg(doctest)]
-#[doc = include_str!("../../../docs/extending.md")]
-struct ExtendingDoctests;

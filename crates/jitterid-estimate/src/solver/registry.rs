@@ -4,28 +4,32 @@ use super::{
     AnySolver, Bfgs, Brent, BrentOrBfgs, GaussNewtonLineSearch, LevenbergMarquardt, LmOptions,
     MultiStart, NelderMead, SolverError,
 };
-use crate::registry::{count, number, Entry, ParamSpec, Registry, RegistryError, SpecTable};
+use crate::registry::{
+    count, number, real, whole, Entry, ParamSpec, Registry, RegistryError, SpecTable,
+};
 
 /// The key of a spec table that names the solver.
 pub const SOLVER_KEY: &str = "solver";
 
-/// Keys that wrap any solver in a [`MultiStart`].
-static MULTISTART: [ParamSpec; 3] = [
-    ParamSpec::integer(
-        "starts",
-        "perturbed starts in addition to the given one (0: a single run)",
-        ">= 0",
-        Some(0.0),
-    ),
-    ParamSpec::real(
-        "radius",
-        "relative radius of the perturbed starts",
-        "",
-        ">= 0, finite",
-        Some(0.5),
-    ),
-    ParamSpec::integer("seed", "seed of the perturbed starts", ">= 0", Some(0.0)),
-];
+/// Keys that wrap any solver in a [`MultiStart`]: `starts`, `radius`, `seed`.
+fn multistart_keys() -> [ParamSpec; 3] {
+    [
+        whole(
+            "starts",
+            "perturbed starts in addition to the given one (0: a single run)",
+            ">= 0",
+            Some(0.0),
+        ),
+        real(
+            "radius",
+            "relative radius of the perturbed starts",
+            "",
+            ">= 0, finite",
+            Some(0.5),
+        ),
+        whole("seed", "seed of the perturbed starts", ">= 0", Some(0.0)),
+    ]
+}
 
 /// A registered solver.
 pub type SolverEntry = Entry<AnySolver>;
@@ -39,27 +43,28 @@ pub type SolverRegistry = Registry<AnySolver>;
 const MAX_ITERS: &str = "max_iters";
 
 fn max_iters(default: f64) -> ParamSpec {
-    ParamSpec::integer(MAX_ITERS, "iteration limit", ">= 1", Some(default))
+    whole(MAX_ITERS, "iteration limit", ">= 1", Some(default))
 }
 
 fn positive(key: &'static str, meaning: &'static str, default: f64) -> ParamSpec {
-    ParamSpec::real(key, meaning, "", "> 0, finite", Some(default))
+    real(key, meaning, "", "> 0, finite", Some(default))
 }
 
 /// Wraps a built solver in a [`MultiStart`] when the table asks for perturbed starts.
 fn multistart(table: &SpecTable, solver: AnySolver) -> Result<AnySolver, RegistryError> {
-    let starts = count(table, &MULTISTART[0], solver.name())?;
+    let [starts, radius, seed] = multistart_keys();
+    let starts = count(table, &starts, solver.name())?;
     if starts == 0 {
         return Ok(solver);
     }
-    let radius = number(table, &MULTISTART[1], solver.name())?;
+    let radius = number(table, &radius, solver.name())?;
     if !(radius.is_finite() && radius >= 0.0) {
         return Err(RegistryError::bad(
             "radius",
             format!("must be finite and >= 0, got {radius}"),
         ));
     }
-    let seed = count(table, &MULTISTART[2], solver.name())?;
+    let seed = count(table, &seed, solver.name())?;
     Ok(AnySolver::new(MultiStart::new(
         solver,
         starts as usize,
@@ -77,9 +82,10 @@ fn read(table: &SpecTable, entry: &str, specs: &[ParamSpec]) -> Result<Vec<f64>,
             if s.key == MAX_ITERS && !(v >= 1.0) {
                 return Err(RegistryError::bad(MAX_ITERS, "must be at least 1"));
             }
-            if !s.integer && !(v.is_finite() && v > 0.0) {
+            let positive = v.is_finite() && v > 0.0;
+            if !s.integer && !positive {
                 return Err(RegistryError::bad(
-                    s.key,
+                    &s.key,
                     format!("must be finite and > 0, got {v}"),
                 ));
             }
@@ -104,7 +110,12 @@ impl Registry<AnySolver> {
     /// # Ok::<(), jitterid_estimate::RegistryError>(())
     /// ```
     pub fn builtin() -> Self {
-        let mut r = Registry::empty(SOLVER_KEY, "solver", &MULTISTART, Some(multistart));
+        let mut r = Registry::empty(
+            SOLVER_KEY,
+            "solver",
+            multistart_keys().to_vec(),
+            Some(multistart),
+        );
         let lm = LmOptions::default();
         let lm_keys = vec![
             max_iters(lm.max_iters as f64),
