@@ -18,13 +18,12 @@
 //! printed with `--nocapture`.)
 
 use jitterid::estimate::solver::{
-    LeastSquares, LevenbergMarquardt, LmOptions, MultiStart, NelderMead, Scaling, Solver,
-    SolverError, SolverReport,
+    AnySolver, LevenbergMarquardt, LmOptions, MultiStart, NelderMead, Scaling,
 };
 use jitterid::estimate::{
-    estimate, initialize, ArmaNoise, Bcls, BoxJenkins, Criterion, Estimate, EstimateError,
-    EstimateOptions, Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel,
-    Record, WeightedBcls,
+    estimate, initialize, ArmaNoise, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
+    Fit, Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, Record,
+    WeightedBcls,
 };
 use jitterid::jitter::{
     Atom, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter, QuadratureRule,
@@ -32,7 +31,7 @@ use jitterid::jitter::{
 };
 use jitterid::prelude::*;
 use jitterid::signal::Tone;
-use jitterid::window::{DirichletWindow, FrequencySet, HannWindow};
+use jitterid::window::{DirichletWindow, HannWindow};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
 use rand::RngCore;
@@ -131,80 +130,6 @@ impl JitterModel for AnyJitter {
     }
     fn rule_from(&self, from: f64, breaks: &[f64], rate: f64) -> QuadratureRule {
         each!(self, j => j.rule_from(from, breaks, rate))
-    }
-}
-
-/// Any criterion.
-#[derive(Debug, Clone)]
-enum AnyCriterion {
-    Ls(Ls),
-    Bcls(Bcls),
-    Weighted(WeightedBcls),
-    Bj(BoxJenkins),
-}
-
-impl Criterion for AnyCriterion {
-    fn name(&self) -> &'static str {
-        match self {
-            AnyCriterion::Ls(c) => c.name(),
-            AnyCriterion::Bcls(c) => c.name(),
-            AnyCriterion::Weighted(c) => c.name(),
-            AnyCriterion::Bj(c) => c.name(),
-        }
-    }
-    fn models_jitter(&self) -> bool {
-        match self {
-            AnyCriterion::Ls(c) => c.models_jitter(),
-            AnyCriterion::Bcls(c) => c.models_jitter(),
-            AnyCriterion::Weighted(c) => c.models_jitter(),
-            AnyCriterion::Bj(c) => c.models_jitter(),
-        }
-    }
-    fn uses_noise_model(&self) -> bool {
-        match self {
-            AnyCriterion::Ls(c) => c.uses_noise_model(),
-            AnyCriterion::Bcls(c) => c.uses_noise_model(),
-            AnyCriterion::Weighted(c) => c.uses_noise_model(),
-            AnyCriterion::Bj(c) => c.uses_noise_model(),
-        }
-    }
-    fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, noise: &N) -> Vec<f64> {
-        match self {
-            AnyCriterion::Ls(c) => c.weights(freqs, noise),
-            AnyCriterion::Bcls(c) => c.weights(freqs, noise),
-            AnyCriterion::Weighted(c) => c.weights(freqs, noise),
-            AnyCriterion::Bj(c) => c.weights(freqs, noise),
-        }
-    }
-    fn validate(&self, freqs: &FrequencySet) -> Result<(), EstimateError> {
-        match self {
-            AnyCriterion::Ls(c) => c.validate(freqs),
-            AnyCriterion::Bcls(c) => c.validate(freqs),
-            AnyCriterion::Weighted(c) => c.validate(freqs),
-            AnyCriterion::Bj(c) => c.validate(freqs),
-        }
-    }
-}
-
-/// Any solver, each with a bounded budget.
-#[derive(Debug, Clone)]
-enum AnySolver {
-    Lm(LevenbergMarquardt),
-    Multi(MultiStart<LevenbergMarquardt>),
-    Simplex(NelderMead),
-}
-
-impl Solver for AnySolver {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
-        match self {
-            AnySolver::Lm(s) => s.minimize(problem, start),
-            AnySolver::Multi(s) => s.minimize(problem, start),
-            AnySolver::Simplex(s) => s.minimize(problem, start),
-        }
     }
 }
 
@@ -634,18 +559,18 @@ fn build_input(spec: &InputSpec) -> Option<Input> {
     }
 }
 
-fn build_criterion(spec: &CriterionSpec) -> Option<AnyCriterion> {
+fn build_criterion(spec: &CriterionSpec) -> Option<Box<dyn Criterion>> {
     Some(match spec {
-        CriterionSpec::Ls => AnyCriterion::Ls(Ls),
-        CriterionSpec::Bcls => AnyCriterion::Bcls(Bcls),
+        CriterionSpec::Ls => Box::new(Ls),
+        CriterionSpec::Bcls => Box::new(Bcls),
         CriterionSpec::Weighted(w) => match WeightedBcls::new(w.clone()) {
-            Ok(c) => AnyCriterion::Weighted(c),
+            Ok(c) => Box::new(c),
             Err(e) => {
                 note_error(&e);
                 return None;
             }
         },
-        CriterionSpec::Bj => AnyCriterion::Bj(BoxJenkins),
+        CriterionSpec::Bj => Box::new(BoxJenkins),
     })
 }
 
@@ -663,9 +588,14 @@ fn build_solver(spec: &SolverSpec) -> AnySolver {
         ..LmOptions::default()
     });
     match spec.kind {
-        0 => AnySolver::Lm(lm),
-        1 => AnySolver::Multi(MultiStart::new(lm, spec.starts, spec.radius, 7)),
-        _ => AnySolver::Simplex(NelderMead {
+        0 => AnySolver::new(lm),
+        1 => AnySolver::new(MultiStart::new(
+            AnySolver::new(lm),
+            spec.starts,
+            spec.radius,
+            7,
+        )),
+        _ => AnySolver::new(NelderMead {
             max_iters: 20 * spec.max_iters,
             ..NelderMead::default()
         }),
@@ -674,7 +604,7 @@ fn build_solver(spec: &SolverSpec) -> AnySolver {
 
 /// The invariants of an `Ok` estimate.
 fn check_estimate<S, J, N>(
-    e: &Estimate,
+    e: &Fit,
     structure: &ModelStructure<S, J, N>,
 ) -> Result<(), TestCaseError>
 where
@@ -709,7 +639,7 @@ fn run_structure<M, N>(
     case: &Case,
     structure: ModelStructure<LtiResponse<M>, AnyJitter, N>,
     record: &Record,
-    criterion: &AnyCriterion,
+    criterion: &dyn Criterion,
 ) -> Result<(), TestCaseError>
 where
     M: InitialModel,
@@ -780,7 +710,7 @@ fn run_model<M: InitialModel>(
     input: Input,
     jitter: AnyJitter,
     record: &Record,
-    criterion: &AnyCriterion,
+    criterion: &dyn Criterion,
 ) -> Result<(), TestCaseError> {
     let signal = LtiResponse::new(model, input);
     let with_std = |x: Result<_, EstimateError>| match x {
