@@ -4,10 +4,13 @@
 //! Jacobian not finite at every nearby trial point)" with `σ ≈ 2e-11`.
 
 use jitterid_estimate::montecarlo::realization_rng;
-use jitterid_estimate::solver::Termination;
-use jitterid_estimate::{estimate, Bcls, Estimate, EstimateOptions, ModelStructure, Record};
+use jitterid_estimate::solver::{LeastSquares, LevenbergMarquardt, Solver, Termination};
+use jitterid_estimate::{
+    estimate, Bcls, Estimate, EstimateOptions, FitProblem, FrequencyData, ModelStructure, Record,
+};
 use jitterid_jitter::Gaussian;
 use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
+use jitterid_window::{DirichletWindow, FrequencySet};
 use rand::rngs::StdRng;
 use rand::Rng;
 
@@ -59,5 +62,72 @@ fn scan_terminations() {
             "{r:3} converged {} σ̂ = {:.3e} ({})",
             e.converged, e.params[4], e.termination
         );
+    }
+}
+
+/// Records of the study where the width goes to 0 (15 of the 128 do; found with
+/// [`scan_terminations`]).
+const AT_BOUND: [u64; 3] = [7, 42, 105];
+
+#[test]
+fn a_width_at_zero_is_converged_at_the_bound() {
+    for r in AT_BOUND {
+        let (structure, record) = setup(r);
+        let start = structure.params();
+        // The plain solver stalls against the domain's edge (σ ≤ 0 is not a model), which is
+        // how these fits used to end.
+        let data = FrequencyData::new(
+            record.clone(),
+            DirichletWindow,
+            FrequencySet::dft(record.grid()),
+        )
+        .expect("data");
+        let problem = FitProblem {
+            structure: &structure,
+            criterion: &Bcls,
+            data: &data,
+        };
+        let stalled = LevenbergMarquardt::default()
+            .minimize(&problem, &start)
+            .expect("runs");
+        assert_eq!(stalled.termination, Termination::NonFinite, "record {r}");
+        assert!(
+            stalled.params[4] < 1e-6 * start[4],
+            "record {r}: {:?}",
+            stalled.params
+        );
+
+        let fit = fit(r);
+        assert!(fit.converged, "record {r}: {}", fit.termination);
+        assert_eq!(fit.termination, Termination::AtBound { params: vec![4] });
+        assert!(fit.params[4] > 0.0 && fit.params[4] < 1e-6 * start[4]);
+        // The other parameters were refitted with the width held: no worse than where the
+        // plain solver stalled, and a first-order stationary point of the criterion.
+        assert!(
+            fit.cost <= stalled.cost,
+            "record {r}: {} > {}",
+            fit.cost,
+            stalled.cost
+        );
+        let residuals = problem.residuals(&fit.params).expect("residuals");
+        let ne = problem
+            .normal_equations(&fit.params, &residuals)
+            .expect("normal equations");
+        for i in 0..4 {
+            // The gradient's cosine with each free column (the solver's own test, gtol 1e-10,
+            // or a cost change below ftol 1e-12 with the gradient then of order √ftol).
+            let norm_r = residuals.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let cosine = ne.gradient[i].abs() / (ne.gram[(i, i)].sqrt() * norm_r);
+            assert!(
+                cosine < 1e-5,
+                "record {r}, parameter {i}: cosine {cosine:e}"
+            );
+        }
+        // Standard errors: withheld (0) at the bound, finite and positive for the others.
+        let se = fit.std_errors.expect("covariance of the free parameters");
+        assert_eq!(se[4], 0.0);
+        assert!(se[..4].iter().all(|s| s.is_finite() && *s > 0.0), "{se:?}");
+        let covariance = fit.covariance.expect("covariance");
+        assert!(covariance[4].iter().all(|c| *c == 0.0));
     }
 }
