@@ -43,6 +43,7 @@
 
 mod any_criterion;
 mod any_noise;
+mod boundary;
 mod covariance;
 mod criterion;
 mod data;
@@ -56,6 +57,7 @@ pub mod ml;
 pub mod montecarlo;
 mod noise;
 mod objective;
+mod parseval;
 mod profile;
 pub mod registry;
 mod result;
