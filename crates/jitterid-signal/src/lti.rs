@@ -35,6 +35,11 @@ pub struct LtiResponse<M> {
     /// `O(log J + poles)`. Built on the first evaluation of `s(t)`: estimation never needs it.
     #[serde(skip)]
     prefix: OnceLock<(Vec<f64>, Vec<Complex64>)>,
+    /// Right after step `j`, per representative pole, `Y_ij = Σ_{l≤j} Δu_l (t_j − t_l)
+    /// e^{p_i (t_j − t_l)}` (row-major): with `X` it gives `∂s(t)/∂θ` in `O(log J + poles ×
+    /// params)`. Built on the first evaluation of the gradient.
+    #[serde(skip)]
+    slope_prefix: OnceLock<Vec<Complex64>>,
 }
 
 impl<M: RationalModel> LtiResponse<M> {
@@ -50,6 +55,7 @@ impl<M: RationalModel> LtiResponse<M> {
             input,
             steps,
             prefix: OnceLock::new(),
+            slope_prefix: OnceLock::new(),
         }
     }
 
@@ -77,6 +83,31 @@ impl<M: RationalModel> LtiResponse<M> {
             states.extend_from_slice(&x);
         }
         (levels, states)
+    }
+
+    /// `Y_ij` of [`slope_prefix`](Self::slope_prefix): between steps, `X ← X e^{pδ}` and
+    /// `Y ← (Y + δ X) e^{pδ}`; a new step adds `Δu` to `X` and nothing to `Y` (its `x` is 0).
+    fn slope_states(&self) -> Vec<Complex64> {
+        let poles: Vec<Complex64> = self
+            .representatives()
+            .iter()
+            .map(|&(i, _)| self.modal().poles[i])
+            .collect();
+        let (_, states) = self.prefix.get_or_init(|| self.prefix_states());
+        let np = poles.len();
+        let mut y = vec![Complex64::new(0.0, 0.0); np];
+        let mut slopes = Vec::with_capacity(states.len());
+        for j in 0..self.steps.len() {
+            if j > 0 {
+                let delta = self.steps[j].0 - self.steps[j - 1].0;
+                let x = &states[(j - 1) * np..j * np];
+                for ((yi, xi), p) in y.iter_mut().zip(x).zip(&poles) {
+                    *yi = (*yi + delta * xi) * (p * delta).exp();
+                }
+            }
+            slopes.extend_from_slice(&y);
+        }
+        slopes
     }
 
     /// The model `G`.
@@ -483,6 +514,7 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
             input: self.input.clone(),
             steps: self.steps.clone(),
             prefix: OnceLock::new(),
+            slope_prefix: OnceLock::new(),
         })
     }
 
@@ -531,20 +563,34 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                 }
             }
             Input::Piecewise(_) => {
+                // s(t) = G(0) L + Σ_i w Re((r_i/p_i) X_i(t)) with X_i(t) = Σ_l Δu_l e^{p_i x_l}, so
+                // ∂s/∂θ_j = ∂G(0)/∂θ_j L + Σ_i w Re(∂(r_i/p_i)/∂θ_j X_i(t) + (r_i/p_i) ∂p_i/∂θ_j
+                // Y_i(t)), Y_i(t) = Σ_l Δu_l x_l e^{p_i x_l}: both from the states after the last
+                // step before t.
+                let j = self.steps.partition_point(|s| s.0 <= t);
+                if j == 0 {
+                    return;
+                }
                 let m = self.modal();
                 let reps = self.representatives();
-                for &(tj, du) in self.steps.iter().take_while(|(tj, _)| *tj <= t) {
-                    let x = t - tj;
-                    for (j, g) in grad.iter_mut().enumerate() {
-                        let mut d = m.d_dc_gain[j];
-                        for &(i, w) in &reps {
-                            let (p, r) = (m.poles[i], m.residues[i]);
-                            let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
-                            let e = (p * x).exp();
-                            let d_rp = dr / p - r * dp / (p * p);
-                            d += w * (d_rp * e + r / p * x * e * dp).re;
-                        }
-                        *g += du * d;
+                let np = reps.len();
+                let (levels, states) = self.prefix.get_or_init(|| self.prefix_states());
+                let slopes = self.slope_prefix.get_or_init(|| self.slope_states());
+                let dt = t - self.steps[j - 1].0;
+                let level = levels[j - 1];
+                for (g, d) in grad.iter_mut().zip(&m.d_dc_gain) {
+                    *g = d * level;
+                }
+                for (q, &(i, w)) in reps.iter().enumerate() {
+                    let (p, r) = (m.poles[i], m.residues[i]);
+                    let e = (p * dt).exp();
+                    let x0 = states[(j - 1) * np + q];
+                    let xt = x0 * e;
+                    let yt = (slopes[(j - 1) * np + q] + dt * x0) * e;
+                    for (k, g) in grad.iter_mut().enumerate() {
+                        let (dp, dr) = (m.d_poles[i][k], m.d_residues[i][k]);
+                        let d_rp = dr / p - r * dp / (p * p);
+                        *g += w * (d_rp * xt + r / p * dp * yt).re;
                     }
                 }
             }
