@@ -38,6 +38,22 @@
 //! and the density once per jitter parameter, so a node costs two short polynomial
 //! evaluations and one exponential.
 //!
+//! # Gradient
+//!
+//! `∂ log p(y_k)/∂θ = Σ_i r_i (y_k − s_i) ∂s(t_k + τ_i)/∂θ / σ_v²` over the same nodes `τ_i`
+//! and responsibilities `r_i = w_i φ(y_k − s_i) / p(y_k)` as the value: one rule per sample
+//! serves the value and every parameter, and the signal's gradient comes from the same
+//! piecewise Chebyshev table as `s` (one channel per parameter, built from
+//! [`Signal::value_gradient`]), so no parameter is differenced. The responsibilities are the
+//! log-sum-exp's own terms, kept from the value's pass.
+//!
+//! # Threads
+//!
+//! Samples are independent, so they are shared among rayon's threads; every sample starts its
+//! table searches afresh, so its terms do not depend on which thread computed it or what that
+//! thread computed before, and the sums over samples are taken afterwards in sample order.
+//! Values and gradients are therefore bit-identical for any number of threads.
+//!
 //! # Robustness
 //!
 //! Terms are summed relative to the largest exponent, and recomputed with the logarithms of
