@@ -109,6 +109,9 @@ fn chebyshev_to_monomial(c: &[f64]) -> [f64; CHEB_POINTS] {
     out
 }
 
+/// Channels whose Clenshaw recurrences [`PiecewiseCheb::eval_all`] runs side by side.
+const INTERLEAVED: usize = 8;
+
 /// Largest number of halvings of one input interval.
 const MAX_DEPTH: u32 = 12;
 
@@ -232,27 +235,35 @@ impl PiecewiseCheb {
         Some(s)
     }
 
-    /// Channel 0 at 16 points of one segment `seg` (Horner in the monomial basis, 16 lanes).
+    /// Channel 0 at the points `ts[lanes]` of one segment `seg`, into `out[lanes]` (Horner in
+    /// the monomial basis, one lane per point; only the lanes asked for are computed).
     #[inline]
-    pub(crate) fn eval0_16(&self, seg: usize, ts: &[f64; 16], out: &mut [f64; 16]) {
+    fn eval0_lanes(
+        &self,
+        seg: usize,
+        ts: &[f64; 16],
+        out: &mut [f64; 16],
+        lanes: std::ops::Range<usize>,
+    ) {
         let (a, b) = (self.starts[seg], self.ends[seg]);
         let (mid, scale) = (0.5 * (a + b), 2.0 / (b - a));
         let m = &self.mono0[seg];
+        let ts = &ts[lanes.clone()];
+        let acc = &mut out[lanes];
         let mut x = [0.0; 16];
-        for i in 0..16 {
-            x[i] = ((ts[i] - mid) * scale).clamp(-1.0, 1.0);
+        for ((xi, &t), ai) in x.iter_mut().zip(ts).zip(acc.iter_mut()) {
+            *xi = ((t - mid) * scale).clamp(-1.0, 1.0);
+            *ai = m[CHEB_POINTS - 1];
         }
-        let mut acc = [m[CHEB_POINTS - 1]; 16];
         for &mk in m[..CHEB_POINTS - 1].iter().rev() {
-            for i in 0..16 {
-                acc[i] = acc[i] * x[i] + mk;
+            for (ai, &xi) in acc.iter_mut().zip(&x) {
+                *ai = *ai * xi + mk;
             }
         }
-        *out = acc;
     }
 
     /// Channel 0 at 16 increasing points, which may span several segments: each run of points
-    /// in one segment is evaluated by the vectorised Clenshaw. Points outside the table are
+    /// in one segment is evaluated by Horner's rule, lane by lane. Points outside the table are
     /// flagged `false` in the returned mask (their values are left untouched).
     #[inline]
     pub(crate) fn eval0_sorted16(
@@ -263,7 +274,6 @@ impl PiecewiseCheb {
     ) -> [bool; 16] {
         let mut ok = [false; 16];
         let mut i = 0;
-        let mut tmp = [0.0; 16];
         while i < 16 {
             let Some(seg) = self.segment_near(ts[i], hint) else {
                 i += 1;
@@ -277,8 +287,7 @@ impl PiecewiseCheb {
             if j - i == 1 {
                 out[i] = self.eval0(seg, ts[i]);
             } else {
-                self.eval0_16(seg, ts, &mut tmp);
-                out[i..j].copy_from_slice(&tmp[i..j]);
+                self.eval0_lanes(seg, ts, out, i..j);
             }
             ok[i..j].iter_mut().for_each(|o| *o = true);
             i = j;
@@ -300,14 +309,31 @@ impl PiecewiseCheb {
         clenshaw(&self.coefs[base..base + CHEB_POINTS], x)
     }
 
-    /// Every channel at `t` in segment `seg`.
+    /// Every channel at `t` in segment `seg`: [`clenshaw`] for up to [`INTERLEAVED`] channels
+    /// at a time, their recurrences interleaved (independent chains keep the floating-point
+    /// units busy; each channel's operations and their order are those of `clenshaw`, so the
+    /// values are the same to the bit).
     #[inline]
     pub(crate) fn eval_all(&self, seg: usize, t: f64, out: &mut [f64]) {
         let x = self.local(seg, t);
+        let x2 = 2.0 * x;
         let base = seg * self.channels * CHEB_POINTS;
-        for (c, o) in out.iter_mut().enumerate().take(self.channels) {
-            let s = base + c * CHEB_POINTS;
-            *o = clenshaw(&self.coefs[s..s + CHEB_POINTS], x);
+        let coefs = &self.coefs[base..base + self.channels * CHEB_POINTS];
+        let n = out.len().min(self.channels);
+        for (group, outs) in out[..n].chunks_mut(INTERLEAVED).enumerate() {
+            let first = group * INTERLEAVED;
+            let mut b1 = [0.0; INTERLEAVED];
+            let mut b2 = [0.0; INTERLEAVED];
+            for j in (1..CHEB_POINTS).rev() {
+                for c in 0..outs.len() {
+                    let b0 = coefs[(first + c) * CHEB_POINTS + j] + x2 * b1[c] - b2[c];
+                    b2[c] = b1[c];
+                    b1[c] = b0;
+                }
+            }
+            for (c, o) in outs.iter_mut().enumerate() {
+                *o = coefs[(first + c) * CHEB_POINTS] + x * b1[c] - b2[c];
+            }
         }
     }
 }
@@ -367,6 +393,29 @@ mod tests {
                 "{i}: {} vs {c}",
                 out[i]
             );
+        }
+    }
+
+    #[test]
+    fn interleaved_channels_equal_clenshaw_to_the_bit() {
+        // 11 channels: one full group of 8 and a partial group of 3.
+        let f = |t: f64, out: &mut [f64]| {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = (-(c as f64 + 1.0) * t).exp() * (2.0 * t + c as f64).sin();
+            }
+        };
+        let table = PiecewiseCheb::build(&[(0.0, 2.0)], 11, 1e-13, f);
+        let mut out = [0.0; 11];
+        for k in 0..=50 {
+            let t = k as f64 / 25.0;
+            let seg = table.segment(t).unwrap();
+            table.eval_all(seg, t, &mut out);
+            let x = table.local(seg, t);
+            for (c, &v) in out.iter().enumerate() {
+                let s = (seg * 11 + c) * CHEB_POINTS;
+                let direct = clenshaw(&table.coefs[s..s + CHEB_POINTS], x);
+                assert_eq!(v.to_bits(), direct.to_bits(), "t = {t}, channel {c}");
+            }
         }
     }
 

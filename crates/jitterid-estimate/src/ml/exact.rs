@@ -38,6 +38,22 @@
 //! and the density once per jitter parameter, so a node costs two short polynomial
 //! evaluations and one exponential.
 //!
+//! # Gradient
+//!
+//! `∂ log p(y_k)/∂θ = Σ_i r_i (y_k − s_i) ∂s(t_k + τ_i)/∂θ / σ_v²` over the same nodes `τ_i`
+//! and responsibilities `r_i = w_i φ(y_k − s_i) / p(y_k)` as the value: one rule per sample
+//! serves the value and every parameter, and the signal's gradient comes from the same
+//! piecewise Chebyshev table as `s` (one channel per parameter, built from
+//! [`Signal::value_gradient`]), so no parameter is differenced. The responsibilities are the
+//! log-sum-exp's own terms, kept from the value's pass.
+//!
+//! # Threads
+//!
+//! Samples are independent, so they are shared among rayon's threads; every sample starts its
+//! table searches afresh, so its terms do not depend on which thread computed it or what that
+//! thread computed before, and the sums over samples are taken afterwards in sample order.
+//! Values and gradients are therefore bit-identical for any number of threads.
+//!
 //! # Robustness
 //!
 //! Terms are summed relative to the largest exponent, and recomputed with the logarithms of
@@ -327,6 +343,12 @@ pub(crate) struct Scratch {
     steep: Vec<Steep>,
     cut: Vec<(f64, f64)>,
     ch: Vec<f64>,
+    /// `[s, ∂s/∂θ…]` at one node.
+    chans: Vec<f64>,
+    /// `w_i e^{−(y − s_i)²/(2σ²) − max}` of the log-sum-exp, kept for the gradient.
+    terms: Vec<f64>,
+    /// `h e ∂s/∂θ_j` at the shortcut's 16 nodes, per parameter.
+    node_gradients: Vec<[f64; CHEB_POINTS]>,
     sig_hint: usize,
     pdf_hint: usize,
 }
@@ -359,6 +381,11 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         scratch: &mut Scratch,
     ) -> f64 {
         let jp = self.jitter;
+        // Segment searches start afresh for every sample: a node on the boundary of two table
+        // segments then takes the same segment whichever samples this thread saw before, so a
+        // sample's value does not depend on how samples are shared between threads.
+        scratch.sig_hint = 0;
+        scratch.pdf_hint = 0;
         let local = local_breaks(self.breaks, t, jp.lo, jp.hi);
         if self.opts.shortcut && local.is_empty() {
             if let Some(mu) = &jp.moments {
@@ -455,8 +482,11 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                     / total
             };
             if ns > 0 {
-                let mut chans = vec![0.0; 1 + self.signal.grad_channels];
-                let mut g = vec![[0.0; CHEB_POINTS]; ns];
+                let mut chans = std::mem::take(&mut scratch.chans);
+                chans.resize(1 + self.signal.grad_channels, 0.0);
+                let mut g = std::mem::take(&mut scratch.node_gradients);
+                g.clear();
+                g.resize(ns, [0.0; CHEB_POINTS]);
                 for (i, &x) in b.nodes.iter().enumerate() {
                     self.signal
                         .all(t + mid + half * x, &mut chans, &mut scratch.sig_hint);
@@ -467,6 +497,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 for j in 0..ns {
                     scratch.ch[j] = dot(&g[j]) / (sigma * sigma);
                 }
+                scratch.chans = chans;
+                scratch.node_gradients = g;
             }
             let mut q = [0.0; CHEB_POINTS];
             for i in 0..CHEB_POINTS {
@@ -710,12 +742,13 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             return f64::NEG_INFINITY;
         }
         let mut total = 0.0;
+        scratch.terms.clear();
         for (&s, &w) in scratch.s.iter().zip(&scratch.w) {
             let e = y - s;
             let q = -e * e * inv2 - lmax;
-            if q > -745.0 {
-                total += w * q.exp();
-            }
+            let term = if q > -745.0 { w * q.exp() } else { 0.0 };
+            total += term;
+            scratch.terms.push(term);
         }
         let mut shift = lmax;
         let mut use_logs = false;
@@ -737,13 +770,14 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         if let Some(g) = grad {
             let ns = g.len() - 1;
             g.fill(0.0);
-            let mut chans = vec![0.0; 1 + self.signal.grad_channels];
+            let mut chans = std::mem::take(&mut scratch.chans);
+            chans.resize(1 + self.signal.grad_channels, 0.0);
             for i in 0..scratch.s.len() {
                 let e = y - scratch.s[i];
                 let r = if use_logs {
                     (scratch.w[i].ln() - e * e * inv2 - shift).exp() / total
                 } else {
-                    scratch.w[i] * (-e * e * inv2 - lmax).exp() / total
+                    scratch.terms[i] / total
                 };
                 if r < 1e-300 {
                     continue;
@@ -757,6 +791,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                     }
                 }
             }
+            scratch.chans = chans;
             let s2 = sigma * sigma;
             for gj in g[..ns].iter_mut() {
                 *gj /= s2;
