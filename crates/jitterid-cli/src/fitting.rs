@@ -1,8 +1,9 @@
 //! From an experiment to signals, model structures and estimates.
 
 use crate::cli_err;
-use crate::error::{CliError, CliResult};
-use crate::experiment::{input_span, Experiment, InputSpec, Method, SolverKind, SystemKind};
+use crate::error::CliResult;
+use crate::experiment::{Experiment, InputSpec, Method, SolverKind, SystemKind};
+use crate::inputs::input_span;
 use crate::models::{AnyJitter, AnyNoise, AnySignal, AnySolver};
 use jitterid::estimate::solver::{
     GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
@@ -41,10 +42,9 @@ pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> CliResult<Option<Inp
         InputSpec::Known(i) => Some(i.clone()),
         InputSpec::RandomBinary(rb) => {
             let (a, b) = input_span(&exp.grid);
-            Some(Input::Piecewise(
-                rb.generate(a, b, rng)
-                    .map_err(|e| exp.error_at("input", "mean_dwell", e))?,
-            ))
+            Some(Input::Piecewise(rb.generate(a, b, rng).map_err(|e| {
+                cli_err!("{}: [input] random-binary: {e}", exp.file)
+            })?))
         }
     })
 }
@@ -67,7 +67,7 @@ pub fn simulate_record(
     rng: &mut StdRng,
 ) -> CliResult<Simulated> {
     let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
-        .map_err(|e| exp.error_at("noise", "std", e))?;
+        .map_err(|e| cli_err!("{}: simulation: {e}", exp.file))?;
     let v = match &exp.noise.shape {
         AnyNoise::White => sim.noise.clone(),
         AnyNoise::Arma(a) => {
@@ -86,7 +86,16 @@ pub fn simulate_record(
         .zip(&sim.noise)
         .zip(&v)
         .map(|((y, e), v)| y - e + v)
-        .collect();
+        .collect::<Vec<f64>>();
+    // The door refuses values outside the representable range; this catches a combination of
+    // values inside it that still overflows, rather than writing NaN samples.
+    if let Some(k) = y.iter().position(|x| !x.is_finite()) {
+        return Err(cli_err!(
+            "{}: sample {k} of the simulated record is {}: the experiment's values are beyond what double precision can simulate",
+            exp.file,
+            y[k]
+        ));
+    }
     Ok(Simulated { y, tau: sim.tau, v })
 }
 
@@ -121,49 +130,8 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
         Ok(s)
     } else {
         s.with_noise_std(exp.noise.std)
-            .map_err(|e| exp.error_at("noise", "std", e))
+            .map_err(|e| cli_err!("{}: [noise] std: {e}", exp.file))
     }
-}
-
-/// Checks that the experiment can be fitted with `method`.
-pub fn check_method(exp: &Experiment, method: Method, from_command_line: bool) -> CliResult<()> {
-    let blame = |msg: String| -> CliError {
-        if from_command_line {
-            cli_err!("--method {}: {msg}", method.as_str())
-        } else {
-            exp.error_at("estimate", "method", msg)
-        }
-    };
-    if method == Method::Ml && !cfg!(feature = "ml") {
-        return Err(blame(
-            "maximum likelihood is not available in this build of jitterid (built without the `ml` feature); use \"bcls\" (or \"ls\", \"bj\")".into(),
-        ));
-    }
-    if method == Method::Ls && exp.jitter.estimate {
-        return Err(blame(
-            "naive least squares ignores the jitter and cannot estimate it; use \"bcls\" or set [jitter] estimate = false".into(),
-        ));
-    }
-    if !exp.system.estimate && !exp.jitter.estimate && !exp.noise.estimate {
-        return Err(exp.error_at(
-            "system",
-            "estimate",
-            "nothing to estimate: set estimate = true in [system], [jitter] or [noise]",
-        ));
-    }
-    if !exp.system.estimate && !exp.jitter.estimate {
-        return Err(exp.error_at(
-            "system",
-            "estimate",
-            "only the noise level is marked for estimation; it is estimated together with the system or the jitter, so set estimate = true in [system] or [jitter]",
-        ));
-    }
-    if method == Method::Ls && !exp.system.estimate {
-        return Err(blame(
-            "naive least squares has nothing to estimate when the system is known".into(),
-        ));
-    }
-    Ok(())
 }
 
 /// The solver of the experiment; `seed` seeds multistart perturbations.
