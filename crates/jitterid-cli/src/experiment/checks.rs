@@ -165,3 +165,72 @@ pub(super) fn describe(v: &toml::Value) -> String {
         toml::Value::Table(_) => "a table".to_string(),
     }
 }
+
+/// Values of a table read without a fixed set of keys (a section whose keys depend on a
+/// choice made in it): each read names the key when the type is wrong.
+impl Source<'_> {
+    fn wrong_type(
+        &self,
+        section: &str,
+        key: &str,
+        v: &Spanned<toml::Value>,
+        what: &str,
+    ) -> crate::error::CliError {
+        self.err(
+            section,
+            key,
+            &v.span(),
+            format!("expected {what}, found {}", describe(v.get_ref())),
+        )
+    }
+
+    /// A finite number (an integer is taken as a real).
+    pub(super) fn number_value(
+        &self,
+        section: &str,
+        key: &str,
+        v: &Spanned<toml::Value>,
+    ) -> CliResult<f64> {
+        let x = number(v.get_ref()).ok_or_else(|| self.wrong_type(section, key, v, "a number"))?;
+        finite_value(x).map_err(|m| self.err(section, key, &v.span(), m))
+    }
+
+    /// A whole number.
+    pub(super) fn integer_value(
+        &self,
+        section: &str,
+        key: &str,
+        v: &Spanned<toml::Value>,
+    ) -> CliResult<i64> {
+        match v.get_ref() {
+            toml::Value::Integer(i) => Ok(*i),
+            _ => Err(self.wrong_type(section, key, v, "a whole number")),
+        }
+    }
+
+    /// `true` or `false`.
+    pub(super) fn bool_value(
+        &self,
+        section: &str,
+        key: &str,
+        v: &Spanned<toml::Value>,
+    ) -> CliResult<bool> {
+        match v.get_ref() {
+            toml::Value::Boolean(b) => Ok(*b),
+            _ => Err(self.wrong_type(section, key, v, "true or false")),
+        }
+    }
+
+    /// A string.
+    pub(super) fn string_value<'v>(
+        &self,
+        section: &str,
+        key: &str,
+        v: &'v Spanned<toml::Value>,
+    ) -> CliResult<&'v str> {
+        match v.get_ref() {
+            toml::Value::String(s) => Ok(s),
+            _ => Err(self.wrong_type(section, key, v, "a string")),
+        }
+    }
+}

@@ -134,13 +134,21 @@ fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-fn suggestion(unknown: &str, known: &[&'static str]) -> Option<&'static str> {
+fn suggestion<'k>(unknown: &str, known: &[&'k str]) -> Option<&'k str> {
     known
         .iter()
         .map(|k| (edit_distance(unknown, k), *k))
         .filter(|(d, k)| *d <= 2 && *d < k.len())
         .min()
         .map(|x| x.1)
+}
+
+/// "unknown key `name`", with the closest of `known` as a suggestion, and the `list` expected.
+pub(super) fn unknown_key(name: &str, known: &[&str], list: &str) -> String {
+    match suggestion(name, known) {
+        Some(s) => format!("unknown key `{name}` (did you mean `{s}`?); expected one of {list}"),
+        None => format!("unknown key `{name}`; expected one of {list}"),
+    }
 }
 
 /// Turns a TOML/serde error into one located line.
@@ -158,12 +166,7 @@ pub(super) fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> CliErro
             .map(|k| k.to_string())
             .collect::<Vec<_>>()
             .join(", ");
-        msg = match suggestion(&name, known) {
-            Some(s) => {
-                format!("unknown key `{name}` (did you mean `{s}`?); expected one of {list}")
-            }
-            None => format!("unknown key `{name}`; expected one of {list}"),
-        };
+        msg = unknown_key(&name, known, &list);
         key = None;
     } else if let Some(rest) = msg.strip_prefix("missing field `") {
         let name = rest.split('`').next().unwrap_or("");

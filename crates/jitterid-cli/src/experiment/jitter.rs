@@ -1,8 +1,13 @@
 //! `[jitter]`: the family of the truth and of the model.
+//!
+//! The section is read without a fixed set of keys: besides the command line's own keys
+//! (`family`, `estimate`, `offset`, `fit_family`, `n_range`) its keys are the chosen family's
+//! parameters, described by [`FamilyParam`]s, so that a family brings its keys with it.
 
-use super::diagnostics::Source;
+use super::checks::describe;
+use super::diagnostics::{unknown_key, Source};
 use super::range;
-use super::raw::RawJitter;
+use super::raw::RawTable;
 use super::spec::JitterSpec;
 use crate::error::{CliError, CliResult};
 use crate::models::AnyJitter;
@@ -11,55 +16,91 @@ use jitterid::jitter::{
     UniformSum,
 };
 use jitterid::signal::SampleGrid;
+use std::collections::BTreeMap;
 use toml::Spanned;
 
 const S: &str = "jitter";
-const FAMILIES: &str =
-    "\"none\", \"uniform-sum\", \"gaussian\", \"laplace\", \"two-point\" or \"exponential\"";
+/// The keys of `[jitter]` that belong to the command line, not to a family.
+const OWN_KEYS: &[&str] = &["family", "estimate", "offset", "fit_family", "n_range"];
 
-/// The keys that carry a family's parameters.
-fn family_keys(family: &str) -> Option<&'static [&'static str]> {
-    Some(match family {
-        "none" => &[],
-        "uniform-sum" => &["n", "a"],
-        "gaussian" => &["sigma"],
-        "laplace" => &["scale"],
-        "two-point" => &["d"],
-        "exponential" => &["mean"],
-        _ => return None,
-    })
+/// One parameter key of a family, as the experiment file gives it.
+#[derive(Debug, Clone, Copy)]
+struct FamilyParam {
+    key: &'static str,
+    /// A whole number (the uniform sum's `n`); otherwise a time scale in seconds.
+    integer: bool,
+    default: Option<f64>,
 }
 
-pub(super) fn parse_jitter(cx: &Source, r: &RawJitter, grid: &SampleGrid) -> CliResult<JitterSpec> {
-    let fam = cx.required(
-        S,
-        "family",
-        &r.family,
-        &format!("expected family = {FAMILIES}"),
-    )?;
-    let family = fam.get_ref().as_str();
-    let Some(own) = family_keys(family) else {
-        return Err(cx.err(
+const fn time(key: &'static str) -> FamilyParam {
+    FamilyParam {
+        key,
+        integer: false,
+        default: None,
+    }
+}
+
+/// The families, each with its parameter keys.
+const FAMILIES: &[(&str, &[FamilyParam])] = &[
+    ("none", &[]),
+    (
+        "uniform-sum",
+        &[
+            FamilyParam {
+                key: "n",
+                integer: true,
+                default: Some(0.0),
+            },
+            time("a"),
+        ],
+    ),
+    ("gaussian", &[time("sigma")]),
+    ("laplace", &[time("scale")]),
+    ("two-point", &[time("d")]),
+    ("exponential", &[time("mean")]),
+];
+
+fn family_params(name: &str) -> Option<&'static [FamilyParam]> {
+    FAMILIES.iter().find(|(n, _)| *n == name).map(|f| f.1)
+}
+
+fn family_names() -> String {
+    let names: Vec<String> = FAMILIES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+    names.join(", ")
+}
+
+pub(super) fn parse_jitter(cx: &Source, r: &RawTable, grid: &SampleGrid) -> CliResult<JitterSpec> {
+    let why = format!("expected family = {}", family_names());
+    let fam = r
+        .get("family")
+        .ok_or_else(|| cx.err_section(S, "family", format!("missing; {why}")))?;
+    let family = cx.string_value(S, "family", fam)?;
+    let params = family_params(family).ok_or_else(|| {
+        cx.err(
             S,
             "family",
             &fam.span(),
-            format!("unknown jitter family \"{family}\"; expected {FAMILIES}"),
-        ));
-    };
-    let mut allowed = vec!["family", "estimate", "offset", "fit_family", "n_range"];
-    allowed.extend_from_slice(own);
-    cx.only(S, &r.present(), "family", &allowed, family)?;
-    let base = given_family(cx, r, family, own, grid)?;
-    let offset = match &r.offset {
-        Some(o) => Some(cx.checked(S, "offset", o, |x| range::offset(x, grid))?),
+            format!("unknown jitter family \"{family}\"; {why}"),
+        )
+    })?;
+    check_keys(cx, r, family, params)?;
+    let base = build(cx, r, family, params, grid)?;
+    let offset = match r.get("offset") {
+        Some(o) => {
+            let x = cx.number_value(S, "offset", o)?;
+            Some(range::offset(x, grid).map_err(|m| cx.err(S, "offset", &o.span(), m))?)
+        }
         None => None,
     };
     let truth = shifted(cx, base.clone(), offset)?;
-    let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
-    let (model, family_differs, model_family) = match &r.fit_family {
-        Some(ff) if ff.get_ref() != family => {
-            let j = fitted_family(cx, ff, &base)?;
-            (shifted(cx, j, offset)?, true, ff.get_ref().as_str())
+    let estimate = match r.get("estimate") {
+        Some(e) => cx.bool_value(S, "estimate", e)?,
+        None => false,
+    };
+    let (model, family_differs, model_family) = match r.get("fit_family") {
+        Some(ff) if cx.string_value(S, "fit_family", ff)? != family => {
+            let (j, name) = fitted_family(cx, ff, &base)?;
+            (shifted(cx, j, offset)?, true, name)
         }
         _ => (truth.clone(), false, family),
     };
@@ -67,12 +108,12 @@ pub(super) fn parse_jitter(cx: &Source, r: &RawJitter, grid: &SampleGrid) -> Cli
         return Err(cx.err_at(
             S,
             "estimate",
-            r.estimate.as_ref(),
+            r.get("estimate"),
             format!("family \"{model_family}\" has no parameter to estimate; set estimate = false"),
         ));
     }
     let profiled = estimate && model_family == "uniform-sum" && offset.is_none();
-    let n_range = n_range(cx, r.n_range.as_ref(), profiled)?;
+    let n_range = n_range(cx, r.get("n_range"), profiled)?;
     Ok(JitterSpec {
         truth,
         model,
@@ -82,59 +123,106 @@ pub(super) fn parse_jitter(cx: &Source, r: &RawJitter, grid: &SampleGrid) -> Cli
     })
 }
 
-/// The family given by `family` and its keys `own`.
-fn given_family(
-    cx: &Source,
-    r: &RawJitter,
-    family: &str,
-    own: &[&str],
-    grid: &SampleGrid,
-) -> CliResult<AnyJitter> {
-    let why = format!("family = \"{family}\" needs {}", own.join(", "));
-    let positive = |key: &str, v: &Option<Spanned<f64>>| -> CliResult<f64> {
-        let v = cx.required(S, key, v, &why)?;
-        cx.positive(S, key, v)?;
-        cx.checked(S, key, v, |x| range::width(x, grid))
-    };
-    let jerr = |key: &'static str| move |e: JitterError| cx.err_section(S, key, e);
-    Ok(match family {
-        "uniform-sum" => {
-            let n = uniform_sum_n(cx, r.n.as_ref())?;
-            let a = positive("a", &r.a)?;
-            AnyJitter::UniformSum(UniformSum::new(n, a).map_err(jerr("a"))?)
+/// Every key is the command line's or the family's.
+fn check_keys(cx: &Source, r: &RawTable, family: &str, params: &[FamilyParam]) -> CliResult<()> {
+    let mut allowed: Vec<&str> = OWN_KEYS.to_vec();
+    allowed.extend(params.iter().map(|p| p.key));
+    for (key, v) in r {
+        if allowed.contains(&key.as_str()) {
+            continue;
         }
-        "gaussian" => {
-            AnyJitter::Gaussian(Gaussian::new(positive("sigma", &r.sigma)?).map_err(jerr("sigma"))?)
-        }
-        "laplace" => {
-            AnyJitter::Laplace(Laplace::new(positive("scale", &r.scale)?).map_err(jerr("scale"))?)
-        }
-        "two-point" => AnyJitter::TwoPoint(TwoPoint::new(positive("d", &r.d)?).map_err(jerr("d"))?),
-        "exponential" => AnyJitter::Exponential(
-            ExponentialDelay::new(positive("mean", &r.mean)?).map_err(jerr("mean"))?,
-        ),
-        // `family_keys` accepted the name, and the only other accepted name is "none".
-        _ => AnyJitter::None(NoJitter),
-    })
+        let of_another = FAMILIES
+            .iter()
+            .any(|(_, ps)| ps.iter().any(|p| p.key == key));
+        let msg = if of_another {
+            format!(
+                "not a key of family = \"{family}\"; expected {}",
+                allowed.join(", ")
+            )
+        } else {
+            let mut known: Vec<&str> = OWN_KEYS.to_vec();
+            known.extend(FAMILIES.iter().flat_map(|(_, ps)| ps.iter().map(|p| p.key)));
+            unknown_key(key, &known, &allowed.join(", "))
+        };
+        return Err(cx.err(S, key, &v.span(), msg));
+    }
+    Ok(())
 }
 
-fn uniform_sum_n(cx: &Source, v: Option<&Spanned<i64>>) -> CliResult<u32> {
-    let Some(v) = v else { return Ok(0) };
-    let n = *v.get_ref();
-    u32::try_from(n)
-        .ok()
-        .filter(|n| *n <= UniformSum::MAX_N)
-        .ok_or_else(|| {
-            cx.err(
-                S,
-                "n",
-                &v.span(),
-                format!(
-                    "expected a whole number in [0, {}], found {n}",
-                    UniformSum::MAX_N
-                ),
-            )
-        })
+/// The family's parameters from the file: whole numbers where the family says so, time
+/// scales within the representable range otherwise.
+fn param_values<'p>(
+    cx: &Source,
+    r: &RawTable,
+    family: &str,
+    params: &'p [FamilyParam],
+    grid: &SampleGrid,
+) -> CliResult<BTreeMap<&'p str, f64>> {
+    let needs: Vec<&str> = params.iter().map(|p| p.key).collect();
+    let why = format!("missing; family = \"{family}\" needs {}", needs.join(", "));
+    let mut out = BTreeMap::new();
+    for p in params {
+        let x = match (r.get(p.key), p.default) {
+            (None, Some(d)) => d,
+            (None, None) => return Err(cx.err_section(S, p.key, &why)),
+            (Some(v), _) if p.integer => cx.integer_value(S, p.key, v)? as f64,
+            (Some(v), _) => {
+                let x = cx.number_value(S, p.key, v)?;
+                if !(x > 0.0) {
+                    return Err(cx.err(
+                        S,
+                        p.key,
+                        &v.span(),
+                        format!("expected a number > 0, found {x}"),
+                    ));
+                }
+                range::width(x, grid).map_err(|m| cx.err(S, p.key, &v.span(), m))?
+            }
+        };
+        out.insert(p.key, x);
+    }
+    Ok(out)
+}
+
+/// The family `family` with the file's parameters; a constructor's refusal names its key.
+fn build(
+    cx: &Source,
+    r: &RawTable,
+    family: &str,
+    params: &[FamilyParam],
+    grid: &SampleGrid,
+) -> CliResult<AnyJitter> {
+    let v = param_values(cx, r, family, params, grid)?;
+    let at = |key: &'static str| move |e: JitterError| cx.err_at(S, key, r.get(key), e);
+    let x = |key: &str| v.get(key).copied().unwrap_or(f64::NAN);
+    Ok(match family {
+        "uniform-sum" => {
+            let n = x("n");
+            let n = u32::try_from(n as i64)
+                .ok()
+                .filter(|n| *n <= UniformSum::MAX_N)
+                .ok_or_else(|| {
+                    cx.err_at(
+                        S,
+                        "n",
+                        r.get("n"),
+                        format!(
+                            "expected a whole number in [0, {}], found {n}",
+                            UniformSum::MAX_N
+                        ),
+                    )
+                })?;
+            AnyJitter::UniformSum(UniformSum::new(n, x("a")).map_err(at("a"))?)
+        }
+        "gaussian" => AnyJitter::Gaussian(Gaussian::new(x("sigma")).map_err(at("sigma"))?),
+        "laplace" => AnyJitter::Laplace(Laplace::new(x("scale")).map_err(at("scale"))?),
+        "two-point" => AnyJitter::TwoPoint(TwoPoint::new(x("d")).map_err(at("d"))?),
+        "exponential" => {
+            AnyJitter::Exponential(ExponentialDelay::new(x("mean")).map_err(at("mean"))?)
+        }
+        // `family_params` accepted the name, and the only other name is "none".
+        _ => AnyJitter::None(NoJitter),
+    })
 }
 
 /// `j` moved by the constant `offset`, if one is given.
@@ -148,19 +236,27 @@ fn shifted(cx: &Source, j: AnyJitter, offset: Option<f64>) -> CliResult<AnyJitte
 }
 
 /// The model's family `fit_family`, started at the standard deviation of the given `base`.
-fn fitted_family(cx: &Source, ff: &Spanned<String>, base: &AnyJitter) -> CliResult<AnyJitter> {
-    let name = ff.get_ref().as_str();
+fn fitted_family<'v>(
+    cx: &Source,
+    ff: &'v Spanned<toml::Value>,
+    base: &AnyJitter,
+) -> CliResult<(AnyJitter, &'v str)> {
+    let name = cx.string_value(S, "fit_family", ff)?;
     let fail = |m: String| -> CliError { cx.err(S, "fit_family", &ff.span(), m) };
-    if family_keys(name).is_none() {
+    if family_params(name).is_none() {
         return Err(fail(format!(
-            "unknown jitter family \"{name}\"; expected {FAMILIES}"
+            "unknown jitter family \"{name}\"; expected {}",
+            family_names()
         )));
     }
     let n = match base {
         AnyJitter::UniformSum(u) => u.n(),
         _ => 0,
     };
-    family_with_std(name, base.std_dev(), n).map_err(fail)
+    Ok((
+        family_with_std(name, base.std_dev(), n).map_err(fail)?,
+        name,
+    ))
 }
 
 /// A family with the standard deviation `sigma` (for `fit_family`); `n` for the uniform sum.
@@ -180,27 +276,41 @@ fn family_with_std(family: &str, sigma: f64, n: u32) -> Result<AnyJitter, String
         "laplace" => AnyJitter::Laplace(Laplace::new(sigma / 2f64.sqrt()).map_err(e)?),
         "two-point" => AnyJitter::TwoPoint(TwoPoint::new(sigma).map_err(e)?),
         "exponential" => AnyJitter::Exponential(ExponentialDelay::new(sigma).map_err(e)?),
-        other => return Err(format!("unknown family \"{other}\"; expected {FAMILIES}")),
+        other => {
+            return Err(format!(
+                "unknown family \"{other}\"; expected {}",
+                family_names()
+            ))
+        }
     })
 }
 
 /// The range of `n` profiled over: given, or `[0, 9]`, and only for a profiled uniform sum.
 fn n_range(
     cx: &Source,
-    v: Option<&Spanned<Vec<i64>>>,
+    v: Option<&Spanned<toml::Value>>,
     profiled: bool,
 ) -> CliResult<Option<(u32, u32)>> {
+    let max = i64::from(UniformSum::MAX_N);
+    let expected = format!("expected [min, max] with 0 <= min <= max <= {max}");
     match (v, profiled) {
         (Some(v), true) => {
-            let l = v.get_ref();
-            let max = i64::from(UniformSum::MAX_N);
-            let ok = l.len() == 2 && l[0] >= 0 && l[0] <= l[1] && l[1] <= max;
+            let l: Vec<i64> = match v.get_ref() {
+                toml::Value::Array(a) => a.iter().filter_map(|x| x.as_integer()).collect(),
+                _ => Vec::new(),
+            };
+            let whole = matches!(v.get_ref(), toml::Value::Array(a) if a.len() == l.len());
+            let ok = whole && l.len() == 2 && l[0] >= 0 && l[0] <= l[1] && l[1] <= max;
             if !ok {
                 return Err(cx.err(
                     S,
                     "n_range",
                     &v.span(),
-                    format!("expected [min, max] with 0 <= min <= max <= {max}, found {l:?}"),
+                    if whole {
+                        format!("{expected}, found {l:?}")
+                    } else {
+                        format!("{expected}, found {}", describe(v.get_ref()))
+                    },
                 ));
             }
             Ok(Some((l[0] as u32, l[1] as u32)))

@@ -2,8 +2,13 @@
 //! keys rejected. Nothing here judges a value; that is the section parsers' job.
 
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::ops::Range;
 use toml::Spanned;
+
+/// A section whose keys depend on a choice made in it (`[jitter]`: the family's keys): every
+/// value spanned, the keys judged by the section's parser.
+pub(super) type RawTable = BTreeMap<String, Spanned<toml::Value>>;
 
 macro_rules! section {
     ($name:ident, $title:literal { $($field:ident : $ty:ty),* $(,)? }) => {
@@ -63,20 +68,6 @@ section!(RawSystem, "table [system]" {
     estimate: bool,
 });
 
-section!(RawJitter, "table [jitter]" {
-    family: String,
-    n: i64,
-    a: f64,
-    sigma: f64,
-    scale: f64,
-    d: f64,
-    mean: f64,
-    offset: f64,
-    estimate: bool,
-    fit_family: String,
-    n_range: Vec<i64>,
-});
-
 section!(RawNoise, "table [noise]" {
     std: f64,
     model: String,
@@ -107,7 +98,7 @@ pub(super) struct RawExperiment {
     #[serde(default)]
     pub(super) system: Option<RawSystem>,
     #[serde(default)]
-    pub(super) jitter: Option<RawJitter>,
+    pub(super) jitter: Option<RawTable>,
     #[serde(default)]
     pub(super) noise: Option<RawNoise>,
     #[serde(default)]
@@ -123,7 +114,6 @@ pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
         "sampling" => RawSampling::KEYS,
         "input" => RawInput::KEYS,
         "system" => RawSystem::KEYS,
-        "jitter" => RawJitter::KEYS,
         "noise" => RawNoise::KEYS,
         "estimate" => RawEstimate::KEYS,
         _ => SECTIONS,
