@@ -1,10 +1,10 @@
 //! Experiment files (TOML): read once, validated once, into an [`Experiment`].
 //!
-//! The way in runs one direction: [`raw`] holds the file as written (serde types),
-//! the section parsers judge each value and build the library's models, [`method`] checks
+//! The way in runs one direction: `raw` holds the file as written (serde types),
+//! the section parsers judge each value and build the library's models, `method` checks
 //! that the method can fit what is marked as estimated, and the result is an [`Experiment`]
 //! that no command has to question again. Every error is one line that names the file, the
-//! line and the key, and says what was expected ([`diagnostics`]). The key names are
+//! line and the key, and says what was expected (`diagnostics`). The key names are
 //! documented in `docs/experiments.md`.
 
 mod checks;

@@ -130,7 +130,9 @@ pub struct EstimateSpec {
     pub max_iterations: Option<u64>,
 }
 
-/// A validated experiment.
+/// A validated experiment: every value is within the representable range, every model is
+/// built, and (when read for estimation) `estimate.method` can fit what is marked as
+/// estimated. Commands use it as it is; nothing in it is checked again.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Experiment {
     /// The file's name, for messages.
