@@ -113,6 +113,21 @@ fn a_transfer_function_with_an_integrator_like_pole_is_refused_at_den() {
 }
 
 #[test]
+fn cr_only_line_endings_are_named() {
+    let text = table2_with("title", "title = \"t\"").replace('\n', "\r");
+    refused("cr-only", &text, &["e.toml:", "CR only"]);
+}
+
+#[test]
+fn crlf_line_endings_are_read() {
+    let (o, _) = simulate(
+        "crlf",
+        &table2_with("title", "title = \"t\"").replace('\n', "\r\n"),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
 fn values_inside_the_range_still_simulate_finite_samples() {
     // The edges of the documented range: the slowest and fastest poles, the smallest gain.
     for (i, (from, to)) in [

@@ -68,6 +68,13 @@ pub fn read(path: &Path, purpose: Purpose) -> CliResult<Experiment> {
 /// Parses and validates experiment text for `purpose`; `file` names it in messages, `dir`
 /// resolves relative paths.
 pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<Experiment> {
+    // TOML knows LF and CRLF only; a lone CR would be reported as a stray character on line 1.
+    let bytes = text.as_bytes();
+    if (0..bytes.len()).any(|i| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
+        return Err(cli_err!(
+            "{file}: line endings are CR only; expected LF or CRLF line endings (a TOML file)"
+        ));
+    }
     if let Some(e) = shape_error(file, text) {
         return Err(e);
     }
