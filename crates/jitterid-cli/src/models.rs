@@ -140,7 +140,7 @@ impl JitterModel for AnyJitter {
     fn name(&self) -> &'static str {
         each_jitter!(self, j => j.name())
     }
-    fn param_names(&self) -> Vec<&'static str> {
+    fn param_names(&self) -> Vec<String> {
         each_jitter!(self, j => j.param_names())
     }
     fn params(&self) -> Vec<f64> {
@@ -160,8 +160,8 @@ impl JitterModel for AnyJitter {
     fn cf(&self, f: f64) -> Complex64 {
         each_jitter!(self, j => j.cf(f))
     }
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
-        each_jitter!(self, j => j.cf_gradient(f, grad))
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
+        each_jitter!(self, j => j.cf_gradient(f))
     }
     fn mgf(&self, z: Complex64) -> Option<Complex64> {
         each_jitter!(self, j => j.mgf(z))

@@ -33,7 +33,7 @@ impl JitterModel for NoJitter {
         "none"
     }
 
-    fn param_names(&self) -> Vec<&'static str> {
+    fn param_names(&self) -> Vec<String> {
         Vec::new()
     }
 
@@ -50,7 +50,9 @@ impl JitterModel for NoJitter {
         Complex64::new(1.0, 0.0)
     }
 
-    fn cf_gradient(&self, _f: f64, _grad: &mut [Complex64]) {}
+    fn cf_gradient(&self, _f: f64) -> Vec<Complex64> {
+        Vec::new()
+    }
 
     fn mgf(&self, _z: Complex64) -> Option<Complex64> {
         Some(Complex64::new(1.0, 0.0))

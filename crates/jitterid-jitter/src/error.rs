@@ -51,50 +51,84 @@ pub enum JitterError {
         /// How many were given.
         got: usize,
     },
+    /// A spec table named a family that the registry does not hold.
+    #[error("unknown jitter family \"{family}\"; expected one of {known}")]
+    UnknownFamily {
+        /// The name given.
+        family: String,
+        /// The registered names, written for a reader.
+        known: String,
+    },
+    /// A spec table lacks a key that the family needs.
+    #[error("jitter family \"{family}\" needs the key `{key}`")]
+    MissingKey {
+        /// The family.
+        family: String,
+        /// The missing key.
+        key: String,
+    },
+    /// A spec table holds a key that the family does not take.
+    #[error("jitter family \"{family}\" takes no key `{key}`; its keys are {allowed}")]
+    UnexpectedKey {
+        /// The family.
+        family: String,
+        /// The key given.
+        key: String,
+        /// The keys the family takes, written for a reader.
+        allowed: String,
+    },
+    /// A key of a spec table has a value of the wrong type, or one its family rejects.
+    #[error("jitter family \"{family}\", key `{key}`: {message}")]
+    InvalidKey {
+        /// The family.
+        family: String,
+        /// The offending key (for a term of a sum or a mixture, `terms.<i>.<key>`).
+        key: String,
+        /// What is wrong, for a reader.
+        message: String,
+    },
+    /// `from_std_dev` was asked of a family that has no single-spread form.
+    #[error("jitter family \"{family}\" cannot be built from a standard deviation alone")]
+    NoStdDevForm {
+        /// The family.
+        family: String,
+    },
+    /// A family of this name is already registered.
+    #[error("a jitter family named \"{family}\" is already registered")]
+    DuplicateFamily {
+        /// The name.
+        family: String,
+    },
+    /// A gradient buffer of the wrong length was given to `cf_gradient`.
+    #[error(
+        "jitter model `{model}` has {expected} parameter(s) but the gradient buffer holds {got}"
+    )]
+    WrongGradientLength {
+        /// The model's name.
+        model: &'static str,
+        /// How many parameters it has.
+        expected: usize,
+        /// The buffer's length.
+        got: usize,
+    },
 }
 
-/// Checks that `value` is finite; the error names the parameter.
-pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(JitterError::NotFinite { name, value })
+impl JitterError {
+    /// The key or parameter the error is about, if any: front ends use it to point at the
+    /// offending entry of an input file.
+    pub fn key(&self) -> Option<&str> {
+        match self {
+            JitterError::NotFinite { name, .. }
+            | JitterError::NotPositive { name, .. }
+            | JitterError::Negative { name, .. }
+            | JitterError::OutOfRange { name, .. } => Some(name),
+            JitterError::MissingKey { key, .. }
+            | JitterError::UnexpectedKey { key, .. }
+            | JitterError::InvalidKey { key, .. } => Some(key),
+            JitterError::UnknownFamily { .. } => Some("family"),
+            _ => None,
+        }
     }
 }
 
-/// Checks that `value` is finite and strictly positive.
-pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if finite(name, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(JitterError::NotPositive { name, value })
-    }
-}
-
-/// Checks that `value` is finite and not negative.
-// No built-in family has a parameter that may be 0; kept for the next one that does.
-#[allow(dead_code)]
-pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if finite(name, value)? >= 0.0 {
-        Ok(value)
-    } else {
-        Err(JitterError::Negative { name, value })
-    }
-}
-
-/// Checks the length of a parameter vector given to `with_params`.
-pub(crate) fn param_count(
-    model: &'static str,
-    expected: usize,
-    params: &[f64],
-) -> Result<(), JitterError> {
-    if params.len() == expected {
-        Ok(())
-    } else {
-        Err(JitterError::WrongParamCount {
-            model,
-            expected,
-            got: params.len(),
-        })
-    }
-}
+pub(crate) use crate::kernels::validate::{finite, param_count, positive};

@@ -74,8 +74,8 @@ impl JitterModel for ExponentialDelay {
         "exponential-delay"
     }
 
-    fn param_names(&self) -> Vec<&'static str> {
-        vec!["mean"]
+    fn param_names(&self) -> Vec<String> {
+        vec!["mean".to_string()]
     }
 
     fn params(&self) -> Vec<f64> {
@@ -91,10 +91,10 @@ impl JitterModel for ExponentialDelay {
         Self::gamma_and_complement(2.0 * PI * f * self.mean).0
     }
 
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
         // ∂γ/∂μ = -iu/(μ(1+iu)²) = -γ(1-γ)/μ.
         let (g, c) = Self::gamma_and_complement(2.0 * PI * f * self.mean);
-        grad[0] = -(g * c) / self.mean;
+        vec![-(g * c) / self.mean]
     }
 
     fn mgf(&self, z: Complex64) -> Option<Complex64> {
@@ -176,8 +176,7 @@ mod tests {
     #[test]
     fn gradient_keeps_precision_at_low_frequency() {
         let j = ExponentialDelay::new(2.0).unwrap();
-        let mut g = [Complex64::new(0.0, 0.0)];
-        j.cf_gradient(1e-10, &mut g);
+        let g = j.cf_gradient(1e-10);
         // ∂γ/∂μ = -iu/(μ(1+iu)²) ≈ -i2πf for tiny u.
         let u = 2.0 * PI * 1e-10 * 2.0;
         let exact = Complex64::new(0.0, -u) / (2.0 * Complex64::new(1.0, u).powi(2));

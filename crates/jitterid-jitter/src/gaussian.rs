@@ -68,8 +68,8 @@ impl JitterModel for Gaussian {
         "gaussian"
     }
 
-    fn param_names(&self) -> Vec<&'static str> {
-        vec!["sigma"]
+    fn param_names(&self) -> Vec<String> {
+        vec!["sigma".to_string()]
     }
 
     fn params(&self) -> Vec<f64> {
@@ -86,7 +86,7 @@ impl JitterModel for Gaussian {
         Complex64::new((-0.5 * u * u).exp(), 0.0)
     }
 
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
         // ∂γ/∂σ = -(u²/σ) γ with u = 2πσf; when γ underflows, u² may be infinite.
         let u = 2.0 * PI * self.sigma * f;
         let g = (-0.5 * u * u).exp();
@@ -95,7 +95,7 @@ impl JitterModel for Gaussian {
         } else {
             -u * u * g / self.sigma
         };
-        grad[0] = Complex64::new(d, 0.0);
+        vec![Complex64::new(d, 0.0)]
     }
 
     fn mgf(&self, z: Complex64) -> Option<Complex64> {
@@ -187,8 +187,7 @@ mod tests {
     fn cf_at_huge_frequency_is_zero_not_nan() {
         let j = Gaussian::new(1.0).unwrap();
         assert_eq!(j.cf(f64::MAX).re, 0.0);
-        let mut g = [Complex64::new(0.0, 0.0)];
-        j.cf_gradient(f64::MAX, &mut g);
+        let g = j.cf_gradient(f64::MAX);
         assert_eq!(g[0].re, 0.0);
     }
 

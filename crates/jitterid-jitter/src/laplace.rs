@@ -77,8 +77,8 @@ impl JitterModel for Laplace {
         "laplace"
     }
 
-    fn param_names(&self) -> Vec<&'static str> {
-        vec!["b"]
+    fn param_names(&self) -> Vec<String> {
+        vec!["b".to_string()]
     }
 
     fn params(&self) -> Vec<f64> {
@@ -94,10 +94,10 @@ impl JitterModel for Laplace {
         Complex64::new(Self::gamma_and_complement(2.0 * PI * f * self.b).0, 0.0)
     }
 
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
         // ∂γ/∂b = -2u²/(b(1+u²)²) = -2γ(1-γ)/b.
         let (g, c) = Self::gamma_and_complement(2.0 * PI * f * self.b);
-        grad[0] = Complex64::new(-2.0 * g * c / self.b, 0.0);
+        vec![Complex64::new(-2.0 * g * c / self.b, 0.0)]
     }
 
     fn mgf(&self, z: Complex64) -> Option<Complex64> {
@@ -177,12 +177,11 @@ mod tests {
         let j = Laplace::new(1.0).unwrap();
         let u = 2.0 * PI * 1e-9;
         // 1 - γ = u² / (1 + u²) must keep full relative precision.
-        let mut g = [Complex64::new(0.0, 0.0)];
-        j.cf_gradient(1e-9, &mut g);
+        let g = j.cf_gradient(1e-9);
         let exact = -2.0 * u * u / (1.0 + u * u).powi(2);
         assert!((g[0].re - exact).abs() < 1e-15 * exact.abs());
         assert_eq!(j.cf(f64::MAX).re, 0.0);
-        j.cf_gradient(f64::MAX, &mut g);
+        let g = j.cf_gradient(f64::MAX);
         assert_eq!(g[0].re, 0.0);
     }
 

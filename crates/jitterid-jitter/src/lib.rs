@@ -37,8 +37,11 @@
 //! windows and estimators take any `JitterModel`. See `docs/extending.md`.
 #![warn(missing_docs)]
 
+mod any;
 mod error;
+pub mod kernels;
 mod model;
+pub mod registry;
 pub mod rule;
 pub mod testing;
 
@@ -50,6 +53,7 @@ mod shifted;
 mod two_point;
 mod uniform_sum;
 
+pub use any::AnyJitter;
 pub use dirac::NoJitter;
 pub use error::JitterError;
 pub use exponential::ExponentialDelay;

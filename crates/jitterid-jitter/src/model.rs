@@ -1,3 +1,4 @@
+pub(crate) use crate::kernels::complex::{cexp, phasor};
 use crate::rule::{build_rule, build_rule_from, QuadratureRule};
 use crate::JitterError;
 use num_complex::Complex64;
@@ -31,7 +32,7 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
     fn name(&self) -> &'static str;
 
     /// Names of the continuous parameters `θ`, in the order of [`params`](Self::params).
-    fn param_names(&self) -> Vec<&'static str>;
+    fn param_names(&self) -> Vec<String>;
 
     /// The current continuous parameters `θ`.
     fn params(&self) -> Vec<f64>;
@@ -45,9 +46,9 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
     /// Characteristic function `γ(f) = E[e^{-i2πfτ}]`.
     fn cf(&self, f: f64) -> Complex64;
 
-    /// `∂γ(f)/∂θ_j` for every parameter, written into `grad` (length
+    /// `∂γ(f)/∂θ_j` for every parameter, in the order of [`params`](Self::params) (length
     /// [`num_params`](Self::num_params)).
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]);
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64>;
 
     /// Moment-generating function `M(z) = E[e^{zτ}]` at a complex `z`, or `None` where the
     /// expectation diverges.
@@ -120,30 +121,4 @@ pub trait JitterModel: fmt::Debug + Send + Sync {
 /// Draws `n` jitter values.
 pub fn sample_n<J: JitterModel + ?Sized>(jitter: &J, n: usize, rng: &mut dyn RngCore) -> Vec<f64> {
     (0..n).map(|_| jitter.sample(rng)).collect()
-}
-
-/// `e^{-i2πx}`, with `x` reduced modulo 1 first so that large `x` keeps the phase accuracy of
-/// `x` itself. A double with `|x| ≥ 2^52` is an integer (or infinite), so its phase is 0: the
-/// result is then 1 instead of a NaN from `sin(∞)`.
-pub(crate) fn phasor(x: f64) -> Complex64 {
-    // Exact: x - round(x) is a multiple of ulp(x) no larger than 1/2.
-    let r = if x.abs() < 4_503_599_627_370_496.0 {
-        x - x.round()
-    } else if x.is_nan() {
-        x
-    } else {
-        0.0
-    };
-    let (s, c) = (2.0 * std::f64::consts::PI * r).sin_cos();
-    Complex64::new(c, -s)
-}
-
-/// Complex exponential that returns an exactly real result for a real argument, so that an
-/// overflow gives `+∞` rather than `∞ · sin(0) = NaN` in the imaginary part.
-pub(crate) fn cexp(w: Complex64) -> Complex64 {
-    if w.im == 0.0 {
-        Complex64::new(w.re.exp(), 0.0)
-    } else {
-        w.exp()
-    }
 }

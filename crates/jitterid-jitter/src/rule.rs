@@ -10,10 +10,8 @@
 //! [`JitterModel::atoms`]: crate::JitterModel::atoms
 
 use crate::JitterModel;
-use std::sync::OnceLock;
 
-/// Number of Gauss–Legendre nodes per sub-interval.
-pub const GL_ORDER: usize = 16;
+pub use crate::kernels::gauss::{gauss_legendre, gl16, GL_ORDER};
 
 /// Largest `rate × width` allowed on one sub-interval: with 16 nodes the Gauss–Legendre error
 /// for `e^{zτ}` with `|z|·width ≤ 6` is below `1e-15` relative.
@@ -21,48 +19,6 @@ pub const MAX_RATE_WIDTH: f64 = 6.0;
 
 /// Upper bound on the sub-intervals of one piece, so that a huge rate cannot exhaust memory.
 pub const MAX_SUBDIVISIONS: usize = 4096;
-
-/// Gauss–Legendre nodes and weights on `[-1, 1]` for `n` points, by Newton's method on the
-/// Legendre recurrence.
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut nodes = vec![0.0; n];
-    let mut weights = vec![0.0; n];
-    for i in 0..n.div_ceil(2) {
-        // Tricomi's initial guess, then Newton.
-        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 0.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let pn = if n == 0 { 1.0 } else { p1 };
-            let pn1 = if n == 0 { 0.0 } else { p0 };
-            dp = n as f64 * (x * pn - pn1) / (x * x - 1.0);
-            let dx = pn / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        let w = 2.0 / ((1.0 - x * x) * dp * dp);
-        nodes[i] = -x;
-        nodes[n - 1 - i] = x;
-        weights[i] = w;
-        weights[n - 1 - i] = w;
-    }
-    (nodes, weights)
-}
-
-/// The [`GL_ORDER`]-point Gauss–Legendre rule on `[-1, 1]` (nodes, weights), computed once: for
-/// callers that integrate over the jitter's pieces themselves without building a
-/// [`QuadratureRule`].
-pub fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
-    static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    RULE.get_or_init(|| gauss_legendre(GL_ORDER))
-}
 
 /// A quadrature rule for expectations over the jitter: `E[h(τ)] ≈ Σ weights[i] · h(nodes[i])`.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -174,16 +130,6 @@ pub(crate) fn build_rule_from<J: JitterModel + ?Sized>(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn gauss_legendre_integrates_polynomials_exactly() {
-        let (x, w) = gauss_legendre(16);
-        // Exact for degree <= 31: ∫_{-1}^{1} x^30 dx = 2/31.
-        let s: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(30)).sum();
-        assert!((s - 2.0 / 31.0).abs() < 1e-14, "{s}");
-        let total: f64 = w.iter().sum();
-        assert!((total - 2.0).abs() < 1e-14);
-    }
 
     #[test]
     fn refined_interval_integrates_fast_exponential() {

@@ -72,8 +72,8 @@ impl<J: JitterModel> JitterModel for Shifted<J> {
         "shifted"
     }
 
-    fn param_names(&self) -> Vec<&'static str> {
-        let mut names = vec!["offset"];
+    fn param_names(&self) -> Vec<String> {
+        let mut names = vec!["offset".to_string()];
         names.extend(self.inner.param_names());
         names
     }
@@ -100,18 +100,16 @@ impl<J: JitterModel> JitterModel for Shifted<J> {
         phasor(f * self.offset) * self.inner.cf(f)
     }
 
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
         let e = phasor(f * self.offset);
         let g = e * self.inner.cf(f);
         // ∂γ/∂c = -i2πf γ = 2πf (Im γ - i Re γ), by components so that a zero component
         // never meets 2πf = ∞ (which would give NaN; the true derivative is then ±∞ or 0).
         let w = 2.0 * PI * f;
         let mul = |x: f64| if x == 0.0 { 0.0 } else { w * x };
-        grad[0] = Complex64::new(mul(g.im), -mul(g.re));
-        self.inner.cf_gradient(f, &mut grad[1..]);
-        for d in &mut grad[1..] {
-            *d *= e;
-        }
+        let mut grad = vec![Complex64::new(mul(g.im), -mul(g.re))];
+        grad.extend(self.inner.cf_gradient(f).into_iter().map(|d| d * e));
+        grad
     }
 
     fn mgf(&self, z: Complex64) -> Option<Complex64> {

@@ -85,7 +85,8 @@ pub fn check_contract<J: JitterModel + Clone>(model: &J, seed: u64) -> Result<()
 ///   within `1e-12` (relative to the spread), also when cut at extra breakpoints;
 /// * the rule at rate `2π|f|` reproduces `γ(f)` within `1e-10` for `2πfs` up to 30: this is
 ///   the check that the pieces are fine enough;
-/// * `cf_gradient` matches central differences of `cf` through `with_params`.
+/// * `cf_gradient` has one entry per parameter and matches central differences of `cf`
+///   through `with_params`.
 pub fn check_closed_forms<J: JitterModel + Clone>(model: &J) -> Result<(), String> {
     let mut fails = Vec::new();
     closed_forms(model, &mut fails);
@@ -197,7 +198,10 @@ fn check_params<J: JitterModel + Clone>(model: &J, fails: &mut Vec<String>) {
             let mut q = p.clone();
             q[j] = bad;
             if model.with_params(&q).is_ok() {
-                fails.push(format!("with_params accepted {} = {bad}", names[j]));
+                fails.push(format!(
+                    "with_params accepted {} = {bad}",
+                    names.get(j).map_or("?", String::as_str)
+                ));
             }
         }
     }
@@ -212,7 +216,6 @@ fn check_cf_bounds<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<S
         .iter()
         .map(|&c| freq(c, s))
         .chain(ABSOLUTE_FREQS);
-    let mut grad = vec![Complex64::new(0.0, 0.0); model.num_params()];
     for f in freqs {
         let (g, gm) = (model.cf(f), model.cf(-f));
         if !(g.re.is_finite() && g.im.is_finite()) {
@@ -231,7 +234,7 @@ fn check_cf_bounds<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<S
         }
         // A derivative may legitimately overflow (∂γ/∂c = -i2πfγ for a location c at
         // f = f64::MAX), but it must never be NaN.
-        model.cf_gradient(f, &mut grad);
+        let grad = model.cf_gradient(f);
         if grad.iter().any(|d| d.re.is_nan() || d.im.is_nan()) {
             fails.push(format!("cf_gradient({f:e}) = {grad:?} is NaN"));
         }
@@ -371,11 +374,18 @@ fn check_rule<J: JitterModel + ?Sized>(model: &J, s: f64, fails: &mut Vec<String
 fn check_gradient<J: JitterModel + Clone>(model: &J, s: f64, fails: &mut Vec<String>) {
     let p = model.params();
     let names = model.param_names();
-    let mut grad = vec![Complex64::new(0.0, 0.0); p.len()];
     for c in MODERATE {
         let f = freq(c, s);
         let g = model.cf(f);
-        model.cf_gradient(f, &mut grad);
+        let grad = model.cf_gradient(f);
+        if grad.len() != p.len() {
+            fails.push(format!(
+                "cf_gradient gives {} entries for {} parameters",
+                grad.len(),
+                p.len()
+            ));
+            return;
+        }
         for j in 0..p.len() {
             // A location parameter may be 0: scale its step by the spread instead.
             let scale = p[j].abs().max(s);
@@ -386,7 +396,7 @@ fn check_gradient<J: JitterModel + Clone>(model: &J, s: f64, fails: &mut Vec<Str
             let (Ok(mu), Ok(md)) = (model.with_params(&up), model.with_params(&down)) else {
                 fails.push(format!(
                     "with_params rejected {} = {} ± {h:e}",
-                    names.get(j).unwrap_or(&"?"),
+                    names.get(j).map_or("?", String::as_str),
                     p[j]
                 ));
                 continue;
@@ -396,7 +406,7 @@ fn check_gradient<J: JitterModel + Clone>(model: &J, s: f64, fails: &mut Vec<Str
             if (fd - grad[j]).norm() > tol {
                 fails.push(format!(
                     "∂γ/∂{} = {} but central difference gives {fd} at 2πf·s = {c}",
-                    names.get(j).unwrap_or(&"?"),
+                    names.get(j).map_or("?", String::as_str),
                     grad[j]
                 ));
             }
@@ -480,7 +490,7 @@ mod tests {
         fn name(&self) -> &'static str {
             "misprinted"
         }
-        fn param_names(&self) -> Vec<&'static str> {
+        fn param_names(&self) -> Vec<String> {
             self.0.param_names()
         }
         fn params(&self) -> Vec<f64> {
@@ -492,8 +502,8 @@ mod tests {
         fn cf(&self, f: f64) -> Complex64 {
             self.0.cf(0.5 * f)
         }
-        fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
-            self.0.cf_gradient(0.5 * f, grad)
+        fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
+            self.0.cf_gradient(0.5 * f)
         }
         fn mgf(&self, _z: Complex64) -> Option<Complex64> {
             None
@@ -534,7 +544,7 @@ mod tests {
             fn name(&self) -> &'static str {
                 "wide"
             }
-            fn param_names(&self) -> Vec<&'static str> {
+            fn param_names(&self) -> Vec<String> {
                 self.0.param_names()
             }
             fn params(&self) -> Vec<f64> {
@@ -546,8 +556,8 @@ mod tests {
             fn cf(&self, f: f64) -> Complex64 {
                 self.0.cf(f)
             }
-            fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
-                self.0.cf_gradient(f, grad)
+            fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
+                self.0.cf_gradient(f)
             }
             fn mgf(&self, z: Complex64) -> Option<Complex64> {
                 self.0.mgf(z)

@@ -59,8 +59,8 @@ impl JitterModel for TwoPoint {
         "two-point"
     }
 
-    fn param_names(&self) -> Vec<&'static str> {
-        vec!["d"]
+    fn param_names(&self) -> Vec<String> {
+        vec!["d".to_string()]
     }
 
     fn params(&self) -> Vec<f64> {
@@ -77,11 +77,11 @@ impl JitterModel for TwoPoint {
         Complex64::new(phasor(f * self.d).re, 0.0)
     }
 
-    fn cf_gradient(&self, f: f64, grad: &mut [Complex64]) {
+    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
         // ∂cos(2πfd)/∂d = -2πf sin(2πfd); Im e^{-i2πfd} = -sin(2πfd).
         let s = -phasor(f * self.d).im;
         let d = if s == 0.0 { 0.0 } else { -2.0 * PI * f * s };
-        grad[0] = Complex64::new(d, 0.0);
+        vec![Complex64::new(d, 0.0)]
     }
 
     fn mgf(&self, z: Complex64) -> Option<Complex64> {
@@ -165,8 +165,7 @@ mod tests {
         }
         for f in [1e300, f64::MAX, -f64::MAX] {
             assert!(j.cf(f).re.is_finite());
-            let mut g = [Complex64::new(0.0, 0.0)];
-            j.cf_gradient(f, &mut g);
+            let g = j.cf_gradient(f);
             assert!(g[0].re.is_finite());
         }
     }

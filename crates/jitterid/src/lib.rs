@@ -52,8 +52,10 @@ pub use rand;
 
 /// The commonly used types and traits.
 pub mod prelude {
+    pub use crate::jitter::registry::{JitterRegistry, ParamSpec};
     pub use crate::jitter::{
-        ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
+        AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter,
+        Shifted, TwoPoint, UniformSum,
     };
     pub use crate::signal::{
         simulate, Input, LtiResponse, Multisine, PiecewiseConstant, RandomBinary, RationalModel,
