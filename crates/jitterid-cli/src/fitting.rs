@@ -4,7 +4,7 @@ use crate::cli_err;
 use crate::error::CliResult;
 use crate::experiment::{Experiment, InputSpec, Method, SolverKind, SystemKind};
 use crate::inputs::input_span;
-use crate::models::{AnyJitter, AnyNoise, AnySignal, AnySolver};
+use crate::models::{AnyNoise, AnySignal, AnySolver};
 use jitterid::estimate::solver::{
     GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
 };
@@ -12,7 +12,8 @@ use jitterid::estimate::{
     estimate, profile_uniform_sum, Bcls, BoxJenkins, Criterion, Estimate, EstimateError,
     EstimateOptions, Ls, ModelStructure, NoiseModel, Record,
 };
-use jitterid::jitter::{JitterModel, UniformSum};
+use jitterid::jitter::registry::JitterRegistry;
+use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
 use jitterid::signal::{simulate, Input, LtiResponse, SampleGrid, Signal};
@@ -211,9 +212,7 @@ pub fn param_names(exp: &Experiment, signal: &AnySignal, method: Method) -> CliR
 }
 
 fn profiled(exp: &Experiment) -> bool {
-    exp.jitter.estimate
-        && exp.jitter.n_range.is_some()
-        && matches!(exp.jitter.model, AnyJitter::UniformSum(_))
+    exp.jitter.estimate && exp.jitter.n_range.is_some()
 }
 
 fn report_names(exp: &Experiment, s: &Structure) -> Vec<String> {
@@ -253,8 +252,8 @@ pub fn truth_values(
     if s.estimate_jitter {
         let t = &exp.jitter.truth;
         if profiled(exp) {
-            match (t, exp.jitter.family_differs) {
-                (AnyJitter::UniformSum(u), false) => {
+            match (t.downcast_ref::<UniformSum>(), exp.jitter.family_differs) {
+                (Some(u), false) => {
                     out.extend([Some(f64::from(u.n())), Some(u.a())]);
                 }
                 _ => out.extend([None, None]),
@@ -294,6 +293,13 @@ fn options(
     }
 }
 
+/// `j`, a uniform sum, with its whole number `n` replaced (rebuilt through the registry).
+fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
+    let mut spec = j.spec();
+    spec.insert("n".into(), n.into());
+    JitterRegistry::builtin().build(&spec)
+}
+
 fn run_criterion<C: Criterion>(
     exp: &Experiment,
     s: &Structure,
@@ -302,7 +308,9 @@ fn run_criterion<C: Criterion>(
     opts: &EstimateOptions<AnySolver, DirichletWindow>,
 ) -> Result<(Estimate, Structure, Option<u32>), EstimateError> {
     if profiled(exp) {
-        if let (AnyJitter::UniformSum(u), Some((lo, hi))) = (&s.jitter, exp.jitter.n_range) {
+        if let (Some(u), Some((lo, hi))) =
+            (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
+        {
             let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
                 signal: s.signal.clone(),
                 jitter: *u,
@@ -314,7 +322,7 @@ fn run_criterion<C: Criterion>(
             };
             let p = profile_uniform_sum(&us, record, criterion, opts, lo..=hi)?;
             let mut base = s.clone();
-            base.jitter = AnyJitter::UniformSum(u.with_n(p.n)?);
+            base.jitter = with_n(&s.jitter, p.n)?;
             let fitted = base.with_params(&p.estimate.params)?;
             return Ok((p.estimate, fitted, Some(p.n)));
         }
@@ -450,7 +458,9 @@ fn fit_ml(
     ) -> Result<(MlEstimate, Option<u32>, Structure), String> {
         let e = |e: jitterid::estimate::ml::MlError| e.to_string();
         if profiled(exp) {
-            if let (AnyJitter::UniformSum(u), Some((lo, hi))) = (&s.jitter, exp.jitter.n_range) {
+            if let (Some(u), Some((lo, hi))) =
+                (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
+            {
                 let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
                     signal: s.signal.clone(),
                     jitter: *u,
@@ -462,7 +472,7 @@ fn fit_ml(
                 };
                 let p = ml_profile_uniform_sum(&us, record, c, opts, lo..=hi).map_err(e)?;
                 let mut base = s.clone();
-                base.jitter = AnyJitter::UniformSum(u.with_n(p.n).map_err(|x| x.to_string())?);
+                base.jitter = with_n(&s.jitter, p.n).map_err(|x| x.to_string())?;
                 return Ok((p.estimate, Some(p.n), base));
             }
         }

@@ -3,8 +3,9 @@
 use crate::error::CliResult;
 use crate::experiment::Experiment;
 use crate::fitting::Structure;
-use crate::models::{AnyJitter, AnySignal};
+use crate::models::AnySignal;
 use crate::svg::{self, figure, Panel, Series, Style, BLACK, BLUE, GREEN, GREY, ORANGE, RED};
+use jitterid::jitter::AnyJitter;
 use jitterid::jitter::{JitterModel, NoJitter};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::{Input, SampleGrid, Signal};

@@ -184,30 +184,6 @@ impl Source<'_> {
         )
     }
 
-    /// A finite number (an integer is taken as a real).
-    pub(super) fn number_value(
-        &self,
-        section: &str,
-        key: &str,
-        v: &Spanned<toml::Value>,
-    ) -> CliResult<f64> {
-        let x = number(v.get_ref()).ok_or_else(|| self.wrong_type(section, key, v, "a number"))?;
-        finite_value(x).map_err(|m| self.err(section, key, &v.span(), m))
-    }
-
-    /// A whole number.
-    pub(super) fn integer_value(
-        &self,
-        section: &str,
-        key: &str,
-        v: &Spanned<toml::Value>,
-    ) -> CliResult<i64> {
-        match v.get_ref() {
-            toml::Value::Integer(i) => Ok(*i),
-            _ => Err(self.wrong_type(section, key, v, "a whole number")),
-        }
-    }
-
     /// `true` or `false`.
     pub(super) fn bool_value(
         &self,

@@ -71,6 +71,52 @@ impl<'a> Source<'a> {
         }
     }
 
+    /// An error on `line`, or at the section header when the line is not known.
+    pub(super) fn err_on_line(
+        &self,
+        section: &str,
+        key: &str,
+        line: Option<usize>,
+        msg: impl std::fmt::Display,
+    ) -> CliError {
+        match line {
+            Some(l) => cli_err!("{}:{l}: [{section}] {key}: {msg}", self.file),
+            None => self.err_section(section, key, msg),
+        }
+    }
+
+    /// The line of a byte offset range.
+    pub(super) fn line_of_span(&self, span: &Range<usize>) -> usize {
+        line_of(self.text, span.start)
+    }
+
+    /// The line of `key = …` in the `index`-th table `[[array]]` of the file (`array` as
+    /// written in the header, for example `jitter.terms`).
+    pub(super) fn array_table_key_line(
+        &self,
+        array: &str,
+        index: usize,
+        key: &str,
+    ) -> Option<usize> {
+        let mut seen = 0;
+        let mut inside = false;
+        for (i, l) in self.text.lines().enumerate() {
+            let t = l.trim();
+            if t.starts_with('[') {
+                let name = t.trim_start_matches('[').split(']').next().map(str::trim);
+                inside = t.starts_with("[[") && name == Some(array) && {
+                    seen += 1;
+                    seen == index + 1
+                };
+                continue;
+            }
+            if inside && key_on_line(self.text, i + 1).as_deref() == Some(key) {
+                return Some(i + 1);
+            }
+        }
+        None
+    }
+
     /// An error about the key at `span` when the key was given, else at the section header.
     pub(super) fn err_at<T>(
         &self,

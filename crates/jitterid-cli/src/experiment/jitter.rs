@@ -1,119 +1,73 @@
-//! `[jitter]`: the family of the truth and of the model.
+//! `[jitter]`: the family of the truth and of the model, from the library's registry.
 //!
-//! The section is read without a fixed set of keys: besides the command line's own keys
-//! (`family`, `estimate`, `offset`, `fit_family`, `n_range`) its keys are the chosen family's
-//! parameters, described by [`FamilyParam`]s, so that a family brings its keys with it.
+//! Besides the command line's own keys (`estimate`, `fit_family`, `n_range`) the section is a
+//! spec table of [`JitterRegistry`]: `family`, that family's keys (described by its
+//! [`ParamSpec`](jitterid::jitter::registry::ParamSpec)s), `offset`, and for a composite family
+//! `[[jitter.terms]]`, each term a spec table of its own. A family registered in the library
+//! reaches the file with no change here.
 
-use super::checks::describe;
 use super::diagnostics::{unknown_key, Source};
 use super::range;
 use super::raw::RawTable;
 use super::spec::JitterSpec;
 use crate::error::{CliError, CliResult};
-use crate::models::AnyJitter;
-use jitterid::jitter::{
-    ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter, Shifted, TwoPoint,
-    UniformSum,
-};
+use jitterid::jitter::registry::{Family, JitterRegistry, Spec, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
+use jitterid::jitter::{AnyJitter, JitterError, JitterModel, NoJitter, UniformSum};
 use jitterid::signal::SampleGrid;
-use std::collections::BTreeMap;
+use serde_json::Value;
 use toml::Spanned;
 
 const S: &str = "jitter";
-/// The keys of `[jitter]` that belong to the command line, not to a family.
-const OWN_KEYS: &[&str] = &["family", "estimate", "offset", "fit_family", "n_range"];
-
-/// One parameter key of a family, as the experiment file gives it.
-#[derive(Debug, Clone, Copy)]
-struct FamilyParam {
-    key: &'static str,
-    /// A whole number (the uniform sum's `n`); otherwise a time scale in seconds.
-    integer: bool,
-    default: Option<f64>,
-}
-
-const fn time(key: &'static str) -> FamilyParam {
-    FamilyParam {
-        key,
-        integer: false,
-        default: None,
-    }
-}
-
-/// The families, each with its parameter keys.
-const FAMILIES: &[(&str, &[FamilyParam])] = &[
-    ("none", &[]),
-    (
-        "uniform-sum",
-        &[
-            FamilyParam {
-                key: "n",
-                integer: true,
-                default: Some(0.0),
-            },
-            time("a"),
-        ],
-    ),
-    ("gaussian", &[time("sigma")]),
-    ("laplace", &[time("scale")]),
-    ("two-point", &[time("d")]),
-    ("exponential", &[time("mean")]),
-];
-
-fn family_params(name: &str) -> Option<&'static [FamilyParam]> {
-    FAMILIES.iter().find(|(n, _)| *n == name).map(|f| f.1)
-}
-
-fn family_names() -> String {
-    let names: Vec<String> = FAMILIES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
-    names.join(", ")
-}
+/// The keys of `[jitter]` that belong to the command line, not to the spec table.
+const OWN_KEYS: &[&str] = &["estimate", "fit_family", "n_range"];
 
 pub(super) fn parse_jitter(cx: &Source, r: &RawTable, grid: &SampleGrid) -> CliResult<JitterSpec> {
-    let why = format!("expected family = {}", family_names());
-    let fam = r
-        .get("family")
-        .ok_or_else(|| cx.err_section(S, "family", format!("missing; {why}")))?;
-    let family = cx.string_value(S, "family", fam)?;
-    let params = family_params(family).ok_or_else(|| {
-        cx.err(
+    let registry = JitterRegistry::builtin();
+    let fam = r.get(FAMILY_KEY).ok_or_else(|| {
+        cx.err_section(
             S,
-            "family",
-            &fam.span(),
-            format!("unknown jitter family \"{family}\"; {why}"),
+            FAMILY_KEY,
+            format!("missing; expected family = {}", registry.names()),
         )
     })?;
-    check_keys(cx, r, family, params)?;
-    let base = build(cx, r, family, params, grid)?;
-    let offset = match r.get("offset") {
-        Some(o) => {
-            let x = cx.number_value(S, "offset", o)?;
-            Some(range::offset(x, grid).map_err(|m| cx.err(S, "offset", &o.span(), m))?)
-        }
-        None => None,
-    };
-    let truth = shifted(cx, base.clone(), offset)?;
+    let family = cx.string_value(S, FAMILY_KEY, fam)?;
+    let entry = registry.family(family).ok_or_else(|| {
+        cx.err(
+            S,
+            FAMILY_KEY,
+            &fam.span(),
+            format!(
+                "unknown jitter family \"{family}\"; expected {}",
+                registry.names()
+            ),
+        )
+    })?;
+    check_keys(cx, r, entry)?;
+    let spec = spec_table(r)?;
+    check_ranges(cx, r, &spec, "", grid)?;
+    let truth = registry.build(&spec).map_err(|e| jitter_error(cx, r, e))?;
     let estimate = match r.get("estimate") {
         Some(e) => cx.bool_value(S, "estimate", e)?,
         None => false,
     };
-    let (model, family_differs, model_family) = match r.get("fit_family") {
+    let (model, family_differs) = match r.get("fit_family") {
         Some(ff) if cx.string_value(S, "fit_family", ff)? != family => {
-            let (j, name) = fitted_family(cx, ff, &base)?;
-            (shifted(cx, j, offset)?, true, name)
+            (fitted_family(cx, ff, &truth, &spec)?, true)
         }
-        _ => (truth.clone(), false, family),
+        _ => (truth.clone(), false),
     };
     if estimate && model.num_params() == 0 {
         return Err(cx.err_at(
             S,
             "estimate",
             r.get("estimate"),
-            format!("family \"{model_family}\" has no parameter to estimate; set estimate = false"),
+            format!(
+                "family \"{}\" has no parameter to estimate; set estimate = false",
+                model.family()
+            ),
         ));
     }
-    let profiled = estimate && model_family == "uniform-sum" && offset.is_none();
-    let n_range = n_range(cx, r.get("n_range"), profiled)?;
+    let n_range = n_range(cx, r.get("n_range"), estimate && profiled(&model))?;
     Ok(JitterSpec {
         truth,
         model,
@@ -123,169 +77,167 @@ pub(super) fn parse_jitter(cx: &Source, r: &RawTable, grid: &SampleGrid) -> CliR
     })
 }
 
-/// Every key is the command line's or the family's.
-fn check_keys(cx: &Source, r: &RawTable, family: &str, params: &[FamilyParam]) -> CliResult<()> {
-    let mut allowed: Vec<&str> = OWN_KEYS.to_vec();
-    allowed.extend(params.iter().map(|p| p.key));
-    for (key, v) in r {
-        if allowed.contains(&key.as_str()) {
-            continue;
+/// No jitter, and nothing of it estimated (the default without a `[jitter]` section).
+pub(super) fn no_jitter() -> JitterSpec {
+    let none = AnyJitter::new("none", NoJitter, |_| Spec::new());
+    JitterSpec {
+        truth: none.clone(),
+        model: none,
+        estimate: false,
+        n_range: None,
+        family_differs: false,
+    }
+}
+
+/// Whether an estimated `model` has its whole-number parameter profiled: the uniform sum
+/// without an offset (the library's profile is over its `n`).
+pub(super) fn profiled(model: &AnyJitter) -> bool {
+    model.downcast_ref::<UniformSum>().is_some()
+}
+
+/// Every key is the command line's or the family's; a typo gets a suggestion.
+fn check_keys(cx: &Source, r: &RawTable, entry: &Family) -> CliResult<()> {
+    let mut allowed: Vec<&str> = entry.keys();
+    allowed.extend_from_slice(OWN_KEYS);
+    let Some((key, v)) = r.iter().find(|(k, _)| !allowed.contains(&k.as_str())) else {
+        return Ok(());
+    };
+    let registry = JitterRegistry::builtin();
+    let of_another = registry
+        .families()
+        .any(|f| f.keys().contains(&key.as_str()));
+    let msg = if of_another {
+        format!(
+            "not a key of family = \"{}\"; expected {}",
+            entry.name(),
+            allowed.join(", ")
+        )
+    } else {
+        let mut known: Vec<&str> = registry.families().flat_map(|f| f.keys()).collect();
+        known.extend_from_slice(OWN_KEYS);
+        unknown_key(key, &known, &allowed.join(", "))
+    };
+    Err(cx.err(S, key, &v.span(), msg))
+}
+
+/// The section as the registry's spec table (the command line's own keys left out).
+fn spec_table(r: &RawTable) -> CliResult<Spec> {
+    r.iter()
+        .filter(|(k, _)| !OWN_KEYS.contains(&k.as_str()))
+        .map(|(k, v)| {
+            serde_json::to_value(v.get_ref())
+                .map(|v| (k.clone(), v))
+                .map_err(|e| crate::cli_err!("[jitter] {k}: {e}"))
+        })
+        .collect()
+}
+
+/// Time scales (keys in seconds) and offsets within the representable range, in the spec
+/// and in each of its terms (`path` is the prefix of a term's keys, `terms.<i>.`).
+fn check_ranges(
+    cx: &Source,
+    r: &RawTable,
+    spec: &Spec,
+    path: &str,
+    grid: &SampleGrid,
+) -> CliResult<()> {
+    let registry = JitterRegistry::builtin();
+    let entry = spec
+        .get(FAMILY_KEY)
+        .and_then(Value::as_str)
+        .and_then(|name| registry.family(name));
+    let seconds = entry
+        .into_iter()
+        .flat_map(|f| f.params())
+        .filter(|p| p.unit == "s" && !p.integer)
+        .map(|p| p.key.as_str());
+    for key in seconds {
+        if let Some(x) = spec.get(key).and_then(Value::as_f64).filter(|x| *x > 0.0) {
+            range::width(x, grid).map_err(|m| located(cx, r, &format!("{path}{key}"), m))?;
         }
-        let of_another = FAMILIES
-            .iter()
-            .any(|(_, ps)| ps.iter().any(|p| p.key == key));
-        let msg = if of_another {
-            format!(
-                "not a key of family = \"{family}\"; expected {}",
-                allowed.join(", ")
-            )
-        } else {
-            let mut known: Vec<&str> = OWN_KEYS.to_vec();
-            known.extend(FAMILIES.iter().flat_map(|(_, ps)| ps.iter().map(|p| p.key)));
-            unknown_key(key, &known, &allowed.join(", "))
-        };
-        return Err(cx.err(S, key, &v.span(), msg));
+    }
+    if let Some(x) = spec.get(OFFSET_KEY).and_then(Value::as_f64) {
+        range::offset(x, grid).map_err(|m| located(cx, r, &format!("{path}{OFFSET_KEY}"), m))?;
+    }
+    if let Some(Value::Array(terms)) = spec.get(TERMS_KEY) {
+        for (i, term) in terms.iter().enumerate() {
+            if let Some(t) = term.as_object() {
+                check_ranges(cx, r, t, &format!("{path}{TERMS_KEY}.{i}."), grid)?;
+            }
+        }
     }
     Ok(())
 }
 
-/// The family's parameters from the file: whole numbers where the family says so, time
-/// scales within the representable range otherwise.
-fn param_values<'p>(
-    cx: &Source,
-    r: &RawTable,
-    family: &str,
-    params: &'p [FamilyParam],
-    grid: &SampleGrid,
-) -> CliResult<BTreeMap<&'p str, f64>> {
-    let needs: Vec<&str> = params.iter().map(|p| p.key).collect();
-    let why = format!("missing; family = \"{family}\" needs {}", needs.join(", "));
-    let mut out = BTreeMap::new();
-    for p in params {
-        let x = match (r.get(p.key), p.default) {
-            (None, Some(d)) => d,
-            (None, None) => return Err(cx.err_section(S, p.key, &why)),
-            (Some(v), _) if p.integer => cx.integer_value(S, p.key, v)? as f64,
-            (Some(v), _) => {
-                let x = cx.number_value(S, p.key, v)?;
-                if !(x > 0.0) {
-                    return Err(cx.err(
-                        S,
-                        p.key,
-                        &v.span(),
-                        format!("expected a number > 0, found {x}"),
-                    ));
-                }
-                range::width(x, grid).map_err(|m| cx.err(S, p.key, &v.span(), m))?
-            }
-        };
-        out.insert(p.key, x);
+/// An error about the key `path` of the section: `key`, or `terms.<i>.key` for a term's key
+/// (located in the `i`-th `[[jitter.terms]]` table).
+fn located(cx: &Source, r: &RawTable, path: &str, msg: impl std::fmt::Display) -> CliError {
+    let term = path
+        .strip_prefix("terms.")
+        .and_then(|rest| rest.split_once('.'))
+        .and_then(|(i, key)| Some((i.parse::<usize>().ok()?, key)));
+    match term {
+        Some((i, key)) => {
+            let line = cx
+                .array_table_key_line("jitter.terms", i, key)
+                .or_else(|| r.get(TERMS_KEY).map(|t| cx.line_of_span(&t.span())));
+            cx.err_on_line(S, path, line, msg)
+        }
+        None => cx.err_at(S, path, r.get(path), msg),
     }
-    Ok(out)
 }
 
-/// The family `family` with the file's parameters; a constructor's refusal names its key.
-fn build(
+/// A registry error, located at the key it names.
+fn jitter_error(cx: &Source, r: &RawTable, e: JitterError) -> CliError {
+    match e.key() {
+        Some(key) => {
+            let key = key.to_string();
+            located(cx, r, &key, e)
+        }
+        None => cx.err_section(S, FAMILY_KEY, e),
+    }
+}
+
+/// The model's family `fit_family`, started at the standard deviation of the given `truth`;
+/// the given whole-number keys (the uniform sum's `n`) and `offset` carry over.
+fn fitted_family(
     cx: &Source,
-    r: &RawTable,
-    family: &str,
-    params: &[FamilyParam],
-    grid: &SampleGrid,
+    ff: &Spanned<toml::Value>,
+    truth: &AnyJitter,
+    spec: &Spec,
 ) -> CliResult<AnyJitter> {
-    let v = param_values(cx, r, family, params, grid)?;
-    let at = |key: &'static str| move |e: JitterError| cx.err_at(S, key, r.get(key), e);
-    let x = |key: &str| v.get(key).copied().unwrap_or(f64::NAN);
-    Ok(match family {
-        "uniform-sum" => {
-            let n = x("n");
-            let n = u32::try_from(n as i64)
-                .ok()
-                .filter(|n| *n <= UniformSum::MAX_N)
-                .ok_or_else(|| {
-                    cx.err_at(
-                        S,
-                        "n",
-                        r.get("n"),
-                        format!(
-                            "expected a whole number in [0, {}], found {n}",
-                            UniformSum::MAX_N
-                        ),
-                    )
-                })?;
-            AnyJitter::UniformSum(UniformSum::new(n, x("a")).map_err(at("a"))?)
-        }
-        "gaussian" => AnyJitter::Gaussian(Gaussian::new(x("sigma")).map_err(at("sigma"))?),
-        "laplace" => AnyJitter::Laplace(Laplace::new(x("scale")).map_err(at("scale"))?),
-        "two-point" => AnyJitter::TwoPoint(TwoPoint::new(x("d")).map_err(at("d"))?),
-        "exponential" => {
-            AnyJitter::Exponential(ExponentialDelay::new(x("mean")).map_err(at("mean"))?)
-        }
-        // `family_params` accepted the name, and the only other name is "none".
-        _ => AnyJitter::None(NoJitter),
-    })
-}
-
-/// `j` moved by the constant `offset`, if one is given.
-fn shifted(cx: &Source, j: AnyJitter, offset: Option<f64>) -> CliResult<AnyJitter> {
-    match offset {
-        Some(c) => Ok(AnyJitter::Shifted(Box::new(
-            Shifted::new(j, c).map_err(|e| cx.err_section(S, "offset", e))?,
-        ))),
-        None => Ok(j),
-    }
-}
-
-/// The model's family `fit_family`, started at the standard deviation of the given `base`.
-fn fitted_family<'v>(
-    cx: &Source,
-    ff: &'v Spanned<toml::Value>,
-    base: &AnyJitter,
-) -> CliResult<(AnyJitter, &'v str)> {
+    let registry = JitterRegistry::builtin();
     let name = cx.string_value(S, "fit_family", ff)?;
     let fail = |m: String| -> CliError { cx.err(S, "fit_family", &ff.span(), m) };
-    if family_params(name).is_none() {
-        return Err(fail(format!(
+    let entry = registry.family(name).ok_or_else(|| {
+        fail(format!(
             "unknown jitter family \"{name}\"; expected {}",
-            family_names()
-        )));
+            registry.names()
+        ))
+    })?;
+    let sigma = truth.std_dev();
+    if name != "none" && !(sigma.is_finite() && sigma > 0.0) {
+        return Err(fail(format!("a fitted family \"{name}\" needs a given jitter with a spread (standard deviation > 0) to start from")));
     }
-    let n = match base {
-        AnyJitter::UniformSum(u) => u.n(),
-        _ => 0,
-    };
-    Ok((
-        family_with_std(name, base.std_dev(), n).map_err(fail)?,
-        name,
-    ))
-}
-
-/// A family with the standard deviation `sigma` (for `fit_family`); `n` for the uniform sum.
-fn family_with_std(family: &str, sigma: f64, n: u32) -> Result<AnyJitter, String> {
-    if family == "none" {
-        return Ok(AnyJitter::None(NoJitter));
-    }
-    if !(sigma.is_finite() && sigma > 0.0) {
-        return Err(format!("a fitted family \"{family}\" needs a given jitter with a spread (standard deviation > 0) to start from"));
-    }
-    let e = |e: JitterError| e.to_string();
-    Ok(match family {
-        "uniform-sum" => AnyJitter::UniformSum(
-            UniformSum::new(n, sigma * (3.0 * (f64::from(n) + 1.0)).sqrt()).map_err(e)?,
-        ),
-        "gaussian" => AnyJitter::Gaussian(Gaussian::new(sigma).map_err(e)?),
-        "laplace" => AnyJitter::Laplace(Laplace::new(sigma / 2f64.sqrt()).map_err(e)?),
-        "two-point" => AnyJitter::TwoPoint(TwoPoint::new(sigma).map_err(e)?),
-        "exponential" => AnyJitter::Exponential(ExponentialDelay::new(sigma).map_err(e)?),
-        other => {
-            return Err(format!(
-                "unknown family \"{other}\"; expected {}",
-                family_names()
-            ))
+    let mut structural = Spec::new();
+    for p in entry.params().iter().filter(|p| p.integer) {
+        if let Some(v) = spec.get(&p.key) {
+            structural.insert(p.key.clone(), v.clone());
         }
-    })
+    }
+    if let Some(v) = spec.get(OFFSET_KEY) {
+        structural.insert(OFFSET_KEY.into(), v.clone());
+    }
+    if name == "none" {
+        structural.insert(FAMILY_KEY.into(), name.into());
+        return registry.build(&structural).map_err(|e| fail(e.to_string()));
+    }
+    registry
+        .from_std_dev(name, sigma, &structural)
+        .map_err(|e| fail(e.to_string()))
 }
 
-/// The range of `n` profiled over: given, or `[0, 9]`, and only for a profiled uniform sum.
+/// The range of `n` profiled over: given, or `[0, 9]`, and only for a profiled model.
 fn n_range(
     cx: &Source,
     v: Option<&Spanned<toml::Value>>,
@@ -302,16 +254,12 @@ fn n_range(
             let whole = matches!(v.get_ref(), toml::Value::Array(a) if a.len() == l.len());
             let ok = whole && l.len() == 2 && l[0] >= 0 && l[0] <= l[1] && l[1] <= max;
             if !ok {
-                return Err(cx.err(
-                    S,
-                    "n_range",
-                    &v.span(),
-                    if whole {
-                        format!("{expected}, found {l:?}")
-                    } else {
-                        format!("{expected}, found {}", describe(v.get_ref()))
-                    },
-                ));
+                let found = if whole {
+                    format!("{l:?}")
+                } else {
+                    super::checks::describe(v.get_ref())
+                };
+                return Err(cx.err(S, "n_range", &v.span(), format!("{expected}, found {found}")));
             }
             Ok(Some((l[0] as u32, l[1] as u32)))
         }

@@ -30,10 +30,9 @@ pub use spec::{
 use crate::cli_err;
 use crate::csvio;
 use crate::error::CliResult;
-use crate::models::{AnyJitter, AnyNoise};
+use crate::models::AnyNoise;
 use diagnostics::{shape_error, toml_error, Source};
 use jitterid::estimate::Frequencies;
-use jitterid::jitter::NoJitter;
 use raw::RawExperiment;
 use std::path::{Path, PathBuf};
 
@@ -91,13 +90,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
     let input = input::parse_input_section(&cx, raw.input.as_ref(), &system.kind, &grid)?;
     let jitter = match &raw.jitter {
         Some(r) => jitter::parse_jitter(&cx, r, &grid)?,
-        None => JitterSpec {
-            truth: AnyJitter::None(NoJitter),
-            model: AnyJitter::None(NoJitter),
-            estimate: false,
-            n_range: None,
-            family_differs: false,
-        },
+        None => jitter::no_jitter(),
     };
     let noise = match &raw.noise {
         Some(r) => noise::parse_noise(&cx, r)?,

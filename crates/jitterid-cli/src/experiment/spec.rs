@@ -1,7 +1,8 @@
 //! The validated experiment: what every command reads, with nothing left to check.
 
-use crate::models::{AnyJitter, AnyNoise};
+use crate::models::AnyNoise;
 use jitterid::estimate::Frequencies;
+use jitterid::jitter::AnyJitter;
 use jitterid::signal::{Input, RandomBinary, SampleGrid, Sinusoid, TransferFunction, Zpk};
 use std::path::PathBuf;
 
