@@ -49,7 +49,10 @@ mod dirac;
 mod exponential;
 mod gaussian;
 mod laplace;
+mod mixture;
+mod periodic;
 mod shifted;
+mod sum;
 mod two_point;
 mod uniform_sum;
 
@@ -59,10 +62,15 @@ pub use error::JitterError;
 pub use exponential::ExponentialDelay;
 pub use gaussian::Gaussian;
 pub use laplace::Laplace;
+pub use mixture::Mixture;
 pub use model::{sample_n, Atom, JitterModel, TAIL_MASS};
 pub use num_complex;
+pub use periodic::Periodic;
 pub use rule::QuadratureRule;
+/// Re-exported: spec tables ([`registry::Spec`]) are `serde_json` maps.
+pub use serde_json;
 pub use shifted::Shifted;
+pub use sum::Sum;
 pub use two_point::TwoPoint;
 pub use uniform_sum::UniformSum;
 

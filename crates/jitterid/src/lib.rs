@@ -54,8 +54,8 @@ pub use rand;
 pub mod prelude {
     pub use crate::jitter::registry::{JitterRegistry, ParamSpec};
     pub use crate::jitter::{
-        AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter,
-        Shifted, TwoPoint, UniformSum,
+        AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, Mixture,
+        NoJitter, Periodic, Shifted, Sum, TwoPoint, UniformSum,
     };
     pub use crate::signal::{
         simulate, Input, LtiResponse, Multisine, PiecewiseConstant, RandomBinary, RationalModel,

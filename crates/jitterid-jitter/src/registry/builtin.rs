@@ -2,8 +2,8 @@
 
 use super::{Family, JitterRegistry, ParamSpec, Spec, SpecReader};
 use crate::{
-    AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter, TwoPoint,
-    UniformSum,
+    AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, Mixture, NoJitter,
+    Periodic, Sum, TwoPoint, UniformSum,
 };
 use serde_json::Value;
 
@@ -77,6 +77,98 @@ fn none() -> Family {
     .with_std_dev(move |_, _, _| Ok(wrap()))
 }
 
+/// The spec tables of the terms of a (right-nested) sum, as one flat list.
+fn sum_terms(s: &Sum<AnyJitter, AnyJitter>) -> Vec<Value> {
+    let mut terms = vec![Value::Object(s.first().spec())];
+    match s.second().downcast_ref::<Sum<AnyJitter, AnyJitter>>() {
+        // A nested sum without an offset of its own continues the list.
+        Some(inner) if s.second().spec().get(super::OFFSET_KEY).is_none() => {
+            terms.extend(sum_terms(inner))
+        }
+        _ => terms.push(Value::Object(s.second().spec())),
+    }
+    terms
+}
+
+fn wrap_sum(s: Sum<AnyJitter, AnyJitter>) -> AnyJitter {
+    AnyJitter::new("sum", s, |s: &Sum<AnyJitter, AnyJitter>| {
+        spec_of([(super::TERMS_KEY, Value::Array(sum_terms(s)))])
+    })
+}
+
+fn sum() -> Family {
+    Family::new(
+        "sum",
+        "independent sum of two or more terms, each a spec table of its own (γ = Π γ_k)",
+        Vec::new(),
+        |r, registry| {
+            let mut terms = r.terms(registry, 2)?;
+            // Nest to the right: t0 + (t1 + (… + tn)).
+            let mut acc = terms
+                .pop()
+                .ok_or_else(|| r.invalid(super::TERMS_KEY, "no terms"))?;
+            while let Some(t) = terms.pop() {
+                acc = wrap_sum(Sum::new(t, acc));
+            }
+            Ok(acc)
+        },
+    )
+    .with_terms()
+}
+
+fn mixture_spec(m: &Mixture<AnyJitter>) -> Spec {
+    let terms = m
+        .components()
+        .iter()
+        .map(|c| Value::Object(c.spec()))
+        .collect();
+    let mut spec = spec_of([
+        (super::TERMS_KEY, Value::Array(terms)),
+        (
+            "weights",
+            m.weights().iter().copied().map(Value::from).collect(),
+        ),
+    ]);
+    if m.fixed_weights() {
+        spec.insert("fixed_weights".into(), true.into());
+    }
+    spec
+}
+
+fn mixture() -> Family {
+    Family::new(
+        "mixture",
+        "with probability w_k, a draw of term k (two or more terms, each a spec table)",
+        vec![
+            ParamSpec::new(
+                "weights",
+                "probability of each term, in the order of `terms` (an array)",
+                "",
+                "each in (0, 1), summing to 1",
+            ),
+            ParamSpec::new(
+                "fixed_weights",
+                "true: the weights are known, not estimated",
+                "",
+                "true or false",
+            )
+            .boolean(false),
+        ],
+        |r, registry| {
+            let terms = r.terms(registry, 2)?;
+            let weights = r.f64_list("weights")?;
+            let m = Mixture::new(terms, weights).map_err(|e| r.invalid("weights", e))?;
+            let m = if r.bool_or("fixed_weights", false)? {
+                m.with_fixed_weights()
+            } else {
+                m
+            };
+            Ok(AnyJitter::new("mixture", m, mixture_spec))
+        },
+    )
+    .with_terms()
+}
+
 /// The families of this crate.
 pub(super) fn registry() -> JitterRegistry {
     let families = [
@@ -93,7 +185,7 @@ pub(super) fn registry() -> JitterRegistry {
         ),
         one_scale(
             "laplace",
-            "zero-mean Laplace (double exponential), density e^{-|τ|/b}/(2b)",
+            "zero-mean Laplace (double exponential) of scale b",
             "scale",
             "scale b (standard deviation b√2)",
             Laplace::new,
@@ -118,6 +210,17 @@ pub(super) fn registry() -> JitterRegistry {
             <ExponentialDelay as JitterModel>::mean,
             1.0,
         ),
+        one_scale(
+            "periodic",
+            "τ = A sin φ, φ uniform: the arcsine law of a clock disturbed by a tone",
+            "amplitude",
+            "amplitude A of the sinusoidal disturbance (standard deviation A/√2)",
+            Periodic::new,
+            Periodic::amplitude,
+            std::f64::consts::FRAC_1_SQRT_2,
+        ),
+        sum(),
+        mixture(),
     ];
     let mut registry = JitterRegistry::new();
     for family in families {

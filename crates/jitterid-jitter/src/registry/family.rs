@@ -19,6 +19,8 @@ pub struct ParamSpec {
     pub constraint: String,
     /// Whether it is a whole number (structural, not estimated: profiled instead).
     pub integer: bool,
+    /// Whether it is a boolean (its default, if any, is 0 for false and 1 for true).
+    pub boolean: bool,
     /// The value taken when the key is absent; `None` when the key is required.
     pub default: Option<f64>,
 }
@@ -37,6 +39,7 @@ impl ParamSpec {
             unit: unit.into(),
             constraint: constraint.into(),
             integer: false,
+            boolean: false,
             default: None,
         }
     }
@@ -44,6 +47,13 @@ impl ParamSpec {
     /// The same key, holding a whole number.
     pub fn integer(mut self) -> Self {
         self.integer = true;
+        self
+    }
+
+    /// The same key, holding `true` or `false`, optional with this default.
+    pub fn boolean(mut self, default: bool) -> Self {
+        self.boolean = true;
+        self.default = Some(if default { 1.0 } else { 0.0 });
         self
     }
 

@@ -108,6 +108,36 @@ impl JitterRegistry {
         names.join(", ")
     }
 
+    /// The families and their keys as a Markdown table (one row per family with its summary,
+    /// then one per key), as `docs/experiments.md` shows it.
+    pub fn markdown_table(&self) -> String {
+        let mut out = String::from(
+            "| family | key | unit | accepts | default | meaning |\n|---|---|---|---|---|---|\n",
+        );
+        for f in self.families() {
+            let name = f.name();
+            out.push_str(&format!("| `{name}` | — | | | | {} |\n", f.summary()));
+            for p in f.params() {
+                let default = match p.default {
+                    Some(d) if p.boolean => (d != 0.0).to_string(),
+                    Some(d) if p.integer || d.fract() == 0.0 => format!("{d:.0}"),
+                    Some(d) => d.to_string(),
+                    None => "required".into(),
+                };
+                out.push_str(&format!(
+                    "| `{name}` | `{}` | {} | {} | {default} | {} |\n",
+                    p.key, p.unit, p.constraint, p.meaning
+                ));
+            }
+            if f.takes_terms() {
+                out.push_str(&format!(
+                    "| `{name}` | `{TERMS_KEY}` | | two or more tables, each with its own `{FAMILY_KEY}` and keys | required | the terms (`[[jitter.terms]]` in an experiment file) |\n"
+                ));
+            }
+        }
+        out
+    }
+
     fn lookup(&self, name: &str) -> Result<&Family, JitterError> {
         self.family(name).ok_or_else(|| JitterError::UnknownFamily {
             family: name.to_string(),

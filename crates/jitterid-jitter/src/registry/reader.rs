@@ -93,6 +93,26 @@ impl<'a> SpecReader<'a> {
         }
     }
 
+    /// The list of numbers at `key`; [`JitterError::MissingKey`] if absent.
+    pub fn f64_list(&self, key: &str) -> Result<Vec<f64>, JitterError> {
+        match self.spec.get(key) {
+            Some(Value::Array(items)) => items
+                .iter()
+                .map(|v| match v.as_f64() {
+                    Some(x) if x.is_finite() => Ok(x),
+                    _ => Err(self.invalid(key, format!("expected finite numbers, found {v}"))),
+                })
+                .collect(),
+            Some(other) => {
+                Err(self.invalid(key, format!("expected an array of numbers, found {other}")))
+            }
+            None => Err(JitterError::MissingKey {
+                family: self.family().to_string(),
+                key: key.to_string(),
+            }),
+        }
+    }
+
     /// The boolean at `key`, or `default` when absent.
     pub fn bool_or(&self, key: &str, default: bool) -> Result<bool, JitterError> {
         match self.spec.get(key) {

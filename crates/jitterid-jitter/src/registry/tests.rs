@@ -154,3 +154,83 @@ fn a_family_added_at_run_time_is_built_like_the_others() {
     ));
     assert!(JitterRegistry::builtin().family("narrow").is_none());
 }
+
+#[test]
+fn composite_families_build_from_terms_and_round_trip() {
+    let r = JitterRegistry::builtin();
+    for spec in [
+        json!({"family": "periodic", "amplitude": 0.2}),
+        json!({"family": "sum", "terms": [
+            {"family": "gaussian", "sigma": 0.01}, {"family": "two-point", "d": 0.03}]}),
+        json!({"family": "sum", "terms": [
+            {"family": "gaussian", "sigma": 0.01}, {"family": "two-point", "d": 0.03},
+            {"family": "periodic", "amplitude": 0.02, "offset": 0.1}]}),
+        json!({"family": "mixture", "weights": [0.25, 0.75], "terms": [
+            {"family": "gaussian", "sigma": 0.01}, {"family": "laplace", "scale": 0.03}]}),
+        json!({"family": "mixture", "weights": [0.5, 0.5], "fixed_weights": true, "terms": [
+            {"family": "gaussian", "sigma": 0.01}, {"family": "gaussian", "sigma": 0.02}]}),
+    ] {
+        let j = r.build(&table(spec.clone())).unwrap();
+        assert_eq!(serde_json::to_value(&j).unwrap(), spec);
+        check_contract(&j, 5).unwrap();
+    }
+    let three = r
+        .build(&table(json!({"family": "sum", "terms": [
+            {"family": "gaussian", "sigma": 0.01}, {"family": "two-point", "d": 0.03},
+            {"family": "uniform-sum", "n": 1, "a": 0.02}]})))
+        .unwrap();
+    assert_eq!(
+        three.param_names(),
+        vec!["terms.0.sigma", "terms.1.d", "terms.2.a"]
+    );
+    let p = r.from_std_dev("periodic", 0.1, &Spec::new()).unwrap();
+    assert!((p.std_dev() - 0.1).abs() < 1e-16);
+}
+
+#[test]
+fn errors_inside_a_term_name_the_term() {
+    let r = JitterRegistry::builtin();
+    let err = |v| r.build(&table(v)).unwrap_err();
+    let e = err(json!({"family": "sum", "terms": [
+        {"family": "gaussian", "sigma": 0.01}, {"family": "two-point", "d": -1}]}));
+    assert_eq!(e.key(), Some("terms.1.d"), "{e}");
+    let e = err(json!({"family": "sum", "terms": [{"family": "gaussian", "sigma": 0.01}]}));
+    assert_eq!(e.key(), Some("terms"), "{e}");
+    let e = err(json!({"family": "sum", "terms": [{"family": "gaussian", "sigma": 0.01}, 3]}));
+    assert_eq!(e.key(), Some("terms.1"), "{e}");
+    let e = err(
+        json!({"family": "mixture", "weights": [0.5, 0.6], "terms": [
+        {"family": "gaussian", "sigma": 0.01}, {"family": "gaussian", "sigma": 0.02}]}),
+    );
+    assert_eq!(e.key(), Some("weights"), "{e}");
+    let e = err(
+        json!({"family": "mixture", "weights": [0.5, 0.5], "terms": [
+        {"family": "gaussian", "sigma": 0.01}, {"family": "nope"}]}),
+    );
+    assert_eq!(e.key(), Some("terms.1.family"), "{e}");
+    assert!(matches!(
+        r.from_std_dev("sum", 0.1, &Spec::new()),
+        Err(JitterError::NoStdDevForm { .. })
+    ));
+}
+
+#[test]
+fn the_docs_table_of_families_is_the_registry_s() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
+    let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
+    let header = "| family | key | unit | accepts | default | meaning |";
+    let start = text
+        .find(header)
+        .expect("docs/experiments.md has the table of jitter families");
+    let table: String = text[start..]
+        .lines()
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let expected = JitterRegistry::builtin().markdown_table();
+    assert!(
+        table == expected,
+        "the [jitter] families table of docs/experiments.md differs from the registry; \
+         replace it with:\n\n{expected}"
+    );
+}
