@@ -2,37 +2,25 @@
 //! refused by the real binary when the experiment is read, with the file, the line and the key
 //! named, and exit status 2; nothing is written.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::{example_with, jitterid, scratch};
+use std::path::PathBuf;
+use std::process::Output;
 
 /// The paper's Table 2 experiment with one line replaced.
 fn table2_with(from: &str, to: &str) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/experiments/table2.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    let line = text
-        .lines()
-        .find(|l| l.starts_with(from))
-        .unwrap_or_else(|| panic!("table2.toml has no line starting with {from:?}"));
-    text.replacen(line, to, 1)
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("jitterid-door")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    example_with("table2.toml", from, to)
 }
 
 /// Runs `simulate` on the experiment `text`, written to a fresh directory `name`; returns the
 /// process output and the data file it was asked to write.
 fn simulate(name: &str, text: &str) -> (Output, PathBuf) {
-    let d = scratch(name);
+    let d = scratch("jitterid-door", name);
     let exp = d.join("e.toml");
     std::fs::write(&exp, text).unwrap();
     let out = d.join("d.csv");
-    let o = Command::new(env!("CARGO_BIN_EXE_jitterid"))
+    let o = jitterid()
         .args([
             "simulate",
             exp.to_str().unwrap(),
@@ -153,4 +141,41 @@ fn values_inside_the_range_still_simulate_finite_samples() {
             }
         }
     }
+}
+
+/// The dual-Dirac example with one line replaced.
+fn dual_dirac_with(from: &str, to: &str) -> String {
+    example_with("dual-dirac.toml", from, to)
+}
+
+#[test]
+fn a_bad_key_of_a_sum_term_is_named_at_its_line() {
+    let text = dual_dirac_with("d = 0.3", "d = -0.3");
+    let line = 1 + text
+        .lines()
+        .position(|l| l.starts_with("d = -0.3"))
+        .unwrap();
+    refused(
+        "term-key",
+        &text,
+        &[&format!("e.toml:{line}:"), "[jitter] terms.1.d"],
+    );
+}
+
+#[test]
+fn a_term_time_scale_outside_the_range_is_named_at_its_line() {
+    let text = dual_dirac_with("sigma = 0.1", "sigma = 1e-300");
+    let line = 1 + text
+        .lines()
+        .position(|l| l.starts_with("sigma = 1e-300"))
+        .unwrap();
+    refused(
+        "term-range",
+        &text,
+        &[
+            &format!("e.toml:{line}:"),
+            "[jitter] terms.0.sigma",
+            "time scale",
+        ],
+    );
 }

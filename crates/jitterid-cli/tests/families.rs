@@ -3,32 +3,13 @@
 //! experiment file, through the real binary — simulate, fit with the family estimated, and a
 //! small seeded Monte Carlo study whose mean is unbiased.
 
+mod common;
+
+use common::{example, jitterid, scratch};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/experiments")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("jitterid-families")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn ok(args: &[&str]) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_jitterid"))
-        .args(args)
-        .output()
-        .unwrap();
+    let o = jitterid().args(args).output().unwrap();
     assert!(
         o.status.success(),
         "jitterid {args:?} failed: {}",
@@ -45,7 +26,7 @@ fn json(args: &[&str]) -> Value {
 /// Simulates one record, fits it with the family estimated, and checks the fit converged
 /// with the expected parameter names, each estimate finite.
 fn simulate_and_fit(name: &str, names: &[&str]) {
-    let d = scratch(name);
+    let d = scratch("jitterid-families", name);
     let data = d.join("d.csv");
     let exp = example(&format!("{name}.toml"));
     ok(&[
