@@ -18,19 +18,18 @@
 //! printed with `--nocapture`.)
 
 use jitterid::estimate::solver::{
-    LeastSquares, LevenbergMarquardt, LmOptions, MultiStart, NelderMead, Scaling, Solver,
-    SolverError, SolverReport,
+    AnySolver, LevenbergMarquardt, LmOptions, MultiStart, NelderMead, Scaling,
 };
 use jitterid::estimate::{
-    estimate, initialize, ArmaNoise, Bcls, BoxJenkins, Criterion, Estimate, EstimateError,
-    EstimateOptions, Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel,
-    Record, WeightedBcls,
+    estimate, initialize, ArmaNoise, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
+    Fit, Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, Record,
+    WeightedBcls,
 };
 use jitterid::jitter::registry::{JitterRegistry, Spec};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel};
 use jitterid::prelude::*;
 use jitterid::signal::Tone;
-use jitterid::window::{DirichletWindow, FrequencySet, HannWindow};
+use jitterid::window::{DirichletWindow, HannWindow};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -41,84 +40,6 @@ use std::time::Instant;
 const CI_CASES: u32 = 256;
 /// Seed in CI (`PROPTEST_RNG_SEED` overrides).
 const CI_SEED: u64 = 0x6a69_7474_6572;
-
-// ---------------------------------------------------------------------------------------------
-// Object-safe stand-ins: one concrete type per trait, so the fuzzer instantiates `estimate`
-// only a few times.
-
-/// Any criterion.
-#[derive(Debug, Clone)]
-enum AnyCriterion {
-    Ls(Ls),
-    Bcls(Bcls),
-    Weighted(WeightedBcls),
-    Bj(BoxJenkins),
-}
-
-impl Criterion for AnyCriterion {
-    fn name(&self) -> &'static str {
-        match self {
-            AnyCriterion::Ls(c) => c.name(),
-            AnyCriterion::Bcls(c) => c.name(),
-            AnyCriterion::Weighted(c) => c.name(),
-            AnyCriterion::Bj(c) => c.name(),
-        }
-    }
-    fn models_jitter(&self) -> bool {
-        match self {
-            AnyCriterion::Ls(c) => c.models_jitter(),
-            AnyCriterion::Bcls(c) => c.models_jitter(),
-            AnyCriterion::Weighted(c) => c.models_jitter(),
-            AnyCriterion::Bj(c) => c.models_jitter(),
-        }
-    }
-    fn uses_noise_model(&self) -> bool {
-        match self {
-            AnyCriterion::Ls(c) => c.uses_noise_model(),
-            AnyCriterion::Bcls(c) => c.uses_noise_model(),
-            AnyCriterion::Weighted(c) => c.uses_noise_model(),
-            AnyCriterion::Bj(c) => c.uses_noise_model(),
-        }
-    }
-    fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, noise: &N) -> Vec<f64> {
-        match self {
-            AnyCriterion::Ls(c) => c.weights(freqs, noise),
-            AnyCriterion::Bcls(c) => c.weights(freqs, noise),
-            AnyCriterion::Weighted(c) => c.weights(freqs, noise),
-            AnyCriterion::Bj(c) => c.weights(freqs, noise),
-        }
-    }
-    fn validate(&self, freqs: &FrequencySet) -> Result<(), EstimateError> {
-        match self {
-            AnyCriterion::Ls(c) => c.validate(freqs),
-            AnyCriterion::Bcls(c) => c.validate(freqs),
-            AnyCriterion::Weighted(c) => c.validate(freqs),
-            AnyCriterion::Bj(c) => c.validate(freqs),
-        }
-    }
-}
-
-/// Any solver, each with a bounded budget.
-#[derive(Debug, Clone)]
-enum AnySolver {
-    Lm(LevenbergMarquardt),
-    Multi(MultiStart<LevenbergMarquardt>),
-    Simplex(NelderMead),
-}
-
-impl Solver for AnySolver {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
-        match self {
-            AnySolver::Lm(s) => s.minimize(problem, start),
-            AnySolver::Multi(s) => s.minimize(problem, start),
-            AnySolver::Simplex(s) => s.minimize(problem, start),
-        }
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Strategies.
@@ -572,18 +493,18 @@ fn build_input(spec: &InputSpec) -> Option<Input> {
     }
 }
 
-fn build_criterion(spec: &CriterionSpec) -> Option<AnyCriterion> {
+fn build_criterion(spec: &CriterionSpec) -> Option<Box<dyn Criterion>> {
     Some(match spec {
-        CriterionSpec::Ls => AnyCriterion::Ls(Ls),
-        CriterionSpec::Bcls => AnyCriterion::Bcls(Bcls),
+        CriterionSpec::Ls => Box::new(Ls),
+        CriterionSpec::Bcls => Box::new(Bcls),
         CriterionSpec::Weighted(w) => match WeightedBcls::new(w.clone()) {
-            Ok(c) => AnyCriterion::Weighted(c),
+            Ok(c) => Box::new(c),
             Err(e) => {
                 note_error(&e);
                 return None;
             }
         },
-        CriterionSpec::Bj => AnyCriterion::Bj(BoxJenkins),
+        CriterionSpec::Bj => Box::new(BoxJenkins),
     })
 }
 
@@ -601,9 +522,14 @@ fn build_solver(spec: &SolverSpec) -> AnySolver {
         ..LmOptions::default()
     });
     match spec.kind {
-        0 => AnySolver::Lm(lm),
-        1 => AnySolver::Multi(MultiStart::new(lm, spec.starts, spec.radius, 7)),
-        _ => AnySolver::Simplex(NelderMead {
+        0 => AnySolver::new(lm),
+        1 => AnySolver::new(MultiStart::new(
+            AnySolver::new(lm),
+            spec.starts,
+            spec.radius,
+            7,
+        )),
+        _ => AnySolver::new(NelderMead {
             max_iters: 20 * spec.max_iters,
             ..NelderMead::default()
         }),
@@ -612,7 +538,7 @@ fn build_solver(spec: &SolverSpec) -> AnySolver {
 
 /// The invariants of an `Ok` estimate.
 fn check_estimate<S, J, N>(
-    e: &Estimate,
+    e: &Fit,
     structure: &ModelStructure<S, J, N>,
 ) -> Result<(), TestCaseError>
 where
@@ -647,7 +573,7 @@ fn run_structure<M, N>(
     case: &Case,
     structure: ModelStructure<LtiResponse<M>, AnyJitter, N>,
     record: &Record,
-    criterion: &AnyCriterion,
+    criterion: &dyn Criterion,
 ) -> Result<(), TestCaseError>
 where
     M: InitialModel,
@@ -718,7 +644,7 @@ fn run_model<M: InitialModel>(
     input: Input,
     jitter: AnyJitter,
     record: &Record,
-    criterion: &AnyCriterion,
+    criterion: &dyn Criterion,
 ) -> Result<(), TestCaseError> {
     let signal = LtiResponse::new(model, input);
     let with_std = |x: Result<_, EstimateError>| match x {

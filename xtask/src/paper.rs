@@ -58,3 +58,21 @@ pub fn eq17(k0: f64, z: f64, pr: f64, pi: f64) -> Result<Zpk, jitterid::signal::
 pub fn rng(seed: u64, r: u64) -> StdRng {
     realization_rng(seed, r)
 }
+
+/// `√(3(n+1))`: the ratio `a/σ` of the uniform-sum family with `n + 1` terms.
+fn uniform_sum_ratio(n: f64) -> f64 {
+    (3.0 * (n + 1.0)).sqrt()
+}
+
+/// The start of every `n` of a uniform-sum profile: `n + 1` terms and standard deviation
+/// `sigma`.
+pub fn uniform_sum_with_std(
+    sigma: f64,
+) -> impl Fn(i64) -> Result<UniformSum, jitterid::jitter::JitterError> + Sync {
+    move |n| UniformSum::new(n as u32, sigma * uniform_sum_ratio(n as f64))
+}
+
+/// `σ = a/√(3(n+1))` of a uniform sum (and the same scaling of a standard error of `a`).
+pub fn uniform_sum_sigma(n: i64, a: f64) -> f64 {
+    a / uniform_sum_ratio(n as f64)
+}

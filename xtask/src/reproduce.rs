@@ -4,7 +4,7 @@ use crate::paper::{self, NOISE_STD, RUNS};
 use crate::Options;
 use jitterid::estimate::montecarlo::{run as mc_run, Summary};
 use jitterid::estimate::{
-    estimate, profile_uniform_sum, Bcls, Criterion, EstimateOptions, Ls, ModelStructure, Record,
+    estimate, profile, Bcls, Criterion, EstimateOptions, Ls, ModelStructure, Record,
 };
 use jitterid::jitter::JitterModel;
 use jitterid::prelude::*;
@@ -411,24 +411,25 @@ fn table1(o: &Options) -> Result<(), String> {
                 let start = UniformSum::new(0, s0 * 3f64.sqrt()).ok()?;
                 let structure =
                     ModelStructure::oe(signal, start).with_estimated(false, true, false);
-                let p = profile_uniform_sum(
+                let p = profile(
                     &structure,
                     &record,
                     &Bcls,
                     &EstimateOptions::default(),
                     0..=9,
+                    paper::uniform_sum_with_std(structure.jitter.std_dev()),
                 )
                 .ok()?;
                 let a_se = p
                     .estimate
                     .std_errors
                     .as_ref()
-                    .map(|s| s[0] / (3.0 * (p.n as f64 + 1.0)).sqrt());
+                    .map(|s| paper::uniform_sum_sigma(p.value, s[0]));
                 p.estimate.converged.then(|| {
                     (
-                        p.n as f64,
+                        p.value as f64,
                         p.estimate.params[0],
-                        p.sigma().unwrap_or(f64::NAN),
+                        paper::uniform_sum_sigma(p.value, p.estimate.params[0]),
                         a_se,
                     )
                 })

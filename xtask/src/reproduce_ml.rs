@@ -4,12 +4,11 @@ use crate::paper::{self, NOISE_STD, RUNS};
 use crate::reproduce::{runs_range, write_outputs};
 use crate::Options;
 use jitterid::estimate::ml::{
-    attenuation_sigma, exact_fisher, fit_sine, gaussian_fisher, ml_estimate,
-    ml_profile_uniform_sum, sine_least_squares, ExactMl, FisherOptions, LikelihoodCriterion,
-    MlOptions, QuasiMl, SineFit,
+    attenuation_sigma, exact_fisher, fit_sine, gaussian_fisher, ml_estimate, ml_profile,
+    sine_least_squares, ExactMl, FisherOptions, LikelihoodCriterion, MlOptions, QuasiMl, SineFit,
 };
 use jitterid::estimate::montecarlo::{run as mc_run, Summary};
-use jitterid::estimate::{profile_uniform_sum, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid::estimate::{profile, Bcls, EstimateOptions, ModelStructure, Record};
 use jitterid::prelude::*;
 use serde::Serialize;
 use serde_json::json;
@@ -124,15 +123,16 @@ fn bootstrap_mean_sigma(
         let mut rng = paper::rng(seed ^ 0xB00_75EED, r * BOOT + b);
         let data = simulate(signal, &fitted, &grid, NOISE_STD, &mut rng).ok()?;
         let record = Record::new(grid, data.y).ok()?;
-        if let Ok(p) = ml_profile_uniform_sum(
+        if let Ok(p) = ml_profile(
             &structure,
             &record,
             &ExactMl::default(),
             &MlOptions::default(),
             0..=9,
+            paper::uniform_sum_with_std(structure.jitter.std_dev()),
         ) {
-            if let (true, Some(sigma)) = (p.estimate.converged, p.sigma()) {
-                s.push(sigma);
+            if let (true, Some(a)) = (p.estimate.converged, p.estimate.param("jitter.a")) {
+                s.push(paper::uniform_sum_sigma(p.value, a));
             }
         }
     }
@@ -148,15 +148,17 @@ fn profile_ml<C: LikelihoodCriterion>(
         covariance: true,
         ..Default::default()
     };
-    let p = ml_profile_uniform_sum(structure, record, criterion, &opts, 0..=9).ok()?;
+    let build = paper::uniform_sum_with_std(structure.jitter.std_dev());
+    let p = ml_profile(structure, record, criterion, &opts, 0..=9, build).ok()?;
+    let sigma = |a: Option<f64>| a.map(|a| paper::uniform_sum_sigma(p.value, a));
     p.estimate.converged.then(|| {
         (
             [
-                f64::from(p.n),
+                p.value as f64,
                 p.estimate.params[0],
-                p.sigma().unwrap_or(f64::NAN),
+                sigma(p.estimate.param("jitter.a")).unwrap_or(f64::NAN),
             ],
-            p.sigma_std(),
+            sigma(p.estimate.std_error("jitter.a")),
         )
     })
 }
@@ -223,18 +225,19 @@ fn one_record(
     let start = UniformSum::new(0, s0 * 3f64.sqrt()).ok()?;
     let structure = ModelStructure::oe(signal.clone(), start).with_estimated(false, true, false);
     let mut rec = Rec::default();
-    if let Ok(p) = profile_uniform_sum(
+    if let Ok(p) = profile(
         &structure,
         &record,
         &Bcls,
         &EstimateOptions::default(),
         0..=9,
+        paper::uniform_sum_with_std(structure.jitter.std_dev()),
     ) {
         if p.estimate.converged {
             rec.bcls = Some([
-                f64::from(p.n),
+                p.value as f64,
                 p.estimate.params[0],
-                p.sigma().unwrap_or(f64::NAN),
+                paper::uniform_sum_sigma(p.value, p.estimate.params[0]),
             ]);
         }
     }
@@ -349,7 +352,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
         "## Table 1 by maximum likelihood: known G(s) = 1/(s+2), jitter estimated from the second moment\n\n\
          Same realisations as `table1` (input, jitter, noise and start drawn in the same order). \
          Noise std 0.01 known to the likelihood estimators. Uniform-sum family: `n` profiled over 0..=9 \
-         (`ml_profile_uniform_sum`), `a` by Brent's method in `ln a`. Exact ML: the per-sample likelihood \
+         (`ml_profile`), `a` by Brent's method in `ln a`. Exact ML: the per-sample likelihood \
          `∫ φ(y − s(t+τ)) p(τ) dτ`; quasi-ML: the Gaussian likelihood of `m_k` and `λ_k`. \
          CRB std: the exact model's Cramér–Rao bound of σ at the truth (the family's own parameter, `n` known; \
          σ = a/√(3(n+1)) for the uniform sum), root mean square over the first ",
@@ -544,7 +547,7 @@ fn sine_record(record: &Record) -> Option<SineRec> {
         fit(SINE_F0, jitter_known, false),
         fit(SINE_ALIAS, jitter_known, false),
     ) {
-        (Some(a), Some(b)) => Some((a.estimate.neg_log_likelihood, b.estimate.neg_log_likelihood)),
+        (Some(a), Some(b)) => Some((a.estimate.cost, b.estimate.cost)),
         _ => None,
     };
     // Each alias from its own classical start: the attenuation Â/A = γ(f) read at that
@@ -561,12 +564,7 @@ fn sine_record(record: &Record) -> Option<SineRec> {
         fit(SINE_F0, start, true),
         start_at(SINE_ALIAS).and_then(|j| fit(SINE_ALIAS, j, true)),
     ) {
-        (Some(a), Some(b)) => Some((
-            a.estimate.neg_log_likelihood,
-            b.estimate.neg_log_likelihood,
-            a.jitter_std,
-            b.jitter_std,
-        )),
+        (Some(a), Some(b)) => Some((a.estimate.cost, b.estimate.cost, a.jitter_std, b.jitter_std)),
         _ => None,
     };
     Some(SineRec {

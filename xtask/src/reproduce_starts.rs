@@ -22,8 +22,8 @@ use crate::Options;
 use jitterid::estimate::montecarlo::run as mc_run;
 use jitterid::estimate::solver::{LevenbergMarquardt, MultiStart, Solver};
 use jitterid::estimate::{
-    estimate, initialize, residual_flatness, Bcls, EstimateOptions, Frequencies, InitOptions,
-    ModelStructure, Record, FLATNESS_BANDS, FLATNESS_LIMIT,
+    estimate, initialize, residual_flatness, Bcls, EstimateOptions, FitProblem, Frequencies,
+    InitOptions, ModelStructure, Record, WhiteNoise, FLATNESS_BANDS, FLATNESS_LIMIT,
 };
 use jitterid::prelude::*;
 use jitterid::window::DirichletWindow;
@@ -80,7 +80,12 @@ impl Outcome {
 
 type Structure = ModelStructure<LtiResponse<Zpk>, UniformSum>;
 
-fn fit<V: Solver>(structure: &Structure, record: &Record, solver: V) -> Outcome {
+fn fit<V>(structure: &Structure, record: &Record, solver: V) -> Outcome
+where
+    V: for<'a> Solver<
+        FitProblem<'a, LtiResponse<Zpk>, UniformSum, WhiteNoise, Bcls, DirichletWindow>,
+    >,
+{
     let options = EstimateOptions {
         frequencies: Frequencies::Dft,
         window: DirichletWindow,

@@ -2,9 +2,7 @@
 
 use crate::paper;
 use jitterid::estimate::montecarlo::realization_rng;
-use jitterid::estimate::{
-    estimate, Bcls, Criterion, EstimateOptions, FrequencyData, ModelStructure, Record,
-};
+use jitterid::estimate::{estimate, Bcls, EstimateOptions, FrequencyData, ModelStructure, Record};
 use jitterid::prelude::*;
 use jitterid::window::{DirichletWindow, FrequencySet};
 use std::time::Instant;
@@ -57,8 +55,8 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
             (0..reps)
                 .map(|_| {
                     let t = Instant::now();
-                    let r = Bcls.residuals(&data, &structure);
-                    let j = Bcls.jacobian(&data, &structure);
+                    let r = data.residuals(&Bcls, &structure);
+                    let j = data.jacobian(&Bcls, &structure);
                     std::hint::black_box((r, j));
                     t.elapsed().as_secs_f64() * 1e3
                 })

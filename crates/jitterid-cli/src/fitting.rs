@@ -9,8 +9,8 @@ use jitterid::estimate::solver::{
     GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
 };
 use jitterid::estimate::{
-    estimate, profile_uniform_sum, Bcls, BoxJenkins, Criterion, Estimate, EstimateError,
-    EstimateOptions, Ls, ModelStructure, NoiseModel, Record,
+    estimate, profile, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
+    Fit as Estimate, Ls, ModelStructure, NoiseModel, Record,
 };
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
@@ -18,6 +18,14 @@ use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
 use jitterid::signal::{simulate, Input, LtiResponse, SampleGrid, Signal};
 use jitterid::window::DirichletWindow;
+
+/// The uniform-sum jitter with `n + 1` terms and standard deviation `sigma`: the start of every
+/// `n` of a profile.
+fn uniform_sum_with_std(
+    sigma: f64,
+) -> impl Fn(i64) -> Result<UniformSum, jitterid::jitter::JitterError> + Sync {
+    move |n| UniformSum::new(n as u32, sigma * (3.0 * (n as f64 + 1.0)).sqrt())
+}
 
 /// The model structure of the command line.
 pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
@@ -320,11 +328,20 @@ fn run_criterion<C: Criterion>(
                 estimate_noise: s.estimate_noise,
                 noise_std: s.noise_std,
             };
-            let p = profile_uniform_sum(&us, record, criterion, opts, lo..=hi)?;
+            let values = i64::from(lo)..=i64::from(hi);
+            let p = profile(
+                &us,
+                record,
+                criterion,
+                opts,
+                values,
+                uniform_sum_with_std(u.std_dev()),
+            )?;
+            let n = p.value as u32;
             let mut base = s.clone();
-            base.jitter = with_n(&s.jitter, p.n)?;
+            base.jitter = with_n(&s.jitter, n)?;
             let fitted = base.with_params(&p.estimate.params)?;
-            return Ok((p.estimate, fitted, Some(p.n)));
+            return Ok((p.estimate, fitted, Some(n)));
         }
     }
     let e = estimate(s, record, criterion, opts)?;
@@ -446,8 +463,7 @@ fn fit_ml(
     covariance: bool,
 ) -> Result<Raw, String> {
     use jitterid::estimate::ml::{
-        ml_estimate, ml_profile_uniform_sum, ExactMl, LikelihoodCriterion, MlEstimate, MlOptions,
-        QuasiMl,
+        ml_estimate, ml_profile, ExactMl, LikelihoodCriterion, MlOptions, QuasiMl,
     };
     fn go<C: LikelihoodCriterion>(
         exp: &Experiment,
@@ -455,7 +471,7 @@ fn fit_ml(
         record: &Record,
         c: &C,
         opts: &MlOptions,
-    ) -> Result<(MlEstimate, Option<u32>, Structure), String> {
+    ) -> Result<(Estimate, Option<u32>, Structure), String> {
         let e = |e: jitterid::estimate::ml::MlError| e.to_string();
         if profiled(exp) {
             if let (Some(u), Some((lo, hi))) =
@@ -470,10 +486,13 @@ fn fit_ml(
                     estimate_noise: s.estimate_noise,
                     noise_std: s.noise_std,
                 };
-                let p = ml_profile_uniform_sum(&us, record, c, opts, lo..=hi).map_err(e)?;
+                let values = i64::from(lo)..=i64::from(hi);
+                let build = uniform_sum_with_std(u.std_dev());
+                let p = ml_profile(&us, record, c, opts, values, build).map_err(e)?;
+                let n = p.value as u32;
                 let mut base = s.clone();
-                base.jitter = with_n(&s.jitter, p.n).map_err(|x| x.to_string())?;
-                return Ok((p.estimate, Some(p.n), base));
+                base.jitter = with_n(&s.jitter, n).map_err(|x| x.to_string())?;
+                return Ok((p.estimate, Some(n), base));
             }
         }
         Ok((ml_estimate(s, record, c, opts).map_err(e)?, None, s.clone()))
@@ -495,7 +514,7 @@ fn fit_ml(
     Ok(Raw {
         params: e.params,
         std_errors: e.std_errors,
-        cost: e.neg_log_likelihood,
+        cost: e.cost,
         iterations: e.iterations,
         termination: e.termination.to_string(),
         converged: e.converged,

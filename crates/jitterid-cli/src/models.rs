@@ -161,12 +161,8 @@ pub enum AnySolver {
     Multi(Box<MultiStart<AnySolver>>),
 }
 
-impl Solver for AnySolver {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
+impl<P: LeastSquares> Solver<P> for AnySolver {
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         match self {
             AnySolver::Lm(s) => s.minimize(problem, start),
             AnySolver::GaussNewton(s) => s.minimize(problem, start),

@@ -3,13 +3,20 @@
 //! Target (issue 4): at most 50 ms median.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jitterid_estimate::ml::{ml_estimate, ml_profile_uniform_sum, ExactMl, MlOptions, QuasiMl};
+use jitterid_estimate::ml::{ml_estimate, ml_profile, ExactMl, MlOptions, QuasiMl};
 use jitterid_estimate::{ModelStructure, Record};
 use jitterid_jitter::UniformSum;
+use jitterid_jitter::{JitterError, JitterModel};
 use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::hint::black_box;
+
+/// The uniform-sum jitter with `n` terms and the standard deviation of `start`.
+fn keep_std_dev(start: &UniformSum) -> impl Fn(i64) -> Result<UniformSum, JitterError> + Sync {
+    let sigma = start.std_dev();
+    move |n| UniformSum::new(n as u32, sigma * (3.0 * (n as f64 + 1.0)).sqrt())
+}
 
 fn setup(seed: u64) -> (ModelStructure<LtiResponse<Zpk>, UniformSum>, Record) {
     let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap();
@@ -39,8 +46,15 @@ fn bench(c: &mut Criterion) {
     group.bench_function("exact-ml profile n=0..=9", |b| {
         b.iter(|| {
             black_box(
-                ml_profile_uniform_sum(&structure, &record, &ExactMl::default(), &opts, 0..=9)
-                    .unwrap(),
+                ml_profile(
+                    &structure,
+                    &record,
+                    &ExactMl::default(),
+                    &opts,
+                    0..=9,
+                    keep_std_dev(&structure.jitter),
+                )
+                .unwrap(),
             )
         })
     });
@@ -49,7 +63,17 @@ fn bench(c: &mut Criterion) {
     });
     group.bench_function("quasi-ml profile n=0..=9", |b| {
         b.iter(|| {
-            black_box(ml_profile_uniform_sum(&structure, &record, &QuasiMl, &opts, 0..=9).unwrap())
+            black_box(
+                ml_profile(
+                    &structure,
+                    &record,
+                    &QuasiMl,
+                    &opts,
+                    0..=9,
+                    keep_std_dev(&structure.jitter),
+                )
+                .unwrap(),
+            )
         })
     });
     group.finish();

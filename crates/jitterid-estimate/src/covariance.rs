@@ -7,7 +7,8 @@
 //! so the simple `σ² H⁻¹` would be wrong. For coloured (Box–Jenkins) noise, its part of `Σ_r`
 //! is the asymptotic diagonal `N Φ_v(f)/2` per real and imaginary part.
 
-use crate::criterion::{Criterion, FrequencyData};
+use crate::criterion::Criterion;
+use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use faer::linalg::solvers::DenseSolveCore;
@@ -30,7 +31,7 @@ where
     S: Signal,
     J: JitterModel,
     N: NoiseModel,
-    C: Criterion,
+    C: Criterion + ?Sized,
     W: Window,
 {
     let record = data.record();
@@ -72,7 +73,7 @@ where
             acc / freqs.len() as f64
         }
     };
-    let w = criterion.weights(freqs, &model.noise);
+    let w = data.weights(criterion, model, None);
     let taper = data.window().weights(n);
 
     let g = project_to_time(jac, freqs, &w, n, t);

@@ -2,84 +2,32 @@
 //! the Box–Jenkins criterion, all of the form
 //!
 //! ```text
-//! V(θ) = ½ Σ_f w_f(θ) |Y(f) − μ_Y(f; θ)|²  = ½ Σ r_i(θ)²
+//! V(θ) = ½ Σ_f w_f |Y(f) − μ_Y(f; θ)|²  = ½ Σ r_i(θ)²
 //! ```
 //!
-//! over an arbitrary [`FrequencySet`]. The residual vector stacks
-//! `√w_f Re(Y − μ)` and `√w_f Im(Y − μ)` per frequency. Jacobians are analytic in the signal's
-//! parameters (the transform of `∂m_k/∂θ`) and central finite differences in the jitter's and
-//! the noise shape's.
+//! over an arbitrary [`FrequencySet`]. A criterion is its weights `w_f`: they may depend on the
+//! frequency set, the data `Y(f)` and the model at the current parameters (its first moment
+//! `μ_Y`, the jitter's `γ(f)`, the noise shape, the variance of `Y(f)`), all offered by the
+//! [`WeightContext`]. The residuals, their Jacobian and the cost are the same for every
+//! criterion ([`FrequencyData::residuals`](crate::FrequencyData::residuals),
+//! [`jacobian`](crate::FrequencyData::jacobian), [`cost`](crate::FrequencyData::cost)).
+//! The trait is object safe: criteria can be collected in a `Vec<Box<dyn Criterion>>`.
 
-use crate::data::Record;
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use crate::EstimateError;
-use faer::Mat;
-use jitterid_jitter::{JitterModel, NoJitter};
-use jitterid_signal::Signal;
-use jitterid_window::{transform, FrequencySet, Window};
+use jitterid_jitter::JitterModel;
+use jitterid_signal::{SampleGrid, Signal};
+use jitterid_window::FrequencySet;
 use num_complex::Complex64;
 use std::fmt;
-
-/// The data side of a frequency-domain criterion: the record, the window, the frequency set
-/// and the windowed DTFT `Y(f)` at those frequencies, computed once.
-#[derive(Debug, Clone)]
-pub struct FrequencyData<W> {
-    record: Record,
-    window: W,
-    freqs: FrequencySet,
-    y: Vec<Complex64>,
-}
-
-impl<W: Window> FrequencyData<W> {
-    /// Transforms the record once.
-    pub fn new(record: Record, window: W, freqs: FrequencySet) -> Result<Self, EstimateError> {
-        let y = transform(record.grid(), &window, record.y(), &freqs)?;
-        Ok(Self {
-            record,
-            window,
-            freqs,
-            y,
-        })
-    }
-
-    /// The record.
-    pub fn record(&self) -> &Record {
-        &self.record
-    }
-
-    /// The window.
-    pub fn window(&self) -> &W {
-        &self.window
-    }
-
-    /// The frequency set.
-    pub fn frequencies(&self) -> &FrequencySet {
-        &self.freqs
-    }
-
-    /// `Y(f)` at the frequency set.
-    pub fn dtft(&self) -> &[Complex64] {
-        &self.y
-    }
-
-    /// Number of real residuals (two per frequency).
-    pub fn num_residuals(&self) -> usize {
-        2 * self.freqs.len()
-    }
-
-    /// `μ_Y(f)` for the model's first moment `m_k`, or NaN where `m` is not finite.
-    pub fn transform_moment(&self, m: &[f64]) -> Vec<Complex64> {
-        transform(self.record.grid(), &self.window, m, &self.freqs)
-            .unwrap_or_else(|_| vec![Complex64::new(f64::NAN, f64::NAN); self.freqs.len()])
-    }
-}
+use std::sync::OnceLock;
 
 /// A frequency-weighted least-squares criterion on the first moment of the DTFT.
 ///
 /// Required: a name, whether the model of the mean includes the jitter, and the weights
-/// `w_f`. Provided: residuals, their Jacobian with respect to the structure's free parameters,
-/// and the cost. A new criterion of this family (a different weighting) is one new type.
+/// `w_f ≥ 0`. Everything else has a default. A new criterion (a different weighting) is one
+/// new type; see the criterion section of `docs/extending.md`.
 pub trait Criterion: fmt::Debug + Send + Sync {
     /// Short name (`"ls"`, `"bcls"`, …).
     fn name(&self) -> &'static str;
@@ -87,22 +35,31 @@ pub trait Criterion: fmt::Debug + Send + Sync {
     /// Whether `μ_Y` includes the jitter's damping (false for naive LS, which uses `γ ≡ 1`).
     fn models_jitter(&self) -> bool;
 
-    /// Whether the weights depend on the noise model (so its parameters enter the criterion).
+    /// Whether the weights depend on the noise model (so its parameters enter the criterion
+    /// through the weights).
     fn uses_noise_model(&self) -> bool {
+        false
+    }
+
+    /// Whether the weights depend on the model's parameters (through `μ_Y`, `γ(f)` or the
+    /// variance of `Y(f)`), so that the Jacobian must include `∂√w_f/∂θ`. False by default:
+    /// weights of the frequency set and the data alone.
+    fn model_dependent_weights(&self) -> bool {
         false
     }
 
     /// Whether the weighted residuals at the true parameters have the same variance at every
     /// frequency (white measurement noise for BCLS; the noise model's shape divided out for
-    /// Box–Jenkins), so that [`estimate`](crate::estimate) can check a converged fit with
+    /// Box–Jenkins), so that [`estimate`](crate::estimate) checks a converged fit with
     /// [`residual_flatness`](crate::residual_flatness). False by default (naive LS keeps the
-    /// jitter's bias in its residuals; user weights can shape them arbitrarily).
+    /// jitter's bias in its residuals; user weights can shape them arbitrarily); a criterion of
+    /// your own that declares it gets the same check.
     fn flat_residuals(&self) -> bool {
         false
     }
 
     /// Weights `w_f ≥ 0`, one per frequency of the set.
-    fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, noise: &N) -> Vec<f64>;
+    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64>;
 
     /// Checks the criterion against a frequency set before a fit (for example the number of
     /// user weights).
@@ -110,145 +67,134 @@ pub trait Criterion: fmt::Debug + Send + Sync {
         let _ = freqs;
         Ok(())
     }
+}
 
-    /// The model's `m_k`: with the structure's jitter, or none for a criterion that ignores it.
-    fn first_moment<S: Signal, J: JitterModel, N: NoiseModel, W: Window>(
-        &self,
-        data: &FrequencyData<W>,
-        model: &ModelStructure<S, J, N>,
-    ) -> Vec<f64> {
-        let grid = data.record().grid();
-        if self.models_jitter() {
-            model.signal.expected_values(grid, &model.jitter)
-        } else {
-            model.signal.expected_values(grid, &NoJitter)
+impl<C: Criterion + ?Sized> Criterion for Box<C> {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+    fn models_jitter(&self) -> bool {
+        (**self).models_jitter()
+    }
+    fn uses_noise_model(&self) -> bool {
+        (**self).uses_noise_model()
+    }
+    fn model_dependent_weights(&self) -> bool {
+        (**self).model_dependent_weights()
+    }
+    fn flat_residuals(&self) -> bool {
+        (**self).flat_residuals()
+    }
+    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
+        (**self).weights(context)
+    }
+    fn validate(&self, freqs: &FrequencySet) -> Result<(), EstimateError> {
+        (**self).validate(freqs)
+    }
+}
+
+/// The parts of a model structure that weights may look at, without its type parameters.
+pub(crate) trait ModelView: Sync {
+    fn jitter_cf(&self, f: f64) -> Complex64;
+    fn noise_shape(&self, f: f64, interval: f64) -> f64;
+    fn jitter_variances(&self, grid: &SampleGrid) -> Vec<f64>;
+    fn noise_std(&self) -> Option<f64>;
+}
+
+impl<S: Signal, J: JitterModel, N: NoiseModel> ModelView for ModelStructure<S, J, N> {
+    fn jitter_cf(&self, f: f64) -> Complex64 {
+        self.jitter.cf(f)
+    }
+    fn noise_shape(&self, f: f64, interval: f64) -> f64 {
+        self.noise.shape(f, interval)
+    }
+    fn jitter_variances(&self, grid: &SampleGrid) -> Vec<f64> {
+        let m = self.signal.expected_values(grid, &self.jitter);
+        let s2 = self.signal.expected_squares(grid, &self.jitter);
+        s2.iter()
+            .zip(&m)
+            .map(|(s2, m)| (s2 - m * m).max(0.0))
+            .collect()
+    }
+    fn noise_std(&self) -> Option<f64> {
+        self.noise_std
+    }
+}
+
+/// What a criterion's weights may depend on: the frequency set, the data's DTFT `Y(f)`, and the
+/// model at the current parameters.
+pub struct WeightContext<'a> {
+    pub(crate) freqs: &'a FrequencySet,
+    pub(crate) grid: &'a SampleGrid,
+    pub(crate) dtft: &'a [Complex64],
+    pub(crate) model_dtft: Option<&'a [Complex64]>,
+    pub(crate) lazy_model_dtft: OnceLock<Vec<Complex64>>,
+    pub(crate) first_moment: &'a (dyn Fn() -> Vec<Complex64> + 'a),
+    pub(crate) model: &'a dyn ModelView,
+}
+
+impl fmt::Debug for WeightContext<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("WeightContext")
+            .field("frequencies", &self.freqs.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl WeightContext<'_> {
+    /// The frequency set (Hz).
+    pub fn frequencies(&self) -> &FrequencySet {
+        self.freqs
+    }
+
+    /// The sampling grid of the record.
+    pub fn grid(&self) -> &SampleGrid {
+        self.grid
+    }
+
+    /// The data's windowed DTFT `Y(f)` at the frequency set.
+    pub fn dtft(&self) -> &[Complex64] {
+        self.dtft
+    }
+
+    /// The model's first moment `μ_Y(f; θ)` at the frequency set (with the jitter if the
+    /// criterion models it).
+    pub fn model_dtft(&self) -> &[Complex64] {
+        match self.model_dtft {
+            Some(mu) => mu,
+            None => self.lazy_model_dtft.get_or_init(self.first_moment),
         }
     }
 
-    /// The residual vector `r(θ)` (length `2F`).
-    fn residuals<S: Signal, J: JitterModel, N: NoiseModel, W: Window>(
-        &self,
-        data: &FrequencyData<W>,
-        model: &ModelStructure<S, J, N>,
-    ) -> Vec<f64> {
-        let mu = data.transform_moment(&self.first_moment(data, model));
-        let w = self.weights(data.frequencies(), &model.noise);
-        stack(data.dtft(), &mu, &w)
+    /// The jitter's characteristic function `γ(f)` at the frequency set.
+    pub fn jitter_cf(&self) -> Vec<Complex64> {
+        let f = self.freqs.frequencies();
+        f.iter().map(|&f| self.model.jitter_cf(f)).collect()
     }
 
-    /// `V = ½ Σ r²`.
-    fn cost<S: Signal, J: JitterModel, N: NoiseModel, W: Window>(
-        &self,
-        data: &FrequencyData<W>,
-        model: &ModelStructure<S, J, N>,
-    ) -> f64 {
-        0.5 * self
-            .residuals(data, model)
+    /// The noise model's shape `|H(f)|²` at the frequency set.
+    pub fn noise_shape(&self) -> Vec<f64> {
+        let t = self.freqs.interval();
+        let f = self.freqs.frequencies();
+        f.iter().map(|&f| self.model.noise_shape(f, t)).collect()
+    }
+
+    /// The structure's known measurement-noise standard deviation, if any.
+    pub fn noise_std(&self) -> Option<f64> {
+        self.model.noise_std()
+    }
+
+    /// `Var Y(f)` of the unwindowed DTFT at the frequency set for measurement-noise level
+    /// `noise_std`: the jitter's flat floor `Σ_k (E[s(t_k+τ)²] − m_k²)` plus the measurement
+    /// noise `N σ_v² |H(f)|²` (exact for white noise, the long-record value for coloured
+    /// noise). Costs two passes of the signal's moments.
+    pub fn dtft_variance(&self, noise_std: f64) -> Vec<f64> {
+        let floor: f64 = self.model.jitter_variances(self.grid).iter().sum();
+        let n = self.grid.len() as f64;
+        self.noise_shape()
             .iter()
-            .map(|r| r * r)
-            .sum::<f64>()
-    }
-
-    /// `∂r/∂θ` (rows residuals, columns the structure's free parameters).
-    fn jacobian<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel, W: Window>(
-        &self,
-        data: &FrequencyData<W>,
-        model: &ModelStructure<S, J, N>,
-    ) -> Mat<f64> {
-        let (ns, nj, nn) = model.blocks();
-        let rows = data.num_residuals();
-        let mut jac = Mat::<f64>::zeros(rows, ns + nj + nn);
-        let w = self.weights(data.frequencies(), &model.noise);
-        let sw: Vec<f64> = w.iter().map(|w| w.sqrt()).collect();
-        let grid = data.record().grid();
-        // Residuals are Y − μ, so ∂r = −√w ∂μ.
-        let mut put = |col: usize, dmu: &[Complex64]| {
-            for (f, d) in dmu.iter().enumerate() {
-                jac[(2 * f, col)] = -sw[f] * d.re;
-                jac[(2 * f + 1, col)] = -sw[f] * d.im;
-            }
-        };
-        if ns > 0 {
-            let cols = if self.models_jitter() {
-                model.signal.expected_values_gradient(grid, &model.jitter)
-            } else {
-                model.signal.expected_values_gradient(grid, &NoJitter)
-            };
-            for (j, c) in cols.iter().enumerate() {
-                put(j, &data.transform_moment(c));
-            }
-        }
-        if nj > 0 && self.models_jitter() {
-            let theta = model.jitter.params();
-            for j in 0..nj {
-                let dm = central_difference(&theta, j, |p| {
-                    let jit = model.jitter.with_params(p).ok()?;
-                    Some(model.signal.expected_values(grid, &jit))
-                });
-                match dm {
-                    Some(dm) => put(ns + j, &data.transform_moment(&dm)),
-                    None => put(
-                        ns + j,
-                        &vec![Complex64::new(f64::NAN, f64::NAN); data.frequencies().len()],
-                    ),
-                }
-            }
-        }
-        if nn > 0 && self.uses_noise_model() {
-            let theta = model.noise.params();
-            let mu = data.transform_moment(&self.first_moment(data, model));
-            for j in 0..nn {
-                let dr = central_difference(&theta, j, |p| {
-                    let noise = model.noise.with_params(p).ok()?;
-                    Some(stack(
-                        data.dtft(),
-                        &mu,
-                        &self.weights(data.frequencies(), &noise),
-                    ))
-                });
-                for i in 0..rows {
-                    jac[(i, ns + nj + j)] = dr.as_ref().map_or(f64::NAN, |d| d[i]);
-                }
-            }
-        }
-        jac
-    }
-}
-
-/// `[√w_f Re(Y − μ), √w_f Im(Y − μ)]` per frequency.
-fn stack(y: &[Complex64], mu: &[Complex64], w: &[f64]) -> Vec<f64> {
-    let mut r = Vec::with_capacity(2 * y.len());
-    for ((y, m), w) in y.iter().zip(mu).zip(w) {
-        let d = (y - m) * w.sqrt();
-        r.push(d.re);
-        r.push(d.im);
-    }
-    r
-}
-
-/// Central difference of a vector function of `θ` in coordinate `j`, falling back to a one-sided
-/// difference where a side leaves the model's domain (for example `a ≤ 0`).
-fn central_difference(
-    theta: &[f64],
-    j: usize,
-    f: impl Fn(&[f64]) -> Option<Vec<f64>>,
-) -> Option<Vec<f64>> {
-    let h = 1e-6 * theta[j].abs().max(1e-3);
-    let mut plus = theta.to_vec();
-    plus[j] += h;
-    let mut minus = theta.to_vec();
-    minus[j] -= h;
-    match (f(&plus), f(&minus)) {
-        (Some(a), Some(b)) => Some(a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()),
-        (Some(a), None) => {
-            let c = f(theta)?;
-            Some(a.iter().zip(&c).map(|(a, c)| (a - c) / h).collect())
-        }
-        (None, Some(b)) => {
-            let c = f(theta)?;
-            Some(c.iter().zip(&b).map(|(c, b)| (c - b) / h).collect())
-        }
-        (None, None) => None,
+            .map(|h| floor + n * noise_std * noise_std * h)
+            .collect()
     }
 }
 
@@ -264,8 +210,8 @@ impl Criterion for Ls {
     fn models_jitter(&self) -> bool {
         false
     }
-    fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, _: &N) -> Vec<f64> {
-        vec![1.0; freqs.len()]
+    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
+        vec![1.0; context.frequencies().len()]
     }
 }
 
@@ -283,8 +229,8 @@ impl Criterion for Bcls {
     fn flat_residuals(&self) -> bool {
         true
     }
-    fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, _: &N) -> Vec<f64> {
-        vec![1.0; freqs.len()]
+    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
+        vec![1.0; context.frequencies().len()]
     }
 }
 
@@ -321,7 +267,7 @@ impl Criterion for WeightedBcls {
     fn models_jitter(&self) -> bool {
         true
     }
-    fn weights<N: NoiseModel>(&self, _: &FrequencySet, _: &N) -> Vec<f64> {
+    fn weights(&self, _: &WeightContext<'_>) -> Vec<f64> {
         self.weights.clone()
     }
     fn validate(&self, freqs: &FrequencySet) -> Result<(), EstimateError> {
@@ -358,13 +304,8 @@ impl Criterion for BoxJenkins {
     fn uses_noise_model(&self) -> bool {
         true
     }
-    fn weights<N: NoiseModel>(&self, freqs: &FrequencySet, noise: &N) -> Vec<f64> {
-        let t = freqs.interval();
-        let shape: Vec<f64> = freqs
-            .frequencies()
-            .iter()
-            .map(|&f| noise.shape(f, t))
-            .collect();
+    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
+        let shape = context.noise_shape();
         let mean_log = shape.iter().map(|s| s.ln()).sum::<f64>() / shape.len() as f64;
         let g = mean_log.exp();
         shape.iter().map(|s| g / s).collect()

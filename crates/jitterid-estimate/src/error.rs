@@ -88,4 +88,7 @@ pub enum EstimateError {
     /// From the solver.
     #[error(transparent)]
     Solver(#[from] SolverError),
+    /// From a likelihood criterion.
+    #[error(transparent)]
+    Likelihood(Box<crate::ml::MlError>),
 }

@@ -2,9 +2,11 @@
 //! solver, with the asymptotic covariance of the estimate.
 
 use crate::covariance::sandwich;
-use crate::criterion::{Criterion, FrequencyData};
+use crate::criterion::Criterion;
 use crate::data::Record;
+use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
+use crate::result::{CostKind, Fit};
 use crate::solver::{LeastSquares, LevenbergMarquardt, Solver, SolverError, Termination};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
@@ -68,45 +70,12 @@ impl Default for EstimateOptions {
 /// Relative residual size below which a fit is exact to rounding and not checked for flatness.
 const EXACT_FIT: f64 = 1e-9;
 
-/// The result of [`estimate`].
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Estimate {
-    /// The criterion's name.
-    pub criterion: String,
-    /// Names of the free parameters.
-    pub names: Vec<String>,
-    /// `θ̂`.
-    pub params: Vec<f64>,
-    /// Asymptotic covariance of `θ̂` (sandwich form), if computed and defined.
-    pub covariance: Option<Vec<Vec<f64>>>,
-    /// Standard errors, the square roots of the covariance's diagonal.
-    pub std_errors: Option<Vec<f64>>,
-    /// Final cost `½ Σ r²`.
-    pub cost: f64,
-    /// Solver iterations.
-    pub iterations: u64,
-    /// Why the solver stopped.
-    pub termination: Termination,
-    /// Whether the solver met a convergence test.
-    pub converged: bool,
-    /// Final residuals.
-    pub residuals: Vec<f64>,
-    /// [`residual_flatness`](crate::residual_flatness) of the final residuals, for criteria
-    /// whose residuals are flat at the truth ([`Criterion::flat_residuals`]) and frequency
-    /// sets large enough for a verdict: about 1–1.6 at a good fit; above
-    /// [`FLATNESS_LIMIT`](crate::FLATNESS_LIMIT) the fit is reported as not converged.
-    #[serde(default)]
-    pub residual_flatness: Option<f64>,
-    /// The measurement-noise standard deviation used for the covariance (known or estimated).
-    pub noise_std: f64,
-}
-
 /// A criterion and its data as a [`LeastSquares`] problem in the structure's free parameters.
 ///
 /// A parameter vector outside the model's domain (an unstable pole, `a ≤ 0`, …) gives NaN
 /// residuals, which the solvers treat as a rejected trial point.
 #[derive(Debug)]
-pub struct FitProblem<'a, S, J, N, C, W> {
+pub struct FitProblem<'a, S, J, N, C: ?Sized, W> {
     /// The structure at the start (fixed parts and the template for `with_params`).
     pub structure: &'a ModelStructure<S, J, N>,
     /// The criterion.
@@ -120,7 +89,7 @@ where
     S: Signal + Clone,
     J: JitterModel + Clone,
     N: NoiseModel,
-    C: Criterion,
+    C: Criterion + ?Sized,
     W: Window,
 {
     fn num_params(&self) -> usize {
@@ -133,14 +102,14 @@ where
 
     fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
         Ok(match self.structure.with_params(theta) {
-            Ok(m) => self.criterion.residuals(self.data, &m),
+            Ok(m) => self.data.residuals(self.criterion, &m),
             Err(_) => vec![f64::NAN; self.num_residuals()],
         })
     }
 
     fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
         Ok(match self.structure.with_params(theta) {
-            Ok(m) => self.criterion.jacobian(self.data, &m),
+            Ok(m) => self.data.jacobian(self.criterion, &m),
             Err(_) => Mat::from_fn(self.num_residuals(), self.num_params(), |_, _| f64::NAN),
         })
     }
@@ -154,19 +123,22 @@ where
 /// No free parameter; a criterion that ignores jitter asked to estimate it; fewer samples or
 /// residuals than parameters; an invalid frequency set or weights; a criterion not finite at
 /// the start; invalid solver options. A search that stops without converging is not an error:
-/// see [`Estimate::converged`] and [`Estimate::termination`].
+/// see [`Fit::converged`] and [`Fit::termination`].
+///
+/// `criterion` may be a trait object (`&dyn Criterion`, `Box<dyn Criterion>`); `options.solver`
+/// any solver of least-squares problems (see [`Solver`]).
 pub fn estimate<S, J, N, C, V, W>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     criterion: &C,
     options: &EstimateOptions<V, W>,
-) -> Result<Estimate, EstimateError>
+) -> Result<Fit, EstimateError>
 where
     S: Signal + Clone,
     J: JitterModel + Clone,
     N: NoiseModel,
-    C: Criterion,
-    V: Solver,
+    C: Criterion + ?Sized,
+    V: for<'a> Solver<FitProblem<'a, S, J, N, C, W>>,
     W: Window + Clone,
 {
     let p = structure.num_params();
@@ -201,15 +173,15 @@ where
         data: &data,
     };
     let start = structure.params();
-    let r0 = criterion.residuals(&data, structure);
+    let r0 = data.residuals(criterion, structure);
     if let Some((index, &value)) = r0.iter().enumerate().find(|(_, r)| !r.is_finite()) {
         return Err(EstimateError::NonFiniteAtStart { index, value });
     }
     let report = options.solver.minimize(&problem, &start)?;
     let fitted = structure.with_params(&report.params)?;
-    let residuals = criterion.residuals(&data, &fitted);
+    let residuals = data.residuals(criterion, &fitted);
     let (covariance, noise_std) = if options.covariance {
-        let jac = criterion.jacobian(&data, &fitted);
+        let jac = data.jacobian(criterion, &fitted);
         let (cov, std) = sandwich(&data, &fitted, criterion, &jac);
         (cov, std)
     } else {
@@ -234,13 +206,14 @@ where
         }
         _ => (report.converged, report.termination),
     };
-    Ok(Estimate {
+    Ok(Fit {
         criterion: criterion.name().to_string(),
         names: structure.param_names(),
         params: report.params,
         covariance,
         std_errors,
         cost: report.cost,
+        cost_kind: CostKind::SumOfSquares,
         iterations: report.iterations,
         termination,
         converged,

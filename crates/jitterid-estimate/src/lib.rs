@@ -4,10 +4,18 @@
 //! noise model (OE, BJ, JOE, JBJ, or any part fixed). A [`Criterion`] compares the data's DTFT
 //! `Y(f)` with the model's first moment `μ_Y(f; θ)` over a frequency set: naive [`Ls`] (the
 //! paper's eq. 9, jitter ignored), [`Bcls`] (eq. 14), [`WeightedBcls`] and the [`BoxJenkins`]
-//! criterion. A [`solver::Solver`] minimises it: Levenberg–Marquardt (written here as an
-//! argmin solver), Gauss–Newton with line search, Nelder–Mead, multi-start. [`estimate`] is the
-//! one entry point; its [`Estimate`] carries `θ̂`, the cost, the termination reason and the
-//! asymptotic (sandwich) covariance that accounts for the heteroscedastic jittered samples.
+//! criterion; the likelihood criteria of [`ml`] use the second moment. Every criterion is an
+//! [`Objective`] for one [`solver::Solver`] trait: Levenberg–Marquardt (written here as an
+//! argmin solver), Gauss–Newton with line search, Nelder–Mead, BFGS, Brent, multi-start.
+//! [`estimate`] (first moment) and [`ml::ml_estimate`] (likelihoods) return the one result
+//! type, [`Fit`]: `θ̂` by name, standard errors and covariance (the sandwich form that accounts
+//! for the heteroscedastic jittered samples, or the inverse Hessian of `−log L`), the cost,
+//! the termination reason. An integer-valued jitter parameter is profiled ([`profile`]).
+//!
+//! Run-time choices (a command line, Python) go through [`AnyNoise`] / [`NoiseRegistry`],
+//! [`AnyCriterion`] / [`CriterionRegistry`] and [`solver::AnySolver`] /
+//! [`solver::SolverRegistry`], built from spec tables whose keys are described by
+//! [`ParamSpec`]; [`AnyCriterion::fit`] fits any of them.
 //!
 //! ```
 //! use jitterid_estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
@@ -33,28 +41,43 @@
 //! ```
 #![warn(missing_docs)]
 
+mod any_criterion;
+mod any_noise;
 mod covariance;
 mod criterion;
 mod data;
 mod error;
+mod finite_diff;
 mod fit;
 mod flatness;
+mod frequency_data;
 mod init;
 pub mod ml;
 pub mod montecarlo;
 mod noise;
+mod objective;
 mod profile;
+pub mod registry;
+mod result;
 pub mod solver;
 mod structure;
 
-pub use criterion::{Bcls, BoxJenkins, Criterion, FrequencyData, Ls, WeightedBcls};
+pub use any_criterion::{AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions};
+pub use any_noise::{AnyNoise, DynNoise, NoiseEntry, NoiseRegistry};
+pub use criterion::{Bcls, BoxJenkins, Criterion, Ls, WeightContext, WeightedBcls};
 pub use data::Record;
 pub use error::EstimateError;
-pub use fit::{estimate, Estimate, EstimateOptions, FitProblem, Frequencies};
+/// The dense matrix type of Jacobians ([`FrequencyData::jacobian`], [`solver::LeastSquares`]).
+pub use faer::Mat;
+pub use fit::{estimate, EstimateOptions, FitProblem, Frequencies};
 pub use flatness::{residual_flatness, FLATNESS_BANDS, FLATNESS_LIMIT, FLATNESS_MIN_PER_BAND};
+pub use frequency_data::FrequencyData;
 pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
-pub use profile::{profile_uniform_sum, ProfileEstimate};
+pub use objective::{ArgminObjective, Objective, WithMetric};
+pub use profile::{profile, Profile};
+pub use registry::{Entry, ParamSpec, Registry, RegistryError, SpecTable};
+pub use result::{CostKind, Fit};
 pub use structure::ModelStructure;

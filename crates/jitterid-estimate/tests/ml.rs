@@ -3,15 +3,23 @@
 
 use jitterid_estimate::ml::*;
 use jitterid_estimate::montecarlo::Summary;
-use jitterid_estimate::solver::{SolverError, Termination};
+use jitterid_estimate::solver::{Bfgs, Brent, NelderMead, Solver, SolverError, Termination};
+use jitterid_estimate::{ArgminObjective, Objective};
 use jitterid_estimate::{ArmaNoise, ModelStructure, Record};
-use jitterid_jitter::{Gaussian, JitterModel, NoJitter, TwoPoint, UniformSum};
+use jitterid_jitter::{Gaussian, JitterError, JitterModel, NoJitter, TwoPoint, UniformSum};
 use jitterid_signal::{
     simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Sinusoid, Zpk,
 };
 use jitterid_window::{DirichletWindow, FrequencySet};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
+
+/// The uniform-sum jitter with `n` terms and the standard deviation of `start` (the start of
+/// every value of an `n` profile).
+fn keep_std_dev(start: &UniformSum) -> impl Fn(i64) -> Result<UniformSum, JitterError> + Sync {
+    let sigma = start.std_dev();
+    move |n| UniformSum::new(n as u32, sigma * (3.0 * (n as f64 + 1.0)).sqrt())
+}
 
 /// The Table 1 system `1/(s+2)` driven by the paper's random binary input.
 fn table1_signal(seed: u64, n: usize) -> LtiResponse<Zpk> {
@@ -400,16 +408,31 @@ fn uniform_sum_profile_finds_sigma() {
     };
     for crit in ["exact", "quasi"] {
         let p = if crit == "exact" {
-            ml_profile_uniform_sum(&structure, &record, &ExactMl::default(), &opts, 0..=4)
+            ml_profile(
+                &structure,
+                &record,
+                &ExactMl::default(),
+                &opts,
+                0..=4,
+                keep_std_dev(&structure.jitter),
+            )
         } else {
-            ml_profile_uniform_sum(&structure, &record, &QuasiMl, &opts, 0..=4)
+            ml_profile(
+                &structure,
+                &record,
+                &QuasiMl,
+                &opts,
+                0..=4,
+                keep_std_dev(&structure.jitter),
+            )
         }
         .unwrap();
         assert_eq!(p.costs.len(), 5);
-        let s = p.sigma().unwrap();
-        println!("{crit}: n = {}, σ = {s}, se {:?}", p.n, p.sigma_std());
+        let s = p.jitter.std_dev();
+        let se = p.estimate.std_error("jitter.a").unwrap() * s / p.jitter.a();
+        println!("{crit}: n = {}, σ = {s}, se {se}", p.value);
         assert!((s - 0.5 / 3f64.sqrt()).abs() < 0.05, "{crit}: σ = {s}");
-        assert!(p.sigma_std().unwrap() > 0.0);
+        assert!(se > 0.0);
     }
 }
 
@@ -418,13 +441,10 @@ fn uniform_sum_profile_finds_sigma() {
 #[test]
 fn staged_profile_equals_full_refinement() {
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
-    let full = MlOptions {
-        solver: MlSolver::Brent(Brent {
-            bracket_step: 0.01,
-            ..Brent::default()
-        }),
-        ..MlOptions::default()
-    };
+    let full = MlOptions::default().with_solver(Brent {
+        bracket_step: 0.01,
+        ..Brent::default()
+    });
     for (r, truth) in [
         (0u64, UniformSum::new(0, 0.5).unwrap()),
         (1, UniformSum::new(2, 0.5).unwrap()),
@@ -440,20 +460,32 @@ fn staged_profile_equals_full_refinement() {
             .with_noise_std(0.01)
             .unwrap();
         let e = ExactMl::default();
-        let staged =
-            ml_profile_uniform_sum(&structure, &record, &e, &MlOptions::default(), 0..=9).unwrap();
-        let every = ml_profile_uniform_sum(&structure, &record, &e, &full, 0..=9).unwrap();
+        let staged = ml_profile(
+            &structure,
+            &record,
+            &e,
+            &MlOptions::default(),
+            0..=9,
+            keep_std_dev(&structure.jitter),
+        )
+        .unwrap();
+        let every = ml_profile(
+            &structure,
+            &record,
+            &e,
+            &full,
+            0..=9,
+            keep_std_dev(&structure.jitter),
+        )
+        .unwrap();
         assert_eq!(
-            staged.n, every.n,
+            staged.value, every.value,
             "record {r}: {:?} vs {:?}",
             staged.costs, every.costs
         );
         // Both refined with Brent's default tolerance on ln a: the minima agree to its
         // quadratic error, far below 1e-4 in −log L.
-        let (a, b) = (
-            staged.estimate.neg_log_likelihood,
-            every.estimate.neg_log_likelihood,
-        );
+        let (a, b) = (staged.estimate.cost, every.estimate.cost);
         assert!((a - b).abs() < 1e-4, "record {r}: {a} vs {b}");
     }
 }
@@ -649,10 +681,10 @@ fn sine_aliases_are_told_apart_by_a_known_jitter_and_not_by_an_estimated_one() {
         assert!(fits[0].estimate.converged && fits[1].estimate.converged);
         assert!((fits[0].frequency - f0).abs() < 1e-3);
         assert!(
-            fits[0].estimate.neg_log_likelihood < fits[1].estimate.neg_log_likelihood - 10.0,
+            fits[0].estimate.cost < fits[1].estimate.cost - 10.0,
             "{} vs {}",
-            fits[0].estimate.neg_log_likelihood,
-            fits[1].estimate.neg_log_likelihood
+            fits[0].estimate.cost,
+            fits[1].estimate.cost
         );
     }
     // With σ free the two aliases are the same model: (f0, σ) and (f0 − 1, σ f0/(f0 − 1))
@@ -779,7 +811,7 @@ fn minimisers_converge_and_respect_infeasible_regions() {
     assert!(r.converged && (r.params[0] - 2.0).abs() < 1e-7, "{r:?}");
     let r = Brent::default().minimize(&Parabola, &[0.01]).unwrap();
     assert!(r.converged && (r.params[0] - 2.0).abs() < 1e-7, "{r:?}");
-    let r = ArgminNelderMead::default()
+    let r = NelderMead::default()
         .minimize(&Rosen, &[-1.2, 1.0])
         .unwrap();
     assert!((r.params[0] - 1.0).abs() < 1e-3, "{r:?}");
@@ -931,9 +963,16 @@ fn timing() {
     ] {
         let mut n = 0;
         let t = min_time(&mut || {
-            n = ml_profile_uniform_sum(&structure, &record, &e, &MlOptions::default(), 0..=9)
-                .unwrap()
-                .n;
+            n = ml_profile(
+                &structure,
+                &record,
+                &e,
+                &MlOptions::default(),
+                0..=9,
+                keep_std_dev(&structure.jitter),
+            )
+            .unwrap()
+            .value;
         });
         println!("profile ({name}): {t:.1} ms, n = {n}");
     }
@@ -964,18 +1003,19 @@ fn diag_uniform_bias() {
             .unwrap();
         let e = ml_estimate(&s, &record, &ExactMl::default(), &MlOptions::default()).unwrap();
         fixed.push(e.params[0]);
-        let p = ml_profile_uniform_sum(
+        let p = ml_profile(
             &s,
             &record,
             &ExactMl::default(),
             &MlOptions::default(),
             0..=9,
+            keep_std_dev(&s.jitter),
         )
         .unwrap();
-        nsel[p.n as usize] += 1;
-        prof.push(p.sigma().unwrap());
-        if p.n == 0 {
-            prof_n0.push(p.sigma().unwrap());
+        nsel[p.value as usize] += 1;
+        prof.push(p.jitter.std_dev());
+        if p.value == 0 {
+            prof_n0.push(p.jitter.std_dev());
         }
     }
     println!(

@@ -1,8 +1,14 @@
 //! Sampling-jitter families for **jitterid**.
 //!
 //! A sensor asked to sample at `t_k = t0 + kT` measures at `t_k + τ_k`, with `τ_k` independent
-//! draws from a jitter distribution `p(τ; θ)`. This crate holds the [`JitterModel`] trait and
-//! its families.
+//! draws from a jitter distribution `p(τ; θ)`. This crate holds the [`JitterModel`] trait, its
+//! families, the run-time type [`AnyJitter`] with the [`registry`] of families by name, and the
+//! workspace's numerical [`kernels`].
+//!
+//! Families: [`NoJitter`], [`UniformSum`] (the paper's), [`Gaussian`], [`Laplace`],
+//! [`TwoPoint`], [`ExponentialDelay`], [`Periodic`] (arcsine law of a tone), and the
+//! combinators [`Shifted`] (a constant offset), [`Sum`] (independent sum, e.g. the dual-Dirac
+//! model `Sum<Gaussian, TwoPoint>`) and [`Mixture`].
 //!
 //! # Conventions
 //!
@@ -30,11 +36,26 @@
 //! assert!((rule.expect(|t| t * t) - jitter.variance()).abs() < 1e-15);
 //! ```
 //!
+//! # Choosing a family at run time
+//!
+//! ```
+//! use jitterid_jitter::registry::JitterRegistry;
+//! use jitterid_jitter::serde_json::json;
+//! use jitterid_jitter::JitterModel;
+//! let spec = json!({"family": "sum", "terms": [
+//!     {"family": "gaussian", "sigma": 0.01}, {"family": "periodic", "amplitude": 0.02}]});
+//! let j = JitterRegistry::builtin().build(spec.as_object().unwrap()).unwrap();
+//! assert!((j.variance() - (1e-4 + 2e-4)).abs() < 1e-18);
+//! ```
+//!
 //! # Adding a family
 //!
-//! Implement [`JitterModel`] for a new type with a validating constructor, and run
-//! [`testing::check_contract`] on it in a test. Nothing else in the workspace changes: signals,
-//! windows and estimators take any `JitterModel`. See `docs/extending.md`.
+//! Implement [`JitterModel`] for a new type with a validating constructor (the validators are in
+//! [`kernels::validate`]), run [`testing::check_contract`] on it in a test, and give a
+//! [`registry::Family`] entry to [`registry::JitterRegistry::register`] so that front ends can
+//! build it from key/value pairs. Nothing else in the workspace changes: signals, windows and
+//! estimators take any `JitterModel`. See `docs/extending.md`, which walks through the periodic
+//! family.
 #![warn(missing_docs)]
 
 mod any;

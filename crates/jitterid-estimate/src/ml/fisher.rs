@@ -17,9 +17,10 @@
 
 use super::exact::{signal_table, ExactMl, JitterPrep, SampleModel, Scratch, SignalEval};
 use super::fit::spd_inverse;
-use super::moments::{fd_step, second_moments};
+use super::moments::second_moments;
 use super::param::{likelihood_param_names, Layout};
 use super::MlError;
+use crate::finite_diff::{fd_step, LIKELIHOOD_FD_STEP};
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use faer::Mat;
@@ -211,7 +212,7 @@ where
     let mut shifted = Vec::new();
     if layout.nj > 0 {
         for j in 0..layout.nj {
-            let h = fd_step(theta_j[j]);
+            let h = fd_step(LIKELIHOOD_FD_STEP, theta_j[j]);
             let mk = |d: f64| {
                 let mut t = theta_j.clone();
                 t[j] += d;

@@ -1,31 +1,36 @@
-//! Maximum-likelihood estimation: [`ml_estimate`] and the integer-`n` profile
-//! [`ml_profile_uniform_sum`], with the covariance of the estimate from the inverse Hessian of
-//! the negative log-likelihood.
+//! Maximum-likelihood estimation: [`ml_estimate`] and the integer profile [`ml_profile`],
+//! with the covariance of the estimate from the inverse Hessian of the negative
+//! log-likelihood.
 
 use super::criterion::{LikelihoodCriterion, LikelihoodData};
 use super::fisher::gaussian_fisher;
 use super::moments::second_moments;
-use super::objective::{LikelihoodObjective, Objective, TransformedObjective};
-use super::optim::{Brent, MlSolver};
+use super::objective::{LikelihoodObjective, TransformedObjective};
 use super::param::{default_transforms, likelihood_param_names, likelihood_params, Layout};
 use super::MlError;
 use crate::covariance::inverse_gram;
 use crate::data::Record;
+use crate::finite_diff::hessian;
 use crate::noise::NoiseModel;
-use crate::solver::{Termination, Transform};
+use crate::objective::{Objective, WithMetric};
+use crate::profile::{best_of, fitted_jitter, Profile};
+use crate::result::{CostKind, Fit};
+use crate::solver::{Brent, BrentOrBfgs, ObjectiveSolver, Transform};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
-use jitterid_jitter::{JitterModel, UniformSum};
+use jitterid_jitter::JitterModel;
 use jitterid_signal::Signal;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::any::Any;
 
 /// How [`ml_estimate`] runs.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-pub struct MlOptions {
-    /// The minimiser (default: Brent for one parameter, BFGS otherwise).
-    pub solver: MlSolver,
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MlOptions<V = BrentOrBfgs> {
+    /// The minimiser (default: Brent for one parameter, BFGS otherwise, with the inverse of
+    /// the Gaussian information at the start as BFGS's first metric).
+    pub solver: V,
     /// Whether to compute the covariance from the inverse Hessian (default false; set it for
     /// standard errors).
     pub covariance: bool,
@@ -36,42 +41,26 @@ pub struct MlOptions {
     pub noise_std_start: Option<f64>,
 }
 
-/// The result of [`ml_estimate`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MlEstimate {
-    /// The criterion's name.
-    pub criterion: String,
-    /// Names of the likelihood's parameters (the structure's free ones, then `noise.std` when
-    /// `σ_v` is estimated).
-    pub names: Vec<String>,
-    /// `θ̂`.
-    pub params: Vec<f64>,
-    /// The inverse of the Hessian of `−log L` at `θ̂`, if computed and positive definite.
-    pub covariance: Option<Vec<Vec<f64>>>,
-    /// Square roots of the covariance's diagonal.
-    pub std_errors: Option<Vec<f64>>,
-    /// `−log L(θ̂)`.
-    pub neg_log_likelihood: f64,
-    /// Iterations of the minimiser.
-    pub iterations: u64,
-    /// Why the minimiser stopped.
-    pub termination: Termination,
-    /// Whether it met a convergence test.
-    pub converged: bool,
-    /// The measurement-noise standard deviation at the estimate (known or estimated).
-    pub noise_std: f64,
+impl Default for MlOptions {
+    fn default() -> Self {
+        MlOptions {
+            solver: BrentOrBfgs::default(),
+            covariance: false,
+            transforms: None,
+            noise_std_start: None,
+        }
+    }
 }
 
-impl MlEstimate {
-    /// The estimate of the parameter called `name`, if any.
-    pub fn param(&self, name: &str) -> Option<f64> {
-        Some(self.params[self.names.iter().position(|n| n == name)?])
-    }
-
-    /// The standard error of the parameter called `name`, if computed.
-    pub fn std_error(&self, name: &str) -> Option<f64> {
-        let i = self.names.iter().position(|n| n == name)?;
-        Some(self.std_errors.as_ref()?[i])
+impl<V> MlOptions<V> {
+    /// The same options with another solver.
+    pub fn with_solver<U>(&self, solver: U) -> MlOptions<U> {
+        MlOptions {
+            solver,
+            covariance: self.covariance,
+            transforms: self.transforms.clone(),
+            noise_std_start: self.noise_std_start,
+        }
     }
 }
 
@@ -101,48 +90,6 @@ fn noise_start<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
     }
 }
 
-/// The Hessian of `objective` at `theta` by central differences of its gradient, symmetrised;
-/// `None` if a gradient is not finite.
-pub(crate) fn hessian<O: Objective + ?Sized>(objective: &O, theta: &[f64]) -> Option<Mat<f64>> {
-    let p = theta.len();
-    let mut h = Mat::<f64>::zeros(p, p);
-    for i in 0..p {
-        let step = 1e-4 * theta[i].abs().max(1e-4);
-        let mut up = theta.to_vec();
-        up[i] += step;
-        let mut dn = theta.to_vec();
-        dn[i] -= step;
-        let (fu, gu) = objective.cost_gradient(&up);
-        let (fd, gd) = objective.cost_gradient(&dn);
-        let lo_ok = fd.is_finite() && gd.iter().all(|v| v.is_finite());
-        let hi_ok = fu.is_finite() && gu.iter().all(|v| v.is_finite());
-        let col: Vec<f64> = match (hi_ok, lo_ok) {
-            (true, true) => gu
-                .iter()
-                .zip(&gd)
-                .map(|(a, b)| (a - b) / (2.0 * step))
-                .collect(),
-            (true, false) | (false, true) => {
-                let (f0, g0) = objective.cost_gradient(theta);
-                if !f0.is_finite() || g0.iter().any(|v| !v.is_finite()) {
-                    return None;
-                }
-                if hi_ok {
-                    gu.iter().zip(&g0).map(|(a, b)| (a - b) / step).collect()
-                } else {
-                    g0.iter().zip(&gd).map(|(a, b)| (a - b) / step).collect()
-                }
-            }
-            (false, false) => return None,
-        };
-        for j in 0..p {
-            h[(j, i)] = col[j];
-        }
-    }
-    let sym = Mat::from_fn(p, p, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
-    Some(sym)
-}
-
 /// The inverse of a symmetric matrix (a Hessian or a Fisher matrix), if it is positive
 /// definite, well enough conditioned to invert ([`inverse_gram`]) and the result finite with
 /// a positive diagonal.
@@ -169,35 +116,37 @@ pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
 /// not defined at the start (the typed reason: [`MlError::LikelihoodUnderflow`],
 /// [`MlError::VanishingVariance`], [`MlError::ReachExceedsRecord`], …); a start outside the
 /// constraints; invalid solver options. A search that stops without converging is not an
-/// error: see [`MlEstimate::converged`] and [`MlEstimate::termination`].
-pub fn ml_estimate<S, J, N, C>(
+/// error: see [`Fit::converged`] and [`Fit::termination`].
+pub fn ml_estimate<S, J, N, C, V>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     criterion: &C,
-    options: &MlOptions,
-) -> Result<MlEstimate, MlError>
+    options: &MlOptions<V>,
+) -> Result<Fit, MlError>
 where
     S: Signal + Clone,
     J: JitterModel + Clone,
     N: NoiseModel,
     C: LikelihoodCriterion,
+    V: ObjectiveSolver,
 {
     ml_estimate_with(structure, record, None, criterion, options)
 }
 
 /// [`ml_estimate`] with optionally prepared data (valid for `structure`'s fixed parts).
-fn ml_estimate_with<S, J, N, C>(
+fn ml_estimate_with<S, J, N, C, V>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     data: Option<&LikelihoodData>,
     criterion: &C,
-    options: &MlOptions,
-) -> Result<MlEstimate, MlError>
+    options: &MlOptions<V>,
+) -> Result<Fit, MlError>
 where
     S: Signal + Clone,
     J: JitterModel + Clone,
     N: NoiseModel,
     C: LikelihoodCriterion,
+    V: ObjectiveSolver,
 {
     let layout = Layout::of(structure);
     let p = layout.len();
@@ -253,9 +202,8 @@ where
     } else {
         None
     };
-    let report = options
-        .solver
-        .minimize_with_metric(&constrained, &phi0, metric.as_deref())?;
+    let problem = WithMetric::new(&constrained, metric);
+    let report = options.solver.minimize(&problem as &dyn Objective, &phi0)?;
     let params = constrained.to_external(&report.params);
     let (_, sigma) = super::param::split(structure, &params)?;
     let covariance = if options.covariance {
@@ -266,17 +214,20 @@ where
     let std_errors = covariance
         .as_ref()
         .map(|c| (0..p).map(|i| c[i][i].sqrt()).collect());
-    Ok(MlEstimate {
+    Ok(Fit {
         criterion: criterion.name().to_string(),
         names: likelihood_param_names(structure),
         params,
         covariance,
         std_errors,
-        neg_log_likelihood: report.cost,
+        cost: report.cost,
+        cost_kind: CostKind::NegLogLikelihood,
         iterations: report.iterations,
         termination: report.termination,
         converged: report.converged,
         noise_std: sigma,
+        residuals: Vec::new(),
+        residual_flatness: None,
     })
 }
 
@@ -289,162 +240,143 @@ where
 /// against refining every `n`.
 pub const PROFILE_MARGIN: f64 = 0.25;
 
-/// The result of [`ml_profile_uniform_sum`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MlProfile {
-    /// The winning `n̂`.
-    pub n: u32,
-    /// The fit at `n̂`.
-    pub estimate: MlEstimate,
-    /// `−log L` at every `n` tried (`None` where the fit failed to run).
-    pub costs: Vec<(u32, Option<f64>)>,
+/// Whether `solver` is the default likelihood solver (the profile's coarse-then-refine
+/// schedule replaces it for one-parameter fits).
+fn is_default_solver<V: Any>(solver: &V) -> bool {
+    (solver as &dyn Any)
+        .downcast_ref::<BrentOrBfgs>()
+        .is_some_and(|s| *s == BrentOrBfgs::default())
 }
 
-impl MlProfile {
-    /// `σ̂ = â/√(3(n̂+1))`, if the jitter's `a` was estimated.
-    pub fn sigma(&self) -> Option<f64> {
-        Some(self.estimate.param("jitter.a")? / (3.0 * (f64::from(self.n) + 1.0)).sqrt())
-    }
-
-    /// The standard error of `σ̂` at `n̂` by the delta method (conditional on `n̂`).
-    pub fn sigma_std(&self) -> Option<f64> {
-        Some(self.estimate.std_error("jitter.a")? / (3.0 * (f64::from(self.n) + 1.0)).sqrt())
-    }
-}
-
-/// Fits `structure` (whose jitter is a [`UniformSum`]) for every `n` in `ns`, each from the
-/// `a` that keeps the structure's jitter standard deviation, in parallel, and returns the
-/// converged fit with the largest likelihood (the largest of all if none converged). The
-/// covariance, if asked for, is computed for the winner only.
+/// Fits `structure` with its jitter replaced by `build(v)` for every `v` in `values`, in
+/// parallel, and returns the converged fit with the largest likelihood (the largest of all if
+/// none converged). `build` makes the start jitter of a value (see
+/// [`profile`](crate::profile)). The covariance, if asked for, is computed for the winner only.
+///
+/// With the default solver and a single free parameter (the jitter's), every value is first
+/// fitted to a loose tolerance and only those within [`PROFILE_MARGIN`] of the best are
+/// refined.
 ///
 /// # Errors
 ///
-/// The first error if no `n` could be fitted.
-pub fn ml_profile_uniform_sum<S, N, C>(
-    structure: &ModelStructure<S, UniformSum, N>,
+/// The first error if no value could be fitted (including errors of `build`).
+pub fn ml_profile<S, J, N, C, V, E>(
+    structure: &ModelStructure<S, J, N>,
     record: &Record,
     criterion: &C,
-    options: &MlOptions,
-    ns: impl IntoIterator<Item = u32>,
-) -> Result<MlProfile, MlError>
+    options: &MlOptions<V>,
+    values: impl IntoIterator<Item = i64>,
+    build: impl Fn(i64) -> Result<J, E> + Sync,
+) -> Result<Profile<J>, MlError>
 where
     S: Signal + Clone,
+    J: JitterModel + Clone,
     N: NoiseModel,
     C: LikelihoodCriterion,
+    V: ObjectiveSolver + Any + Clone + Sync,
+    E: Into<MlError>,
 {
-    let sigma = structure.jitter.std_dev();
-    let ns: Vec<u32> = ns.into_iter().collect();
+    let values: Vec<i64> = values.into_iter().collect();
     let layout = Layout::of(structure);
-    // One parameter with the default solver: a coarse pass for every n, then the n that can
-    // still win refined (see `PROFILE_MARGIN`).
-    let staged = layout.len() == 1 && layout.nj == 1 && options.solver == MlSolver::Auto;
-    let inner = MlOptions {
-        covariance: false,
-        solver: if staged {
-            MlSolver::Brent(Brent {
-                tolerance: 3e-3,
-                ..Brent::default()
-            })
-        } else {
-            options.solver.clone()
-        },
-        ..options.clone()
-    };
-    // The record prepared once for all n, for the widest reach of the profile.
-    let data = ns.iter().max().and_then(|&n| {
-        let a = sigma * (3.0 * (f64::from(n) + 1.0)).sqrt();
+    // One parameter with the default solver: a coarse pass for every value, then the values
+    // that can still win refined (see `PROFILE_MARGIN`).
+    let staged = layout.len() == 1 && layout.nj == 1 && is_default_solver(&options.solver);
+    let at = |v: i64| -> Result<ModelStructure<S, J, N>, MlError> {
         let mut s = structure.clone();
-        s.jitter = UniformSum::new(n, a).ok()?;
-        Some(criterion.prepare(&s, record))
-    });
-    let fit_at = |n: u32, a: f64, opts: &MlOptions| {
-        UniformSum::new(n, a).map_err(MlError::from).and_then(|j| {
-            let mut s = structure.clone();
-            s.jitter = j;
-            ml_estimate_with(&s, record, data.as_ref(), criterion, opts)
+        s.jitter = build(v).map_err(Into::into)?;
+        Ok(s)
+    };
+    // The record prepared once for all values, for the widest reach of the profile.
+    let data = values
+        .iter()
+        .filter_map(|&v| at(v).ok())
+        .max_by(|a, b| {
+            let width = |s: &ModelStructure<S, J, N>| {
+                let (lo, hi) = s.jitter.reach();
+                hi - lo
+            };
+            width(a).total_cmp(&width(b))
+        })
+        .map(|s| criterion.prepare(&s, record));
+    let coarse = MlOptions {
+        covariance: false,
+        ..options.with_solver(Brent {
+            tolerance: 3e-3,
+            ..Brent::default()
         })
     };
-    let mut fits: Vec<(u32, Result<MlEstimate, MlError>)> = ns
+    let plain = MlOptions {
+        covariance: false,
+        ..options.clone()
+    };
+    let fit_with =
+        |s: &ModelStructure<S, J, N>, staged_solver: Option<&MlOptions<Brent>>| match staged_solver
+        {
+            Some(o) => ml_estimate_with(s, record, data.as_ref(), criterion, o),
+            None => ml_estimate_with(s, record, data.as_ref(), criterion, &plain),
+        };
+    let mut fits: Vec<(i64, Result<Fit, MlError>)> = values
         .par_iter()
-        .map(|&n| {
-            let a = sigma * (3.0 * (f64::from(n) + 1.0)).sqrt();
-            (n, fit_at(n, a, &inner))
+        .map(|&v| {
+            (
+                v,
+                at(v).and_then(|s| fit_with(&s, staged.then_some(&coarse))),
+            )
         })
         .collect();
     if staged {
         let best = fits
             .iter()
             .filter_map(|(_, f)| f.as_ref().ok().filter(|e| e.converged))
-            .map(|e| e.neg_log_likelihood)
+            .map(|e| e.cost)
             .fold(f64::INFINITY, f64::min);
+        let fine = options.with_solver(Brent {
+            bracket_step: 0.01,
+            ..Brent::default()
+        });
         let fine = MlOptions {
             covariance: false,
-            solver: MlSolver::Brent(Brent {
-                bracket_step: 0.01,
-                ..Brent::default()
-            }),
-            ..options.clone()
+            ..fine
         };
-        fits.par_iter_mut().for_each(|(n, fit)| {
+        fits.par_iter_mut().for_each(|(v, fit)| {
             let refine = match fit {
-                Ok(e) => !(e.neg_log_likelihood > best + PROFILE_MARGIN),
+                Ok(e) => !(e.cost > best + PROFILE_MARGIN),
                 Err(_) => false,
             };
             if refine {
                 if let Ok(e) = fit {
-                    let a = e.params[0];
-                    if let Ok(better) = fit_at(*n, a, &fine) {
+                    // Restart from the coarse minimum.
+                    let refined = at(*v).and_then(|s| {
+                        let s = s.with_params(&e.params).map_err(MlError::from)?;
+                        fit_with(&s, Some(&fine))
+                    });
+                    if let Ok(better) = refined {
                         *fit = Ok(better);
                     }
                 }
             }
         });
     }
-    let mut best: Option<(u32, MlEstimate)> = None;
-    let mut costs = Vec::new();
-    let mut first_error = None;
-    for (n, fit) in fits {
-        match fit {
-            Ok(e) => {
-                costs.push((n, Some(e.neg_log_likelihood)));
-                let better = match &best {
-                    None => true,
-                    Some((_, b)) => {
-                        (e.converged && !b.converged)
-                            || (e.converged == b.converged
-                                && e.neg_log_likelihood < b.neg_log_likelihood)
-                    }
-                };
-                if better {
-                    best = Some((n, e));
-                }
-            }
-            Err(err) => {
-                costs.push((n, None));
-                first_error.get_or_insert(err);
-            }
-        }
-    }
-    let Some((n, mut estimate)) = best else {
+    let (best, costs, first_error) = best_of(fits);
+    let Some((value, mut estimate)) = best else {
         return Err(first_error.unwrap_or(EstimateError::NothingToEstimate.into()));
     };
+    let start = at(value)?;
     if options.covariance {
-        let mut s = structure.clone();
-        let k = layout;
+        // The Hessian at the winner, in the likelihood's parameters.
         let theta = estimate.params.clone();
-        // Rebuild the winning structure and evaluate the Hessian there.
-        let a = if k.nj > 0 {
-            theta[k.ns]
-        } else {
-            sigma * (3.0 * (f64::from(n) + 1.0)).sqrt()
-        };
-        s.jitter = UniformSum::new(n, a)?;
-        let objective = LikelihoodObjective::new(&s, criterion, record);
+        let objective = LikelihoodObjective::new(&start, criterion, record);
         estimate.covariance = hessian(&objective, &theta).and_then(|h| spd_inverse(&h));
         estimate.std_errors = estimate
             .covariance
             .as_ref()
             .map(|c| (0..theta.len()).map(|i| c[i][i].sqrt()).collect());
     }
-    Ok(MlProfile { n, estimate, costs })
+    let jitter = fitted_jitter(&start, start.jitter.clone(), &estimate)?;
+    Ok(Profile {
+        value,
+        jitter,
+        estimate,
+        costs,
+    })
 }

@@ -15,13 +15,15 @@
 //!   or estimated); `σ_v` is known (`structure.noise_std`) or estimated jointly as the last
 //!   parameter ([`likelihood_param_names`]).
 //! * Minimisation ([`ml_estimate`]): the criteria are general cost + gradient objectives
-//!   ([`Objective`]), not sums of squares, so the Levenberg–Marquardt layer does not apply.
-//!   [`Bfgs`] (dense BFGS, Armijo backtracking, started from the inverse of the Gaussian
-//!   Fisher information as metric) for several parameters, argmin's Brent method ([`Brent`])
-//!   for one, argmin's Nelder–Mead as a derivative-free fallback. Positivity (`a`, `σ`, `σ_v`)
-//!   is a [`Transform::Positive`](crate::solver::Transform) reparametrisation
+//!   ([`Objective`](crate::Objective)), not sums of squares, so any solver of the one
+//!   [`Solver`](crate::solver::Solver) trait that needs no residuals applies: by default
+//!   [`BrentOrBfgs`](crate::solver::BrentOrBfgs) (Brent's method for one parameter, dense BFGS
+//!   started from the inverse of the Gaussian Fisher information otherwise), or
+//!   [`NelderMead`](crate::solver::NelderMead) as a derivative-free fallback. Positivity (`a`,
+//!   `σ`, `σ_v`) is a [`Transform::Positive`](crate::solver::Transform) reparametrisation
 //!   ([`default_transforms`]); other invalid trial points are rejected (infinite cost).
-//!   The integer `n` of the uniform-sum family is profiled ([`ml_profile_uniform_sum`]).
+//!   An integer-valued jitter parameter (the `n` of the uniform sum) is profiled
+//!   ([`ml_profile`]). The result is the crate's one result type, [`Fit`](crate::Fit).
 //!   The covariance of the estimate is the inverse of the Hessian of `−log L`.
 //! * Bounds: [`gaussian_fisher`] (Slepian–Bangs) and [`exact_fisher`] (the exact model's
 //!   information by integration over `y`); [`FisherInformation::crb`].
@@ -71,7 +73,6 @@ mod fisher;
 mod fit;
 mod moments;
 mod objective;
-mod optim;
 mod param;
 mod quasi;
 pub mod sine;
@@ -82,14 +83,11 @@ pub use exact::ExactMl;
 pub use fisher::{
     delta_method_std, exact_fisher, gaussian_fisher, FisherInformation, FisherOptions,
 };
-pub use fit::{
-    ml_estimate, ml_profile_uniform_sum, MlEstimate, MlOptions, MlProfile, PROFILE_MARGIN,
-};
+pub use fit::{ml_estimate, ml_profile, MlOptions, PROFILE_MARGIN};
 pub use moments::{
     dtft_covariance, expected_squares_gradient, second_moments, DtftCovariance, SecondMoments,
 };
-pub use objective::{LikelihoodObjective, Objective, TransformedObjective};
-pub use optim::{ArgminNelderMead, ArgminObjective, Bfgs, Brent, MlSolver};
+pub use objective::{LikelihoodObjective, TransformedObjective};
 pub use param::{default_transforms, likelihood_param_names, likelihood_params, NOISE_STD_NAME};
 pub use quasi::{noise_autocovariance, QuasiMl};
 pub use sine::{alias_start, attenuation_sigma, fit_sine, sine_least_squares, SineFit, SineLs};

@@ -15,15 +15,13 @@
 
 use super::param::Layout;
 use super::MlError;
+use crate::finite_diff::{central_difference, LIKELIHOOD_FD_STEP};
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::{local_breaks, Jacobian, SampleGrid, Signal};
 use jitterid_window::{dtft, fft_grid, FrequencySet, Window};
 use num_complex::Complex64;
-
-/// Relative step of the central differences in the jitter's parameters (`≈ ε^{1/3}`).
-pub(crate) const JITTER_FD_STEP: f64 = 6e-6;
 
 /// The first two moments of every sample of a record, with gradients when requested.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -91,32 +89,6 @@ fn moments_of<S: Signal, J: JitterModel>(
     )
 }
 
-/// The step of a central difference in a parameter of value `v`.
-pub(crate) fn fd_step(v: f64) -> f64 {
-    JITTER_FD_STEP * v.abs().max(1e-3)
-}
-
-/// Central difference of `f` in coordinate `j` of `theta`, one-sided where a side is outside
-/// the model's domain (`f` returns `None`), `None` if neither side is.
-pub(crate) fn central_difference<T>(
-    theta: &[f64],
-    j: usize,
-    f: impl Fn(&[f64]) -> Option<T>,
-    diff: impl Fn(&T, &T, f64) -> Vec<f64>,
-) -> Option<Vec<f64>> {
-    let h = fd_step(theta[j]);
-    let mut plus = theta.to_vec();
-    plus[j] += h;
-    let mut minus = theta.to_vec();
-    minus[j] -= h;
-    match (f(&plus), f(&minus)) {
-        (Some(a), Some(b)) => Some(diff(&a, &b, 2.0 * h)),
-        (Some(a), None) => Some(diff(&a, &f(theta)?, h)),
-        (None, Some(b)) => Some(diff(&f(theta)?, &b, h)),
-        (None, None) => None,
-    }
-}
-
 /// The second moments of every sample of `grid` under `structure`, with measurement-noise
 /// level `noise_std` (used when the structure does not fix it), and the gradients in the
 /// likelihood's parameters when `gradient` is true.
@@ -174,6 +146,7 @@ where
                 let d = central_difference(
                     &theta,
                     j,
+                    LIKELIHOOD_FD_STEP,
                     |p| {
                         let jit = structure.jitter.with_params(p).ok()?;
                         Some(moments_of(&structure.signal, &jit, grid))

@@ -1,52 +1,16 @@
-//! General (cost + gradient) objectives: the likelihood criteria in the likelihood's parameter
-//! vector, and their constrained form in unconstrained coordinates.
+//! The likelihood criteria as [`Objective`]s in the likelihood's parameter vector, and the
+//! constrained form of any objective in unconstrained coordinates.
 
 use super::criterion::{GradientRequest, LikelihoodCriterion, LikelihoodData};
-use super::moments::fd_step;
 use super::param::{split, Layout};
 use super::MlError;
+use crate::finite_diff::{partial, LIKELIHOOD_FD_STEP};
 use crate::noise::NoiseModel;
+use crate::objective::Objective;
 use crate::solver::{SolverError, Transform};
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::Signal;
-
-/// A smooth objective `f(θ)` to minimise, with its gradient. `f` is `+∞` where `θ` is
-/// infeasible; minimisers treat that as a rejected trial point.
-pub trait Objective: Send + Sync {
-    /// Number of parameters.
-    fn num_params(&self) -> usize;
-
-    /// `f(θ)`, or `+∞` where `θ` is infeasible.
-    fn cost(&self, theta: &[f64]) -> f64;
-
-    /// `(f(θ), ∇f(θ))`. The default takes central differences of [`cost`](Self::cost)
-    /// (one-sided next to an infeasible point).
-    fn cost_gradient(&self, theta: &[f64]) -> (f64, Vec<f64>) {
-        let f = self.cost(theta);
-        let g = (0..theta.len())
-            .map(|j| fd_partial(|p| self.cost(p), theta, j, f))
-            .collect();
-        (f, g)
-    }
-}
-
-/// Central difference of `f` in coordinate `j` (one-sided where a side is infinite, NaN if
-/// both are).
-pub(crate) fn fd_partial(f: impl Fn(&[f64]) -> f64, theta: &[f64], j: usize, f0: f64) -> f64 {
-    let h = fd_step(theta[j]);
-    let mut p = theta.to_vec();
-    p[j] = theta[j] + h;
-    let fp = f(&p);
-    p[j] = theta[j] - h;
-    let fm = f(&p);
-    match (fp.is_finite(), fm.is_finite()) {
-        (true, true) => (fp - fm) / (2.0 * h),
-        (true, false) if f0.is_finite() => (fp - f0) / h,
-        (false, true) if f0.is_finite() => (f0 - fm) / h,
-        _ => f64::NAN,
-    }
-}
 
 /// A likelihood criterion on a record as an [`Objective`] in the likelihood's parameter
 /// vector ([`likelihood_param_names`](super::likelihood_param_names)): the structure's free
@@ -155,7 +119,7 @@ where
             g[..l.ns].copy_from_slice(gs);
         }
         for j in l.jitter_range().chain(l.noise_range()) {
-            g[j] = fd_partial(|p| self.cost(p), theta, j, ev.nll);
+            g[j] = partial(|p| self.cost(p), theta, j, ev.nll, LIKELIHOOD_FD_STEP);
         }
         if let (Some(i), Some(d)) = (l.sigma_index(), ev.noise_std_gradient) {
             g[i] = d;

@@ -20,11 +20,12 @@
 //! tone sharing it, tells the aliases apart.
 
 use super::criterion::LikelihoodCriterion;
-use super::fit::{ml_estimate, MlEstimate, MlOptions};
-use super::objective::Objective;
-use super::optim::Brent;
+use super::fit::{ml_estimate, MlOptions};
 use super::MlError;
 use crate::data::Record;
+use crate::objective::Objective;
+use crate::result::Fit;
+use crate::solver::{Brent, Solver};
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::{Signal, Sinusoid};
@@ -294,7 +295,7 @@ pub struct SineFit {
     /// `σ̂_v` (estimated or known).
     pub noise_std: f64,
     /// The full estimate (names, covariance, termination).
-    pub estimate: MlEstimate,
+    pub estimate: Fit,
 }
 
 /// The representative of `(A, φ)` with `A ≥ 0` and `φ ∈ (−π, π]` (the same tone).

@@ -14,6 +14,15 @@ pub enum SolverError {
         /// Length of the given start.
         got: usize,
     },
+    /// The problem lacks what the solver requires (for example a residual form for
+    /// Levenberg–Marquardt, or one parameter for Brent's method).
+    #[error("solver `{solver}` cannot minimise this problem: {reason}")]
+    Unsupported {
+        /// The solver's name.
+        solver: &'static str,
+        /// What it requires.
+        reason: &'static str,
+    },
     /// A start parameter is NaN or infinite.
     #[error("start parameter {index} is not finite ({value})")]
     NonFiniteStart {

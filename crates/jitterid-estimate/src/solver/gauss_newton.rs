@@ -130,12 +130,11 @@ impl GaussNewtonLineSearch {
     }
 }
 
-impl Solver for GaussNewtonLineSearch {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
+/// # Requirements
+///
+/// The problem is a [`LeastSquares`] problem (residuals and their Jacobian).
+impl<P: LeastSquares + ?Sized> Solver<P> for GaussNewtonLineSearch {
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         self.validate()?;
         validate_start(problem, start)?;
         let r0 = start_residuals(problem, start)?;

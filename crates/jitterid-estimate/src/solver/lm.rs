@@ -523,12 +523,11 @@ where
     }
 }
 
-impl super::Solver for LevenbergMarquardt {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
+/// # Requirements
+///
+/// The problem is a [`LeastSquares`] problem (residuals and their Jacobian).
+impl<P: LeastSquares + ?Sized> super::Solver<P> for LevenbergMarquardt {
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         self.options.validate()?;
         validate_start(problem, start)?;
         let result = Executor::new(

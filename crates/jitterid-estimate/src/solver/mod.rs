@@ -1,18 +1,26 @@
-//! Optimisation layer: nonlinear least squares over [argmin].
+//! Optimisation layer over [argmin]: one [`Solver`] trait, implemented by every minimiser.
 //!
-//! Every estimation criterion of this crate ends up as a [`LeastSquares`] problem: a residual
-//! vector `r(θ)` and its Jacobian, with cost `V(θ) = ½ Σ rᵢ²`. A [`Solver`] minimises `V` from a
-//! start and returns a [`SolverReport`] that says where it stopped and why.
+//! Every estimation criterion of this crate ends up as an [`Objective`](crate::Objective):
+//! the first-moment criteria as a [`LeastSquares`] problem (a residual vector `r(θ)` and its
+//! Jacobian, cost `V(θ) = ½ Σ rᵢ²`), the likelihood criteria as `−log L` with its gradient.
+//! A [`Solver<P>`](Solver) minimises a problem `P` from a start and returns a [`SolverReport`]
+//! that says where it stopped and why. What a solver needs from `P` is stated in the
+//! where-clause of its implementation and in a "Requirements" section (the argmin style):
 //!
-//! # Solvers
+//! | solver | requires | for |
+//! |---|---|---|
+//! | [`LevenbergMarquardt`] | [`LeastSquares`] | first-moment criteria (the workhorse) |
+//! | [`GaussNewtonLineSearch`] | [`LeastSquares`] | first-moment criteria |
+//! | [`NelderMead`] | [`Objective`](crate::Objective) (cost only) | any; derivative-free fallback |
+//! | [`Bfgs`] | [`Objective`](crate::Objective) (cost and gradient) | likelihoods, several parameters |
+//! | [`Brent`] | [`Objective`](crate::Objective) of one parameter | likelihoods, one parameter |
+//! | [`BrentOrBfgs`] | [`Objective`](crate::Objective) | the likelihoods' default |
+//! | [`MultiStart`] | what its inner solver requires | escaping local minima |
+//! | [`AnySolver`] | [`Objective`](crate::Objective); a residual form for LM and GN | a choice made at run time |
 //!
-//! * [`LevenbergMarquardt`]: the workhorse. Written here as an argmin [`argmin::core::Solver`]
-//!   (argmin has none), so it can also run under argmin's `Executor` with observers and
-//!   checkpointing; see [`lm`].
-//! * [`GaussNewtonLineSearch`]: argmin's `GaussNewtonLS` with a backtracking (Armijo) line search.
-//! * [`NelderMead`]: argmin's derivative-free simplex method on the cost.
-//! * [`MultiStart`]: runs another solver from the start plus seeded perturbed starts and keeps
-//!   the best result, to escape local minima.
+//! [`LevenbergMarquardt`] is written here as an argmin [`argmin::core::Solver`] (argmin has
+//! none), so it can also run under argmin's `Executor` with observers and checkpointing; see
+//! [`lm`]. Run-time choices go through the [`SolverRegistry`] and [`AnySolver`].
 //!
 //! # Constraints
 //!
@@ -53,50 +61,61 @@
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
+mod any;
+mod bfgs;
+mod brent;
 mod error;
 mod gauss_newton;
 pub mod lm;
 mod multistart;
 mod nelder_mead;
 pub(crate) mod problem;
+mod registry;
 mod transform;
 
+pub use any::{AnySolver, DynSolver};
+pub use bfgs::Bfgs;
+pub use brent::{Brent, BrentOrBfgs};
 pub use error::SolverError;
 pub use gauss_newton::GaussNewtonLineSearch;
 pub use lm::{LevenbergMarquardt, LmOptions, Scaling};
 pub use multistart::MultiStart;
 pub use nelder_mead::NelderMead;
 pub use problem::{fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, DEFAULT_FD_STEP};
+pub use registry::{SolverEntry, SolverRegistry};
 pub use transform::{Transform, Transformed};
 
-/// A minimiser of `V(θ) = ½ Σ rᵢ(θ)²`.
-pub trait Solver {
-    /// Minimises the cost of `problem` from `start`.
+/// A minimiser of problems of type `P`.
+///
+/// Implementations state what they need from `P` in their where-clause (for example
+/// `P: LeastSquares` for Levenberg–Marquardt, `P: Objective` for BFGS) and in a
+/// "Requirements" section of their docs.
+pub trait Solver<P: ?Sized> {
+    /// Minimises `problem` from `start`.
     ///
     /// # Errors
     ///
     /// Invalid starts ([`SolverError::WrongStartLength`], [`SolverError::NonFiniteStart`]),
     /// problems with fewer residuals than parameters ([`SolverError::TooFewResiduals`]), a start
     /// where the residuals are not finite ([`SolverError::NonFiniteResidual`]), invalid solver
-    /// options ([`SolverError::InvalidOption`]), and errors returned by the problem itself.
+    /// options ([`SolverError::InvalidOption`]), a problem without what the solver requires
+    /// ([`SolverError::Unsupported`]), and errors returned by the problem itself.
     /// Running out of iterations or getting stuck is *not* an error: it is reported through
     /// [`SolverReport::termination`] with [`SolverReport::converged`] `false`.
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError>;
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError>;
 }
 
-impl<S: Solver + ?Sized> Solver for &S {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
+impl<P: ?Sized, S: Solver<P> + ?Sized> Solver<P> for &S {
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         (**self).minimize(problem, start)
     }
 }
+
+/// A solver of every [`Objective`](crate::Objective) seen through a trait object: what the
+/// likelihood fits ask of their solver. Implemented for every such solver.
+pub trait ObjectiveSolver: for<'o> Solver<dyn crate::Objective + 'o> {}
+
+impl<S: ?Sized> ObjectiveSolver for S where S: for<'o> Solver<dyn crate::Objective + 'o> {}
 
 /// Outcome of [`Solver::minimize`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,7 +1,6 @@
 //! Multi-start wrapper around any [`Solver`].
 
 use super::error::check_option;
-use super::problem::LeastSquares;
 use super::{Solver, SolverError, SolverReport};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -60,12 +59,15 @@ fn better(a: &SolverReport, b: &SolverReport) -> bool {
     }
 }
 
-impl<S: Solver> Solver for MultiStart<S> {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
+/// # Requirements
+///
+/// Whatever the inner solver requires of the problem.
+impl<P, S> Solver<P> for MultiStart<S>
+where
+    P: ?Sized,
+    S: Solver<P>,
+{
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         check_option(
             "radius",
             self.radius,

@@ -1,19 +1,20 @@
 //! Derivative-free minimisation: argmin's Nelder–Mead on the cost.
 
 use super::error::check_option;
-use super::problem::{
-    checked_residuals, half_sum_sq, start_residuals, validate_start, LeastSquares,
-};
+use super::problem::{half_sum_sq, start_residuals, validate_start};
 use super::{from_argmin_reason, Solver, SolverError, SolverReport, Termination};
+use crate::objective::{check_objective_start, Objective};
 use argmin::core::{CostFunction, Error, Executor, IterState, State};
 use argmin::solver::neldermead::NelderMead as ArgminNelderMead;
 
-/// argmin's Nelder–Mead simplex method on `V(θ) = ½ Σ rᵢ²`; needs no Jacobian.
+/// argmin's Nelder–Mead simplex method on an objective's cost (`V(θ) = ½ Σ rᵢ²` for a
+/// least-squares problem); needs no gradient.
 ///
 /// The initial simplex is the start plus, for each parameter `j`, the start with `θⱼ` moved by
 /// `initial_step · |θⱼ|` (or by `zero_step` if `θⱼ = 0`). The cost is divided by `V(θ₀)`, so
 /// the stopping test "standard deviation of the simplex's costs `< sd_tolerance`" is relative
-/// to the starting cost. Trial points whose residuals are not finite, or whose evaluation
+/// to the starting cost (to `|f(θ₀)|` for an objective that can be negative, such as `−log L`;
+/// not scaled where `f(θ₀) = 0`). Trial points whose residuals are not finite, or whose evaluation
 /// fails, count as infinite cost.
 ///
 /// Slow for more than a handful of parameters; meant as a robust fallback and for checking the
@@ -49,13 +50,12 @@ struct RelativeCost<'a, P: ?Sized> {
     scale: f64,
 }
 
-impl<P: LeastSquares + ?Sized> CostFunction for RelativeCost<'_, P> {
+impl<P: Objective + ?Sized> CostFunction for RelativeCost<'_, P> {
     type Param = Vec<f64>;
     type Output = f64;
 
     fn cost(&self, theta: &Vec<f64>) -> Result<f64, Error> {
-        let v = checked_residuals(self.problem, theta)
-            .map_or(f64::INFINITY, |r| self.scale * half_sum_sq(&r));
+        let v = self.scale * self.problem.cost(theta);
         Ok(if v.is_finite() { v } else { f64::INFINITY })
     }
 }
@@ -84,16 +84,21 @@ impl NelderMead {
     }
 }
 
-impl Solver for NelderMead {
-    fn minimize<P: LeastSquares + ?Sized>(
-        &self,
-        problem: &P,
-        start: &[f64],
-    ) -> Result<SolverReport, SolverError> {
+/// # Requirements
+///
+/// The problem is an [`Objective`]; only its cost is used. A least-squares problem
+/// ([`Objective::as_least_squares`]) has its start checked residual by residual.
+impl<P: Objective + ?Sized> Solver<P> for NelderMead {
+    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         self.validate()?;
-        validate_start(problem, start)?;
-        let v0 = half_sum_sq(&start_residuals(problem, start)?);
-        if v0 == 0.0 {
+        let v0 = match problem.as_least_squares() {
+            Some(ls) => {
+                validate_start(ls, start)?;
+                half_sum_sq(&start_residuals(ls, start)?)
+            }
+            None => check_objective_start(problem, start)?,
+        };
+        if v0 == 0.0 && problem.as_least_squares().is_some() {
             return Ok(SolverReport {
                 params: start.to_vec(),
                 cost: 0.0,
@@ -117,7 +122,7 @@ impl Solver for NelderMead {
             .map_err(SolverError::from_argmin)?;
         let cost = RelativeCost {
             problem,
-            scale: 1.0 / v0,
+            scale: if v0 == 0.0 { 1.0 } else { 1.0 / v0.abs() },
         };
         let result = Executor::new(cost, solver)
             .configure(|state: IterState<Vec<f64>, (), (), (), (), f64>| {
@@ -133,7 +138,7 @@ impl Solver for NelderMead {
             .take_best_param()
             .or_else(|| state.take_param())
             .unwrap_or_else(|| start.to_vec());
-        let cost = half_sum_sq(&checked_residuals(problem, &params)?);
+        let cost = problem.cost(&params);
         Ok(SolverReport {
             converged: termination.is_convergence() && cost.is_finite(),
             params,

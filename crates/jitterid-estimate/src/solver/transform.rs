@@ -220,7 +220,7 @@ impl<P: LeastSquares> Transformed<P> {
     /// # Errors
     ///
     /// Those of [`to_internal`](Self::to_internal) for the start, and those of the solver.
-    pub fn minimize<S: Solver + ?Sized>(
+    pub fn minimize<S: Solver<Self> + ?Sized>(
         &self,
         solver: &S,
         theta0: &[f64],

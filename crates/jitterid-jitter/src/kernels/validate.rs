@@ -1,5 +1,5 @@
 //! Validators for a family's constructor: each returns the value or a
-//! [`JitterError`](crate::JitterError) that names the parameter.
+//! [`JitterError`] that names the parameter.
 //!
 //! ```
 //! use jitterid_jitter::kernels::validate::{finite, param_count, positive};

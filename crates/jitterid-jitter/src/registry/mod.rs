@@ -4,7 +4,7 @@
 //!
 //! A spec table is a [`Spec`] (a JSON object): `"family"` names the family, the other keys are
 //! the family's (see [`Family::params`]); any family also takes `"offset"` (s), a constant
-//! added to the jitter ([`Shifted`](crate::Shifted)). Composite families (`"sum"`,
+//! added to the jitter ([`Shifted`]). Composite families (`"sum"`,
 //! `"mixture"`) take `"terms"`, an array of spec tables.
 //!
 //! ```
