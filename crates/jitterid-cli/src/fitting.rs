@@ -4,9 +4,9 @@ use crate::cli_err;
 use crate::error::CliResult;
 use crate::experiment::{Experiment, InputSpec, Method, SolverKind, SystemKind};
 use crate::inputs::input_span;
-use crate::models::{AnyNoise, AnySignal, AnySolver};
+use crate::models::{AnyNoise, AnySignal};
 use jitterid::estimate::solver::{
-    GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
+    AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
 };
 use jitterid::estimate::{
     estimate, profile, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
@@ -152,30 +152,30 @@ pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
             if let Some(n) = e.max_iterations {
                 s = s.with_max_iters(n);
             }
-            AnySolver::Lm(s)
+            AnySolver::new(s)
         }
         SolverKind::GaussNewton => {
             let mut s = GaussNewtonLineSearch::default();
             if let Some(n) = e.max_iterations {
                 s.max_iters = n;
             }
-            AnySolver::GaussNewton(s)
+            AnySolver::new(s)
         }
         SolverKind::NelderMead => {
             let mut s = NelderMead::default();
             if let Some(n) = e.max_iterations {
                 s.max_iters = n;
             }
-            AnySolver::NelderMead(s)
+            AnySolver::new(s)
         }
     };
     if e.multistart > 0 {
-        AnySolver::Multi(Box::new(MultiStart::new(
+        AnySolver::new(MultiStart::new(
             base,
             e.multistart,
             e.multistart_radius,
             seed,
-        )))
+        ))
     } else {
         base
     }

@@ -1,12 +1,10 @@
-//! Run-time choice of signal, noise model and solver: enums that delegate every trait method to
-//! the chosen library type (including the fast exact overrides), so that one non-generic
+//! Run-time choice of signal and noise model: enums that delegate every trait method to the
+//! chosen library type (including the fast exact overrides), so that one non-generic
 //! [`ModelStructure`](jitterid::estimate::ModelStructure) serves every experiment. (The jitter
-//! family is the library's [`AnyJitter`](jitterid::jitter::AnyJitter), from its registry.)
+//! family and the solver are the library's run-time types,
+//! [`AnyJitter`](jitterid::jitter::AnyJitter) and
+//! [`AnySolver`](jitterid::estimate::solver::AnySolver).)
 
-use jitterid::estimate::solver::{
-    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, MultiStart, NelderMead, Solver,
-    SolverError, SolverReport,
-};
 use jitterid::estimate::{ArmaNoise, EstimateError, NoiseModel};
 use jitterid::jitter::JitterModel;
 use jitterid::num_complex::Complex64;
@@ -145,29 +143,5 @@ impl NoiseModel for AnyNoise {
     }
     fn is_white(&self) -> bool {
         matches!(self, AnyNoise::White)
-    }
-}
-
-/// A solver chosen at run time.
-#[derive(Debug, Clone)]
-pub enum AnySolver {
-    /// Levenberg–Marquardt.
-    Lm(LevenbergMarquardt),
-    /// Gauss–Newton with a backtracking line search.
-    GaussNewton(GaussNewtonLineSearch),
-    /// Nelder–Mead simplex.
-    NelderMead(NelderMead),
-    /// Any of these from several starts.
-    Multi(Box<MultiStart<AnySolver>>),
-}
-
-impl<P: LeastSquares> Solver<P> for AnySolver {
-    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
-        match self {
-            AnySolver::Lm(s) => s.minimize(problem, start),
-            AnySolver::GaussNewton(s) => s.minimize(problem, start),
-            AnySolver::NelderMead(s) => s.minimize(problem, start),
-            AnySolver::Multi(s) => s.minimize(problem, start),
-        }
     }
 }
