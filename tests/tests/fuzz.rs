@@ -25,16 +25,13 @@ use jitterid::estimate::{
     Fit, Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, Record,
     WeightedBcls,
 };
-use jitterid::jitter::{
-    Atom, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter, QuadratureRule,
-    Shifted, TwoPoint, UniformSum,
-};
+use jitterid::jitter::registry::{JitterRegistry, Spec};
+use jitterid::jitter::{AnyJitter, JitterError, JitterModel};
 use jitterid::prelude::*;
 use jitterid::signal::Tone;
 use jitterid::window::{DirichletWindow, HannWindow};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
-use rand::RngCore;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -43,95 +40,6 @@ use std::time::Instant;
 const CI_CASES: u32 = 256;
 /// Seed in CI (`PROPTEST_RNG_SEED` overrides).
 const CI_SEED: u64 = 0x6a69_7474_6572;
-
-// ---------------------------------------------------------------------------------------------
-// Object-safe stand-ins: one concrete type per trait, so the fuzzer instantiates `estimate`
-// only a few times.
-
-/// Any jitter family, delegating every method (including the provided ones).
-#[derive(Debug, Clone)]
-enum AnyJitter {
-    None(NoJitter),
-    Uniform(UniformSum),
-    Gauss(Gaussian),
-    Laplace(Laplace),
-    Two(TwoPoint),
-    Exp(ExponentialDelay),
-    Shift(Shifted<UniformSum>),
-}
-
-macro_rules! each {
-    ($self:ident, $j:ident => $e:expr) => {
-        match $self {
-            AnyJitter::None($j) => $e,
-            AnyJitter::Uniform($j) => $e,
-            AnyJitter::Gauss($j) => $e,
-            AnyJitter::Laplace($j) => $e,
-            AnyJitter::Two($j) => $e,
-            AnyJitter::Exp($j) => $e,
-            AnyJitter::Shift($j) => $e,
-        }
-    };
-}
-
-impl JitterModel for AnyJitter {
-    fn name(&self) -> &'static str {
-        each!(self, j => j.name())
-    }
-    fn param_names(&self) -> Vec<String> {
-        each!(self, j => j.param_names())
-    }
-    fn params(&self) -> Vec<f64> {
-        each!(self, j => j.params())
-    }
-    fn with_params(&self, p: &[f64]) -> Result<Self, JitterError> {
-        Ok(match self {
-            AnyJitter::None(j) => AnyJitter::None(j.with_params(p)?),
-            AnyJitter::Uniform(j) => AnyJitter::Uniform(j.with_params(p)?),
-            AnyJitter::Gauss(j) => AnyJitter::Gauss(j.with_params(p)?),
-            AnyJitter::Laplace(j) => AnyJitter::Laplace(j.with_params(p)?),
-            AnyJitter::Two(j) => AnyJitter::Two(j.with_params(p)?),
-            AnyJitter::Exp(j) => AnyJitter::Exp(j.with_params(p)?),
-            AnyJitter::Shift(j) => AnyJitter::Shift(j.with_params(p)?),
-        })
-    }
-    fn cf(&self, f: f64) -> Complex64 {
-        each!(self, j => j.cf(f))
-    }
-    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
-        each!(self, j => j.cf_gradient(f))
-    }
-    fn mgf(&self, z: Complex64) -> Option<Complex64> {
-        each!(self, j => j.mgf(z))
-    }
-    fn pdf(&self, tau: f64) -> f64 {
-        each!(self, j => j.pdf(tau))
-    }
-    fn atoms(&self) -> Vec<Atom> {
-        each!(self, j => j.atoms())
-    }
-    fn pieces(&self) -> Vec<(f64, f64)> {
-        each!(self, j => j.pieces())
-    }
-    fn mean(&self) -> f64 {
-        each!(self, j => j.mean())
-    }
-    fn variance(&self) -> f64 {
-        each!(self, j => j.variance())
-    }
-    fn sample(&self, rng: &mut dyn RngCore) -> f64 {
-        each!(self, j => j.sample(rng))
-    }
-    fn reach(&self) -> (f64, f64) {
-        each!(self, j => j.reach())
-    }
-    fn rule(&self, breaks: &[f64], rate: f64) -> QuadratureRule {
-        each!(self, j => j.rule(breaks, rate))
-    }
-    fn rule_from(&self, from: f64, breaks: &[f64], rate: f64) -> QuadratureRule {
-        each!(self, j => j.rule_from(from, breaks, rate))
-    }
-}
 
 // ---------------------------------------------------------------------------------------------
 // Strategies.
@@ -269,15 +177,15 @@ fn input() -> impl Strategy<Value = InputSpec> {
     ]
 }
 
+/// A spec table for the library's jitter registry: a family (any registered one that takes no
+/// terms), a value for each of its keys, and sometimes an offset. A family added to the
+/// registry is fuzzed with no edit here.
 #[derive(Debug, Clone)]
-enum JitterSpec {
-    None,
-    Uniform(u32, f64),
-    Gauss(f64),
-    Laplace(f64),
-    Two(f64),
-    Exp(f64),
-    Shift(f64, f64),
+struct JitterSpec {
+    family: String,
+    /// Each key's value; a real JSON cannot hold (NaN, ±∞) is null.
+    values: Vec<(String, serde_json::Value)>,
+    offset: Option<f64>,
 }
 
 fn jitter() -> impl Strategy<Value = JitterSpec> {
@@ -288,18 +196,44 @@ fn jitter() -> impl Strategy<Value = JitterSpec> {
             1 => any_value(1.0),
         ]
     };
-    prop_oneof![
-        Just(JitterSpec::None),
-        // n ≤ 12 keeps the CI budget: the uniform sum's density costs O(n²) per node, and the
-        // second moment's rules are rebuilt for every sample with input steps in reach (n up to
-        // 50 is a corner test of its own).
-        (0u32..13, width()).prop_map(|(n, a)| JitterSpec::Uniform(n, a)),
-        width().prop_map(JitterSpec::Gauss),
-        width().prop_map(JitterSpec::Laplace),
-        width().prop_map(JitterSpec::Two),
-        width().prop_map(JitterSpec::Exp),
-        (any_value(1.0), width()).prop_map(|(c, a)| JitterSpec::Shift(c, a)),
-    ]
+    // (name, [(key, whole number?)]) of every family without terms.
+    let families: Vec<(String, Vec<(String, bool)>)> = JitterRegistry::builtin()
+        .families()
+        .filter(|f| !f.takes_terms())
+        .map(|f| {
+            let keys = f.params().iter().map(|p| (p.key.clone(), p.integer));
+            (f.name().to_string(), keys.collect())
+        })
+        .collect();
+    let count = families.len();
+    // n ≤ 12 for whole-number keys keeps the CI budget: the uniform sum's density costs O(n²)
+    // per node, and the second moment's rules are rebuilt for every sample with input steps in
+    // reach (n up to 50 is a corner test of its own).
+    (
+        0..count,
+        prop::collection::vec((0u32..13, width()), 8),
+        prop::option::weighted(0.15, any_value(1.0)),
+    )
+        .prop_map(move |(i, draws, offset)| {
+            let (family, keys) = &families[i];
+            let values = keys
+                .iter()
+                .zip(draws)
+                .map(|((k, whole), (n, w))| {
+                    let v = if *whole {
+                        serde_json::Value::from(n)
+                    } else {
+                        serde_json::Value::from(w)
+                    };
+                    (k.clone(), v)
+                })
+                .collect();
+            JitterSpec {
+                family: family.clone(),
+                values,
+                offset,
+            }
+        })
 }
 
 #[derive(Debug, Clone)]
@@ -518,15 +452,15 @@ fn note_error(e: &dyn std::fmt::Display) {
 }
 
 fn build_jitter(spec: &JitterSpec) -> Result<AnyJitter, JitterError> {
-    Ok(match *spec {
-        JitterSpec::None => AnyJitter::None(NoJitter),
-        JitterSpec::Uniform(n, a) => AnyJitter::Uniform(UniformSum::new(n, a)?),
-        JitterSpec::Gauss(s) => AnyJitter::Gauss(Gaussian::new(s)?),
-        JitterSpec::Laplace(b) => AnyJitter::Laplace(Laplace::new(b)?),
-        JitterSpec::Two(d) => AnyJitter::Two(TwoPoint::new(d)?),
-        JitterSpec::Exp(m) => AnyJitter::Exp(ExponentialDelay::new(m)?),
-        JitterSpec::Shift(c, a) => AnyJitter::Shift(Shifted::new(UniformSum::new(1, a)?, c)?),
-    })
+    let mut table = Spec::new();
+    table.insert("family".into(), spec.family.clone().into());
+    for (key, v) in &spec.values {
+        table.insert(key.clone(), v.clone());
+    }
+    if let Some(c) = spec.offset {
+        table.insert("offset".into(), c.into());
+    }
+    JitterRegistry::builtin().build(&table)
 }
 
 fn build_input(spec: &InputSpec) -> Option<Input> {

@@ -3,8 +3,9 @@
 use crate::cli_err;
 use crate::csvio::{self, Column};
 use crate::error::{CliError, CliResult};
-use crate::experiment::{self, Experiment, InputSpec, Method};
+use crate::experiment::{self, Experiment, InputSpec, Method, Purpose};
 use crate::fitting::{self, Fit, Structure};
+use crate::inputs;
 use crate::output::{ensure_dir, write_atomic, Staged};
 use crate::plots;
 use crate::progress::Progress;
@@ -50,7 +51,7 @@ pub struct SimulateOptions {
 
 /// `jitterid simulate`: one record of the experiment's truth. Returns the report line.
 pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
-    let exp = experiment::read(&o.experiment)?;
+    let exp = experiment::read(&o.experiment, Purpose::Simulate)?;
     let mut rng = realization_rng(o.seed, o.run);
     let input = fitting::realize_input(&exp, &mut rng)?;
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
@@ -189,9 +190,8 @@ fn fmt_num(x: f64) -> String {
 
 /// `jitterid fit`: returns the text to print.
 pub fn fit(o: &FitOptions) -> CliResult<String> {
-    let exp = experiment::read(&o.experiment)?;
-    let method = o.method.unwrap_or(exp.estimate.method);
-    fitting::check_method(&exp, method, o.method.is_some())?;
+    let exp = experiment::read(&o.experiment, Purpose::Estimate(o.method))?;
+    let method = exp.estimate.method;
     let table = read_data(&exp, &o.data)?;
     let y = table.column("y")?.to_vec();
     let input: Option<Input> = match &exp.input {
@@ -206,7 +206,7 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
                 ));
             }
             let t = csvio::read(&side)?;
-            Some(Input::Piecewise(experiment::piecewise_from_table(
+            Some(Input::Piecewise(inputs::piecewise_from_table(
                 &t, "t", "u", &exp.grid,
             )?))
         }
@@ -589,9 +589,8 @@ fn mc_table(j: &McJson) -> String {
 
 /// `jitterid montecarlo`: returns the text to print (empty if written to `--out`).
 pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
-    let exp = experiment::read(&o.experiment)?;
-    let method = o.method.unwrap_or(exp.estimate.method);
-    fitting::check_method(&exp, method, o.method.is_some())?;
+    let exp = experiment::read(&o.experiment, Purpose::Estimate(o.method))?;
+    let method = exp.estimate.method;
     if o.runs == 0 || o.runs > MAX_RUNS {
         return Err(cli_err!(
             "--runs: expected a number of realisations in [1, {MAX_RUNS}], found {}",

@@ -1,17 +1,19 @@
 //! From an experiment to signals, model structures and estimates.
 
 use crate::cli_err;
-use crate::error::{CliError, CliResult};
-use crate::experiment::{input_span, Experiment, InputSpec, Method, SolverKind, SystemKind};
-use crate::models::{AnyJitter, AnyNoise, AnySignal, AnySolver};
+use crate::error::CliResult;
+use crate::experiment::{Experiment, InputSpec, Method, SolverKind, SystemKind};
+use crate::inputs::input_span;
+use crate::models::{AnyNoise, AnySignal};
 use jitterid::estimate::solver::{
-    GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
+    AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
 };
 use jitterid::estimate::{
     estimate, profile, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
     Fit as Estimate, Ls, ModelStructure, NoiseModel, Record,
 };
-use jitterid::jitter::{JitterModel, UniformSum};
+use jitterid::jitter::registry::JitterRegistry;
+use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
 use jitterid::signal::{simulate, Input, LtiResponse, SampleGrid, Signal};
@@ -49,10 +51,9 @@ pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> CliResult<Option<Inp
         InputSpec::Known(i) => Some(i.clone()),
         InputSpec::RandomBinary(rb) => {
             let (a, b) = input_span(&exp.grid);
-            Some(Input::Piecewise(
-                rb.generate(a, b, rng)
-                    .map_err(|e| exp.error_at("input", "mean_dwell", e))?,
-            ))
+            Some(Input::Piecewise(rb.generate(a, b, rng).map_err(|e| {
+                cli_err!("{}: [input] random-binary: {e}", exp.file)
+            })?))
         }
     })
 }
@@ -75,7 +76,7 @@ pub fn simulate_record(
     rng: &mut StdRng,
 ) -> CliResult<Simulated> {
     let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
-        .map_err(|e| exp.error_at("noise", "std", e))?;
+        .map_err(|e| cli_err!("{}: simulation: {e}", exp.file))?;
     let v = match &exp.noise.shape {
         AnyNoise::White => sim.noise.clone(),
         AnyNoise::Arma(a) => {
@@ -94,7 +95,16 @@ pub fn simulate_record(
         .zip(&sim.noise)
         .zip(&v)
         .map(|((y, e), v)| y - e + v)
-        .collect();
+        .collect::<Vec<f64>>();
+    // The door refuses values outside the representable range; this catches a combination of
+    // values inside it that still overflows, rather than writing NaN samples.
+    if let Some(k) = y.iter().position(|x| !x.is_finite()) {
+        return Err(cli_err!(
+            "{}: sample {k} of the simulated record is {}: the experiment's values are beyond what double precision can simulate",
+            exp.file,
+            y[k]
+        ));
+    }
     Ok(Simulated { y, tau: sim.tau, v })
 }
 
@@ -129,49 +139,8 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
         Ok(s)
     } else {
         s.with_noise_std(exp.noise.std)
-            .map_err(|e| exp.error_at("noise", "std", e))
+            .map_err(|e| cli_err!("{}: [noise] std: {e}", exp.file))
     }
-}
-
-/// Checks that the experiment can be fitted with `method`.
-pub fn check_method(exp: &Experiment, method: Method, from_command_line: bool) -> CliResult<()> {
-    let blame = |msg: String| -> CliError {
-        if from_command_line {
-            cli_err!("--method {}: {msg}", method.as_str())
-        } else {
-            exp.error_at("estimate", "method", msg)
-        }
-    };
-    if method == Method::Ml && !cfg!(feature = "ml") {
-        return Err(blame(
-            "maximum likelihood is not available in this build of jitterid (built without the `ml` feature); use \"bcls\" (or \"ls\", \"bj\")".into(),
-        ));
-    }
-    if method == Method::Ls && exp.jitter.estimate {
-        return Err(blame(
-            "naive least squares ignores the jitter and cannot estimate it; use \"bcls\" or set [jitter] estimate = false".into(),
-        ));
-    }
-    if !exp.system.estimate && !exp.jitter.estimate && !exp.noise.estimate {
-        return Err(exp.error_at(
-            "system",
-            "estimate",
-            "nothing to estimate: set estimate = true in [system], [jitter] or [noise]",
-        ));
-    }
-    if !exp.system.estimate && !exp.jitter.estimate {
-        return Err(exp.error_at(
-            "system",
-            "estimate",
-            "only the noise level is marked for estimation; it is estimated together with the system or the jitter, so set estimate = true in [system] or [jitter]",
-        ));
-    }
-    if method == Method::Ls && !exp.system.estimate {
-        return Err(blame(
-            "naive least squares has nothing to estimate when the system is known".into(),
-        ));
-    }
-    Ok(())
 }
 
 /// The solver of the experiment; `seed` seeds multistart perturbations.
@@ -183,30 +152,30 @@ pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
             if let Some(n) = e.max_iterations {
                 s = s.with_max_iters(n);
             }
-            AnySolver::Lm(s)
+            AnySolver::new(s)
         }
         SolverKind::GaussNewton => {
             let mut s = GaussNewtonLineSearch::default();
             if let Some(n) = e.max_iterations {
                 s.max_iters = n;
             }
-            AnySolver::GaussNewton(s)
+            AnySolver::new(s)
         }
         SolverKind::NelderMead => {
             let mut s = NelderMead::default();
             if let Some(n) = e.max_iterations {
                 s.max_iters = n;
             }
-            AnySolver::NelderMead(s)
+            AnySolver::new(s)
         }
     };
     if e.multistart > 0 {
-        AnySolver::Multi(Box::new(MultiStart::new(
+        AnySolver::new(MultiStart::new(
             base,
             e.multistart,
             e.multistart_radius,
             seed,
-        )))
+        ))
     } else {
         base
     }
@@ -251,9 +220,7 @@ pub fn param_names(exp: &Experiment, signal: &AnySignal, method: Method) -> CliR
 }
 
 fn profiled(exp: &Experiment) -> bool {
-    exp.jitter.estimate
-        && exp.jitter.n_range.is_some()
-        && matches!(exp.jitter.model, AnyJitter::UniformSum(_))
+    exp.jitter.estimate && exp.jitter.n_range.is_some()
 }
 
 fn report_names(exp: &Experiment, s: &Structure) -> Vec<String> {
@@ -293,8 +260,8 @@ pub fn truth_values(
     if s.estimate_jitter {
         let t = &exp.jitter.truth;
         if profiled(exp) {
-            match (t, exp.jitter.family_differs) {
-                (AnyJitter::UniformSum(u), false) => {
+            match (t.downcast_ref::<UniformSum>(), exp.jitter.family_differs) {
+                (Some(u), false) => {
                     out.extend([Some(f64::from(u.n())), Some(u.a())]);
                 }
                 _ => out.extend([None, None]),
@@ -334,6 +301,13 @@ fn options(
     }
 }
 
+/// `j`, a uniform sum, with its whole number `n` replaced (rebuilt through the registry).
+fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
+    let mut spec = j.spec();
+    spec.insert("n".into(), n.into());
+    JitterRegistry::builtin().build(&spec)
+}
+
 fn run_criterion<C: Criterion>(
     exp: &Experiment,
     s: &Structure,
@@ -342,7 +316,9 @@ fn run_criterion<C: Criterion>(
     opts: &EstimateOptions<AnySolver, DirichletWindow>,
 ) -> Result<(Estimate, Structure, Option<u32>), EstimateError> {
     if profiled(exp) {
-        if let (AnyJitter::UniformSum(u), Some((lo, hi))) = (&s.jitter, exp.jitter.n_range) {
+        if let (Some(u), Some((lo, hi))) =
+            (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
+        {
             let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
                 signal: s.signal.clone(),
                 jitter: *u,
@@ -363,7 +339,7 @@ fn run_criterion<C: Criterion>(
             )?;
             let n = p.value as u32;
             let mut base = s.clone();
-            base.jitter = AnyJitter::UniformSum(u.with_n(n)?);
+            base.jitter = with_n(&s.jitter, n)?;
             let fitted = base.with_params(&p.estimate.params)?;
             return Ok((p.estimate, fitted, Some(n)));
         }
@@ -498,7 +474,9 @@ fn fit_ml(
     ) -> Result<(Estimate, Option<u32>, Structure), String> {
         let e = |e: jitterid::estimate::ml::MlError| e.to_string();
         if profiled(exp) {
-            if let (AnyJitter::UniformSum(u), Some((lo, hi))) = (&s.jitter, exp.jitter.n_range) {
+            if let (Some(u), Some((lo, hi))) =
+                (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
+            {
                 let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
                     signal: s.signal.clone(),
                     jitter: *u,
@@ -513,7 +491,7 @@ fn fit_ml(
                 let p = ml_profile(&us, record, c, opts, values, build).map_err(e)?;
                 let n = p.value as u32;
                 let mut base = s.clone();
-                base.jitter = AnyJitter::UniformSum(u.with_n(n).map_err(|x| x.to_string())?);
+                base.jitter = with_n(&s.jitter, n).map_err(|x| x.to_string())?;
                 return Ok((p.estimate, Some(n), base));
             }
         }

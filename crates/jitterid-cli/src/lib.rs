@@ -11,6 +11,7 @@ pub mod csvio;
 pub mod error;
 pub mod experiment;
 pub mod fitting;
+pub mod inputs;
 pub mod models;
 pub mod output;
 pub mod plots;

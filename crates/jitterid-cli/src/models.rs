@@ -1,18 +1,13 @@
-//! Run-time choice of signal, jitter family, noise model and solver: enums that delegate every
-//! trait method to the chosen library type (including the fast exact overrides), so that one
-//! non-generic [`ModelStructure`](jitterid::estimate::ModelStructure) serves every experiment.
+//! Run-time choice of signal and noise model: enums that delegate every trait method to the
+//! chosen library type (including the fast exact overrides), so that one non-generic
+//! [`ModelStructure`](jitterid::estimate::ModelStructure) serves every experiment. (The jitter
+//! family and the solver are the library's run-time types,
+//! [`AnyJitter`](jitterid::jitter::AnyJitter) and
+//! [`AnySolver`](jitterid::estimate::solver::AnySolver).)
 
-use jitterid::estimate::solver::{
-    GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, MultiStart, NelderMead, Solver,
-    SolverError, SolverReport,
-};
 use jitterid::estimate::{ArmaNoise, EstimateError, NoiseModel};
-use jitterid::jitter::{
-    Atom, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, NoJitter, QuadratureRule,
-    Shifted, TwoPoint, UniformSum,
-};
+use jitterid::jitter::JitterModel;
 use jitterid::num_complex::Complex64;
-use jitterid::rand::RngCore;
 use jitterid::signal::{
     Jacobian, LtiResponse, SampleGrid, Signal, SignalError, Sinusoid, SpectralLine, Spectrum,
     TransferFunction, Zpk,
@@ -106,101 +101,6 @@ impl AnySignal {
     }
 }
 
-/// A jitter family chosen at run time.
-#[derive(Debug, Clone, PartialEq)]
-pub enum AnyJitter {
-    /// `τ ≡ 0`.
-    None(NoJitter),
-    /// Sum of `n + 1` uniforms on `[-a, a]`.
-    UniformSum(UniformSum),
-    /// Gaussian.
-    Gaussian(Gaussian),
-    /// Laplace.
-    Laplace(Laplace),
-    /// `±d` with probability ½ each.
-    TwoPoint(TwoPoint),
-    /// One-sided exponential delay.
-    Exponential(ExponentialDelay),
-    /// Any of these moved by a constant offset.
-    Shifted(Box<Shifted<AnyJitter>>),
-}
-
-macro_rules! each_jitter {
-    ($self:expr, $j:ident => $e:expr) => {
-        match $self {
-            AnyJitter::None($j) => $e,
-            AnyJitter::UniformSum($j) => $e,
-            AnyJitter::Gaussian($j) => $e,
-            AnyJitter::Laplace($j) => $e,
-            AnyJitter::TwoPoint($j) => $e,
-            AnyJitter::Exponential($j) => $e,
-            AnyJitter::Shifted($j) => $e,
-        }
-    };
-}
-
-impl JitterModel for AnyJitter {
-    fn name(&self) -> &'static str {
-        each_jitter!(self, j => j.name())
-    }
-    fn param_names(&self) -> Vec<String> {
-        each_jitter!(self, j => j.param_names())
-    }
-    fn params(&self) -> Vec<f64> {
-        each_jitter!(self, j => j.params())
-    }
-    fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
-        Ok(match self {
-            AnyJitter::None(j) => AnyJitter::None(j.with_params(params)?),
-            AnyJitter::UniformSum(j) => AnyJitter::UniformSum(j.with_params(params)?),
-            AnyJitter::Gaussian(j) => AnyJitter::Gaussian(j.with_params(params)?),
-            AnyJitter::Laplace(j) => AnyJitter::Laplace(j.with_params(params)?),
-            AnyJitter::TwoPoint(j) => AnyJitter::TwoPoint(j.with_params(params)?),
-            AnyJitter::Exponential(j) => AnyJitter::Exponential(j.with_params(params)?),
-            AnyJitter::Shifted(j) => AnyJitter::Shifted(Box::new(j.with_params(params)?)),
-        })
-    }
-    fn cf(&self, f: f64) -> Complex64 {
-        each_jitter!(self, j => j.cf(f))
-    }
-    fn cf_gradient(&self, f: f64) -> Vec<Complex64> {
-        each_jitter!(self, j => j.cf_gradient(f))
-    }
-    fn mgf(&self, z: Complex64) -> Option<Complex64> {
-        each_jitter!(self, j => j.mgf(z))
-    }
-    fn pdf(&self, tau: f64) -> f64 {
-        each_jitter!(self, j => j.pdf(tau))
-    }
-    fn atoms(&self) -> Vec<Atom> {
-        each_jitter!(self, j => j.atoms())
-    }
-    fn pieces(&self) -> Vec<(f64, f64)> {
-        each_jitter!(self, j => j.pieces())
-    }
-    fn mean(&self) -> f64 {
-        each_jitter!(self, j => j.mean())
-    }
-    fn variance(&self) -> f64 {
-        each_jitter!(self, j => j.variance())
-    }
-    fn sample(&self, rng: &mut dyn RngCore) -> f64 {
-        each_jitter!(self, j => j.sample(rng))
-    }
-    fn num_params(&self) -> usize {
-        each_jitter!(self, j => j.num_params())
-    }
-    fn std_dev(&self) -> f64 {
-        each_jitter!(self, j => j.std_dev())
-    }
-    fn reach(&self) -> (f64, f64) {
-        each_jitter!(self, j => j.reach())
-    }
-    fn rule(&self, breaks: &[f64], rate: f64) -> QuadratureRule {
-        each_jitter!(self, j => j.rule(breaks, rate))
-    }
-}
-
 /// A measurement-noise shape chosen at run time.
 #[derive(Debug, Clone, PartialEq)]
 pub enum AnyNoise {
@@ -246,29 +146,5 @@ impl NoiseModel for AnyNoise {
     }
     fn is_white(&self) -> bool {
         matches!(self, AnyNoise::White)
-    }
-}
-
-/// A solver chosen at run time.
-#[derive(Debug, Clone)]
-pub enum AnySolver {
-    /// Levenberg–Marquardt.
-    Lm(LevenbergMarquardt),
-    /// Gauss–Newton with a backtracking line search.
-    GaussNewton(GaussNewtonLineSearch),
-    /// Nelder–Mead simplex.
-    NelderMead(NelderMead),
-    /// Any of these from several starts.
-    Multi(Box<MultiStart<AnySolver>>),
-}
-
-impl<P: LeastSquares> Solver<P> for AnySolver {
-    fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
-        match self {
-            AnySolver::Lm(s) => s.minimize(problem, start),
-            AnySolver::GaussNewton(s) => s.minimize(problem, start),
-            AnySolver::NelderMead(s) => s.minimize(problem, start),
-            AnySolver::Multi(s) => s.minimize(problem, start),
-        }
     }
 }

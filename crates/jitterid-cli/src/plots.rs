@@ -3,8 +3,9 @@
 use crate::error::CliResult;
 use crate::experiment::Experiment;
 use crate::fitting::Structure;
-use crate::models::{AnyJitter, AnySignal};
+use crate::models::AnySignal;
 use crate::svg::{self, figure, Panel, Series, Style, BLACK, BLUE, GREEN, GREY, ORANGE, RED};
+use jitterid::jitter::AnyJitter;
 use jitterid::jitter::{JitterModel, NoJitter};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::{Input, SampleGrid, Signal};
@@ -163,117 +164,10 @@ pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
     let mut out = Vec::new();
     let data = spectrum(grid, p.y);
     let title = exp.title.clone().unwrap_or_else(|| exp.file.clone());
-
-    // Bode: |G| and phase of the file's, LS and main models, with Y/U of the data.
     if p.file_model.frequency_response(0.0).is_some() {
-        let fs = log_band(grid);
-        let mut mag = Vec::new();
-        let mut ph = Vec::new();
-        if let Some(u) = p.input {
-            let us: Vec<f64> = grid.times().map(|t| u.value(t)).collect();
-            let uf = spectrum(grid, &us);
-            let umax = uf.iter().map(|(_, z)| z.norm()).fold(0.0, f64::max);
-            let etfe: Vec<(f64, Complex64)> = data
-                .iter()
-                .zip(&uf)
-                .filter(|(_, (_, u))| u.norm() > 1e-3 * umax)
-                .map(|((f, y), (_, u))| (*f, y / u))
-                .collect();
-            mag.push(
-                Series::markers(
-                    "data Y/U",
-                    GREY,
-                    etfe.iter().map(|(f, z)| (*f, z.norm())).collect(),
-                )
-                .with_opacity(0.45),
-            );
-        }
-        let mut add = |label: &str, color: &'static str, dashed: bool, s: &AnySignal| {
-            if let Some((m, ph_)) = bode_points(s, &fs) {
-                if dashed {
-                    mag.push(Series::dashed(label, color, m));
-                    ph.push(Series::dashed(label, color, ph_));
-                } else {
-                    mag.push(Series::line(label, color, m));
-                    ph.push(Series::line(label, color, ph_));
-                }
-            }
-        };
-        add("experiment file", BLACK, false, p.file_model);
-        if let Some(ls) = p.ls {
-            add("naive LS", RED, true, &ls.signal);
-        }
-        if main.estimate_signal {
-            add(main_label, BLUE, false, &main.signal);
-        }
-        out.push((
-            "bode.svg".to_string(),
-            figure(
-                "Bode diagram",
-                &title,
-                &[
-                    Panel {
-                        title: "magnitude |G(i2πf)|".into(),
-                        xlabel: "frequency (Hz)".into(),
-                        ylabel: "|G|".into(),
-                        xlog: true,
-                        ylog: true,
-                        series: mag,
-                        ..Default::default()
-                    },
-                    Panel {
-                        title: "phase".into(),
-                        xlabel: "frequency (Hz)".into(),
-                        ylabel: "phase (degrees)".into(),
-                        xlog: true,
-                        series: ph,
-                        ..Default::default()
-                    },
-                ],
-                1,
-            ),
-        ));
+        out.push(("bode.svg".to_string(), fit_bode(p, &data, &title)));
     }
-
-    // The data's |Y(f)| against the models' first moments.
-    let mut sp = vec![Series::markers("data |Y(f)|", GREY, abs_points(&data))];
-    sp.push(Series::line(
-        "experiment file, μ_Y",
-        BLACK,
-        abs_points(&moment(grid, p.file_model, &exp.jitter.truth)),
-    ));
-    if let Some(ls) = p.ls {
-        sp.push(Series::dashed(
-            "naive LS, μ_Y without jitter",
-            RED,
-            abs_points(&moment(grid, &ls.signal, &NoJitter)),
-        ));
-    }
-    sp.push(
-        Series::line(
-            &format!("{main_label}, μ_Y"),
-            BLUE,
-            abs_points(&moment(grid, &main.signal, &main.jitter)),
-        )
-        .with_width(1.4),
-    );
-    out.push((
-        "spectrum.svg".to_string(),
-        figure(
-            "Data |Y(f)| and model first moments |μ_Y(f)|",
-            &title,
-            &[Panel {
-                title: "|Y(f)| and |μ_Y(f)| on the DFT grid".into(),
-                xlabel: "frequency (Hz)".into(),
-                ylabel: "magnitude".into(),
-                ylog: true,
-                series: sp,
-                ..Default::default()
-            }],
-            1,
-        ),
-    ));
-
+    out.push(("spectrum.svg".to_string(), fit_spectrum(p, &data, &title)));
     out.push((
         "moment.svg".to_string(),
         moment_figure(
@@ -295,6 +189,121 @@ pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
         jitter_figure(&title, &exp.jitter.truth, &est, p.tau),
     ));
     Ok(out)
+}
+
+/// `|G|` and phase of the file's, LS and main models, over the data's `Y/U`.
+fn fit_bode(p: &FitPlots<'_>, data: &[(f64, Complex64)], title: &str) -> String {
+    let grid = &p.exp.grid;
+    let (main_label, main) = p.main;
+    let fs = log_band(grid);
+    let mut mag = Vec::new();
+    let mut ph = Vec::new();
+    if let Some(u) = p.input {
+        let us: Vec<f64> = grid.times().map(|t| u.value(t)).collect();
+        let uf = spectrum(grid, &us);
+        let umax = uf.iter().map(|(_, z)| z.norm()).fold(0.0, f64::max);
+        let etfe: Vec<(f64, Complex64)> = data
+            .iter()
+            .zip(&uf)
+            .filter(|(_, (_, u))| u.norm() > 1e-3 * umax)
+            .map(|((f, y), (_, u))| (*f, y / u))
+            .collect();
+        mag.push(
+            Series::markers(
+                "data Y/U",
+                GREY,
+                etfe.iter().map(|(f, z)| (*f, z.norm())).collect(),
+            )
+            .with_opacity(0.45),
+        );
+    }
+    let mut add = |label: &str, color: &'static str, dashed: bool, s: &AnySignal| {
+        if let Some((m, ph_)) = bode_points(s, &fs) {
+            if dashed {
+                mag.push(Series::dashed(label, color, m));
+                ph.push(Series::dashed(label, color, ph_));
+            } else {
+                mag.push(Series::line(label, color, m));
+                ph.push(Series::line(label, color, ph_));
+            }
+        }
+    };
+    add("experiment file", BLACK, false, p.file_model);
+    if let Some(ls) = p.ls {
+        add("naive LS", RED, true, &ls.signal);
+    }
+    if main.estimate_signal {
+        add(main_label, BLUE, false, &main.signal);
+    }
+    bode_figure("Bode diagram", title, mag, ph)
+}
+
+/// Magnitude and phase panels of a Bode diagram.
+fn bode_figure(heading: &str, title: &str, mag: Vec<Series>, ph: Vec<Series>) -> String {
+    figure(
+        heading,
+        title,
+        &[
+            Panel {
+                title: "magnitude |G(i2πf)|".into(),
+                xlabel: "frequency (Hz)".into(),
+                ylabel: "|G|".into(),
+                xlog: true,
+                ylog: true,
+                series: mag,
+                ..Default::default()
+            },
+            Panel {
+                title: "phase".into(),
+                xlabel: "frequency (Hz)".into(),
+                ylabel: "phase (degrees)".into(),
+                xlog: true,
+                series: ph,
+                ..Default::default()
+            },
+        ],
+        1,
+    )
+}
+
+/// The data's `|Y(f)|` against the models' first moments.
+fn fit_spectrum(p: &FitPlots<'_>, data: &[(f64, Complex64)], title: &str) -> String {
+    let grid = &p.exp.grid;
+    let (main_label, main) = p.main;
+    let mut sp = vec![Series::markers("data |Y(f)|", GREY, abs_points(data))];
+    sp.push(Series::line(
+        "experiment file, μ_Y",
+        BLACK,
+        abs_points(&moment(grid, p.file_model, &p.exp.jitter.truth)),
+    ));
+    if let Some(ls) = p.ls {
+        sp.push(Series::dashed(
+            "naive LS, μ_Y without jitter",
+            RED,
+            abs_points(&moment(grid, &ls.signal, &NoJitter)),
+        ));
+    }
+    sp.push(
+        Series::line(
+            &format!("{main_label}, μ_Y"),
+            BLUE,
+            abs_points(&moment(grid, &main.signal, &main.jitter)),
+        )
+        .with_width(1.4),
+    );
+    figure(
+        "Data |Y(f)| and model first moments |μ_Y(f)|",
+        title,
+        &[Panel {
+            title: "|Y(f)| and |μ_Y(f)| on the DFT grid".into(),
+            xlabel: "frequency (Hz)".into(),
+            ylabel: "magnitude".into(),
+            ylog: true,
+            series: sp,
+            ..Default::default()
+        }],
+        1,
+    )
 }
 
 /// `|μ_Y(f)|` with and without the jitter's damping, and `|γ(f)|`.
@@ -391,17 +400,22 @@ fn jitter_figure(
     figure(
         "Jitter density",
         title,
-        &[Panel {
-            title: "p(τ)".into(),
-            xlabel: "τ (s)".into(),
-            ylabel: "density (1/s)".into(),
-            y_from_zero: true,
-            yrange: pdf_yrange(truth, &taus),
-            series,
-            ..Default::default()
-        }],
+        &[pdf_panel(series, truth, &taus)],
         1,
     )
+}
+
+/// The panel of densities `p(τ)`, its y range set by the `reference` density.
+fn pdf_panel(series: Vec<Series>, reference: &AnyJitter, taus: &[f64]) -> Panel {
+    Panel {
+        title: "p(τ)".into(),
+        xlabel: "τ (s)".into(),
+        ylabel: "density (1/s)".into(),
+        y_from_zero: true,
+        yrange: pdf_yrange(reference, taus),
+        series,
+        ..Default::default()
+    }
 }
 
 /// A y range for densities that an estimate collapsing to a spike cannot squash: up to 2.5
@@ -436,7 +450,29 @@ pub struct McPlots<'a> {
 pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
     let exp = p.exp;
     let title = exp.title.clone().unwrap_or_else(|| exp.file.clone());
-    let mut out = Vec::new();
+    let mut out = vec![("histograms.svg".to_string(), mc_histograms(p, &title))];
+    if exp.system.estimate && p.true_signal.frequency_response(0.0).is_some() {
+        out.push(("bode.svg".to_string(), mc_bode(p, &title)));
+    }
+    if exp.jitter.estimate {
+        out.push(("jitter-pdf.svg".to_string(), mc_jitter(p, &title)));
+    }
+    out.push((
+        "moment.svg".to_string(),
+        moment_figure(
+            &format!("{title} (realisation 0)"),
+            &exp.grid,
+            p.true_signal,
+            &exp.jitter.truth,
+            "true",
+            None,
+        ),
+    ));
+    out
+}
+
+/// One histogram panel per parameter, with the true value and the mean.
+fn mc_histograms(p: &McPlots<'_>, title: &str) -> String {
     let panels: Vec<Panel> = p
         .names
         .iter()
@@ -482,127 +518,79 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
         })
         .collect();
     let cols = if panels.len() <= 1 { 1 } else { 2 };
-    out.push((
-        "histograms.svg".to_string(),
-        figure(
-            &format!(
-                "Monte Carlo estimates ({}, {} converged runs)",
-                p.method,
-                p.values.len()
-            ),
-            &title,
-            &panels,
-            cols,
+    figure(
+        &format!(
+            "Monte Carlo estimates ({}, {} converged runs)",
+            p.method,
+            p.values.len()
         ),
-    ));
+        title,
+        &panels,
+        cols,
+    )
+}
 
-    let grid = &exp.grid;
-    if exp.system.estimate && p.true_signal.frequency_response(0.0).is_some() {
-        let fs = log_band(grid);
-        let mut mag = Vec::new();
-        let mut ph = Vec::new();
-        for (k, s) in p.fitted.iter().enumerate() {
-            if let Some((m, a)) = bode_points(&s.signal, &fs) {
-                let label = if k == 0 {
-                    format!("{} estimates", p.method)
-                } else {
-                    String::new()
-                };
-                mag.push(
-                    Series::line(&label, BLUE, m)
-                        .with_opacity(0.3)
-                        .with_width(1.0),
-                );
-                ph.push(
-                    Series::line(&label, BLUE, a)
-                        .with_opacity(0.3)
-                        .with_width(1.0),
-                );
-            }
-        }
-        if let Some((m, a)) = bode_points(p.true_signal, &fs) {
-            mag.push(Series::dashed("true", BLACK, m));
-            ph.push(Series::dashed("true", BLACK, a));
-        }
-        out.push((
-            "bode.svg".to_string(),
-            figure(
-                &format!(
-                    "Bode diagram, true and estimated ({} runs shown)",
-                    p.fitted.len()
-                ),
-                &title,
-                &[
-                    Panel {
-                        title: "magnitude |G(i2πf)|".into(),
-                        xlabel: "frequency (Hz)".into(),
-                        ylabel: "|G|".into(),
-                        xlog: true,
-                        ylog: true,
-                        series: mag,
-                        ..Default::default()
-                    },
-                    Panel {
-                        title: "phase".into(),
-                        xlabel: "frequency (Hz)".into(),
-                        ylabel: "phase (degrees)".into(),
-                        xlog: true,
-                        series: ph,
-                        ..Default::default()
-                    },
-                ],
-                1,
-            ),
-        ));
+/// The label of the first of many faint estimate curves (the others stay out of the legend).
+fn first_label(k: usize, method: &str) -> String {
+    if k == 0 {
+        format!("{method} estimates")
+    } else {
+        String::new()
     }
-    if exp.jitter.estimate {
-        let est: Vec<(&str, &AnyJitter)> = p.fitted.iter().map(|s| ("", &s.jitter)).collect();
-        let mut all: Vec<&AnyJitter> = vec![&exp.jitter.truth];
-        all.extend(est.iter().map(|e| e.1));
-        let taus = tau_axis(&all, &[]);
-        let mut series = Vec::new();
-        for (k, (_, j)) in est.iter().enumerate() {
-            let label = if k == 0 {
-                format!("{} estimates", p.method)
-            } else {
-                String::new()
-            };
-            for s in pdf_series(&label, BLUE, j, &taus, false) {
-                series.push(s.with_opacity(0.3).with_width(1.0));
-            }
+}
+
+/// The true Bode diagram over those of the kept fits.
+fn mc_bode(p: &McPlots<'_>, title: &str) -> String {
+    let fs = log_band(&p.exp.grid);
+    let mut mag = Vec::new();
+    let mut ph = Vec::new();
+    for (k, s) in p.fitted.iter().enumerate() {
+        if let Some((m, a)) = bode_points(&s.signal, &fs) {
+            let label = first_label(k, p.method);
+            mag.push(
+                Series::line(&label, BLUE, m)
+                    .with_opacity(0.3)
+                    .with_width(1.0),
+            );
+            ph.push(
+                Series::line(&label, BLUE, a)
+                    .with_opacity(0.3)
+                    .with_width(1.0),
+            );
         }
-        series.extend(pdf_series("true", BLACK, &exp.jitter.truth, &taus, true));
-        out.push((
-            "jitter-pdf.svg".to_string(),
-            figure(
-                &format!(
-                    "Jitter density, true and estimated ({} runs shown)",
-                    est.len()
-                ),
-                &title,
-                &[Panel {
-                    title: "p(τ)".into(),
-                    xlabel: "τ (s)".into(),
-                    ylabel: "density (1/s)".into(),
-                    y_from_zero: true,
-                    yrange: pdf_yrange(&exp.jitter.truth, &taus),
-                    series,
-                    ..Default::default()
-                }],
-                1,
-            ),
-        ));
     }
-    out.push((
-        "moment.svg".to_string(),
-        moment_figure(
-            &format!("{title} (realisation 0)"),
-            grid,
-            p.true_signal,
-            &exp.jitter.truth,
-            "true",
-            None,
+    if let Some((m, a)) = bode_points(p.true_signal, &fs) {
+        mag.push(Series::dashed("true", BLACK, m));
+        ph.push(Series::dashed("true", BLACK, a));
+    }
+    let heading = format!(
+        "Bode diagram, true and estimated ({} runs shown)",
+        p.fitted.len()
+    );
+    bode_figure(&heading, title, mag, ph)
+}
+
+/// The true jitter density over those of the kept fits.
+fn mc_jitter(p: &McPlots<'_>, title: &str) -> String {
+    let truth = &p.exp.jitter.truth;
+    let est: Vec<&AnyJitter> = p.fitted.iter().map(|s| &s.jitter).collect();
+    let mut all: Vec<&AnyJitter> = vec![truth];
+    all.extend(est.iter().copied());
+    let taus = tau_axis(&all, &[]);
+    let mut series = Vec::new();
+    for (k, j) in est.iter().enumerate() {
+        for s in pdf_series(&first_label(k, p.method), BLUE, j, &taus, false) {
+            series.push(s.with_opacity(0.3).with_width(1.0));
+        }
+    }
+    series.extend(pdf_series("true", BLACK, truth, &taus, true));
+    figure(
+        &format!(
+            "Jitter density, true and estimated ({} runs shown)",
+            est.len()
         ),
-    ));
-    out
+        title,
+        &[pdf_panel(series, truth, &taus)],
+        1,
+    )
 }

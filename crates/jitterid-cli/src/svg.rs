@@ -329,6 +329,40 @@ pub fn figure(title: &str, subtitle: &str, panels: &[Panel], cols: usize) -> Str
     s
 }
 
+/// Where a panel's data go on the page: its origin and size, and the two axes.
+struct Frame {
+    ox: f64,
+    oy: f64,
+    w: f64,
+    h: f64,
+    xa: Axis,
+    ya: Axis,
+}
+
+impl Frame {
+    fn px(&self, x: f64) -> f64 {
+        self.ox + self.xa.frac(x) * self.w
+    }
+
+    fn py(&self, y: f64) -> f64 {
+        self.oy + self.h - self.ya.frac(y) * self.h
+    }
+
+    /// Whether a point can be drawn (finite, and positive on a logarithmic axis).
+    fn ok(&self, x: f64, y: f64) -> bool {
+        x.is_finite() && y.is_finite() && (!self.xa.log || x > 0.0) && (!self.ya.log || y > 0.0)
+    }
+
+    /// The baseline of bars and stems: 0, or the bottom of a logarithmic axis.
+    fn base(&self) -> f64 {
+        if self.ya.log {
+            self.ya.lo
+        } else {
+            0.0
+        }
+    }
+}
+
 fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
     let (w, h) = (PANEL_W, PANEL_H);
     let _ = writeln!(
@@ -338,6 +372,51 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
         oy - 10.0,
         esc(&p.title)
     );
+    let (xr, yr) = data_ranges(p);
+    let _ = writeln!(
+        s,
+        r##"<rect x="{ox}" y="{oy}" width="{w}" height="{h}" fill="#ffffff" stroke="#444" stroke-width="1"/>"##
+    );
+    let (Some((x0, x1)), Some((y0, y1))) = (xr, yr) else {
+        let _ = writeln!(
+            s,
+            r##"<text x="{}" y="{}" text-anchor="middle" fill="#888">no finite data</text>"##,
+            ox + w / 2.0,
+            oy + h / 2.0
+        );
+        return;
+    };
+    let f = Frame {
+        ox,
+        oy,
+        w,
+        h,
+        xa: Axis::new(x0, x1, p.xlog),
+        ya: Axis::new(y0, y1, p.ylog),
+    };
+    grid_and_labels(s, p, &f);
+    let _ = writeln!(
+        s,
+        r#"<clipPath id="clip{id}"><rect x="{ox}" y="{oy}" width="{w}" height="{h}"/></clipPath><g clip-path="url(#clip{id})">"#
+    );
+    for se in &p.series {
+        match &se.style {
+            Style::Line { width, dash } => line(s, &f, se, *width, *dash),
+            Style::Markers { radius } => markers(s, &f, se, *radius),
+            Style::Bars { width } => bars(s, &f, se, *width),
+            Style::VRule { dash } => vrules(s, &f, se, *dash),
+            Style::Stems => stems(s, &f, se),
+        }
+    }
+    s.push_str("</g>\n");
+    legend(s, p, &f);
+}
+
+/// A data range `(lo, hi)`, `None` where no point can be drawn.
+type Span = Option<(f64, f64)>;
+
+/// The padded x and y ranges of a panel's data.
+fn data_ranges(p: &Panel) -> (Span, Span) {
     let xs = p.series.iter().flat_map(|se| {
         let half = match se.style {
             Style::Bars { width } => width / 2.0,
@@ -375,26 +454,14 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
             }
         }),
     };
-    let _ = writeln!(
-        s,
-        r##"<rect x="{ox}" y="{oy}" width="{w}" height="{h}" fill="#ffffff" stroke="#444" stroke-width="1"/>"##
-    );
-    let (Some((x0, x1)), Some((y0, y1))) = (xr, yr) else {
-        let _ = writeln!(
-            s,
-            r##"<text x="{}" y="{}" text-anchor="middle" fill="#888">no finite data</text>"##,
-            ox + w / 2.0,
-            oy + h / 2.0
-        );
-        return;
-    };
-    let xa = Axis::new(x0, x1, p.xlog);
-    let ya = Axis::new(y0, y1, p.ylog);
-    let px = |x: f64| ox + xa.frac(x) * w;
-    let py = |y: f64| oy + h - ya.frac(y) * h;
-    // Grid and ticks.
-    for (v, label) in &xa.ticks {
-        let x = px(*v);
+    (xr, yr)
+}
+
+/// Grid lines, tick labels and the axis labels.
+fn grid_and_labels(s: &mut String, p: &Panel, f: &Frame) {
+    let (ox, oy, w, h) = (f.ox, f.oy, f.w, f.h);
+    for (v, label) in &f.xa.ticks {
+        let x = f.px(*v);
         let _ = writeln!(
             s,
             r##"<line x1="{x:.1}" y1="{oy}" x2="{x:.1}" y2="{}" stroke="#e6e6e6"/><text x="{x:.1}" y="{}" text-anchor="middle">{}</text>"##,
@@ -403,8 +470,8 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
             esc(label)
         );
     }
-    for (v, label) in &ya.ticks {
-        let y = py(*v);
+    for (v, label) in &f.ya.ticks {
+        let y = f.py(*v);
         let _ = writeln!(
             s,
             r##"<line x1="{ox}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#e6e6e6"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
@@ -428,206 +495,214 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
         oy + h / 2.0,
         esc(&p.ylabel)
     );
-    let _ = writeln!(
-        s,
-        r#"<clipPath id="clip{id}"><rect x="{ox}" y="{oy}" width="{w}" height="{h}"/></clipPath><g clip-path="url(#clip{id})">"#
-    );
-    let ok = |x: f64, y: f64| {
-        x.is_finite() && y.is_finite() && (!p.xlog || x > 0.0) && (!p.ylog || y > 0.0)
-    };
-    for se in &p.series {
-        let op = se.opacity;
-        match &se.style {
-            Style::Line { width, dash } => {
-                let dash = dash
-                    .map(|d| format!(r#" stroke-dasharray="{d}""#))
-                    .unwrap_or_default();
-                let mut run: Vec<String> = Vec::new();
-                let flush = |run: &mut Vec<String>, s: &mut String| {
-                    if run.len() >= 2 {
-                        let _ = writeln!(
-                            s,
-                            r#"<polyline fill="none" stroke="{}" stroke-opacity="{op}" stroke-width="{width}"{dash} stroke-linejoin="round" points="{}"/>"#,
-                            se.color,
-                            run.join(" ")
-                        );
-                    }
-                    run.clear();
-                };
-                for &(x, y) in &se.points {
-                    if ok(x, y) {
-                        run.push(format!(
-                            "{:.1},{:.1}",
-                            px(x),
-                            py(y).clamp(oy - 2.0 * h, oy + 3.0 * h)
-                        ));
-                    } else {
-                        flush(&mut run, s);
-                    }
-                }
-                flush(&mut run, s);
-            }
-            Style::Markers { radius } => {
-                for &(x, y) in &se.points {
-                    if ok(x, y) {
-                        let _ = writeln!(
-                            s,
-                            r#"<circle cx="{:.1}" cy="{:.1}" r="{radius}" fill="{}" fill-opacity="{op}"/>"#,
-                            px(x),
-                            py(y),
-                            se.color
-                        );
-                    }
-                }
-            }
-            Style::Bars { width } => {
-                let base = if p.ylog { ya.lo } else { 0.0 };
-                for &(x, y) in &se.points {
-                    if ok(x, y) && ok(x - width / 2.0, y) {
-                        let (xa_, xb) = (px(x - width / 2.0), px(x + width / 2.0));
-                        let (ya_, yb) = (py(y), py(base));
-                        let _ = writeln!(
-                            s,
-                            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{}" fill-opacity="{op}" stroke="white" stroke-width="0.5"/>"#,
-                            xa_.min(xb),
-                            ya_.min(yb),
-                            (xb - xa_).abs(),
-                            (yb - ya_).abs(),
-                            se.color
-                        );
-                    }
-                }
-            }
-            Style::VRule { dash } => {
-                let dash = dash
-                    .map(|d| format!(r#" stroke-dasharray="{d}""#))
-                    .unwrap_or_default();
-                for &(x, _) in &se.points {
-                    if x.is_finite() && (!p.xlog || x > 0.0) {
-                        let _ = writeln!(
-                            s,
-                            r#"<line x1="{0:.1}" y1="{oy}" x2="{0:.1}" y2="{1}" stroke="{2}" stroke-opacity="{op}" stroke-width="2"{dash}/>"#,
-                            px(x),
-                            oy + h,
-                            se.color
-                        );
-                    }
-                }
-            }
-            Style::Stems => {
-                let base = if p.ylog { ya.lo } else { 0.0 };
-                for &(x, y) in &se.points {
-                    if ok(x, y) {
-                        let _ = writeln!(
-                            s,
-                            r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-opacity="{op}" stroke-width="2"/><circle cx="{0:.1}" cy="{1:.1}" r="3.5" fill="{3}" fill-opacity="{op}"/>"#,
-                            px(x),
-                            py(y),
-                            py(base),
-                            se.color
-                        );
-                    }
-                }
-            }
-        }
-    }
-    s.push_str("</g>\n");
-    // Legend.
-    let entries: Vec<&Series> = p.series.iter().filter(|se| !se.label.is_empty()).collect();
-    if !entries.is_empty() {
-        let lw = entries
-            .iter()
-            .map(|e| e.label.chars().count())
-            .max()
-            .unwrap_or(0) as f64
-            * 6.8
-            + 40.0;
-        let lh = entries.len() as f64 * 16.0 + 8.0;
-        // The corner that hides the fewest points: top right, top left, bottom right, bottom left.
-        let corners = [
-            (ox + w - lw - 8.0, oy + 8.0),
-            (ox + 8.0, oy + 8.0),
-            (ox + w - lw - 8.0, oy + h - lh - 8.0),
-            (ox + 8.0, oy + h - lh - 8.0),
-        ];
-        let hidden = |(cx, cy): (f64, f64)| -> usize {
-            p.series
-                .iter()
-                .map(|se| {
-                    se.points
-                        .iter()
-                        .filter(|&&(x, y)| {
-                            if !ok(x, y) && !matches!(se.style, Style::VRule { .. }) {
-                                return false;
-                            }
-                            let gx = px(x);
-                            let inside_x = gx >= cx - 4.0 && gx <= cx + lw + 4.0;
-                            match se.style {
-                                Style::VRule { .. } => inside_x,
-                                Style::Bars { .. } | Style::Stems => {
-                                    inside_x && py(y) <= cy + lh + 4.0
-                                }
-                                _ => {
-                                    let gy = py(y);
-                                    inside_x && gy >= cy - 4.0 && gy <= cy + lh + 4.0
-                                }
-                            }
-                        })
-                        .count()
-                })
-                .sum()
-        };
-        let (lx, ly) = corners
-            .iter()
-            .copied()
-            .enumerate()
-            .min_by_key(|(i, c)| (hidden(*c), *i))
-            .map_or(corners[0], |x| x.1);
-        let _ = writeln!(
-            s,
-            r##"<rect x="{lx:.1}" y="{ly:.1}" width="{lw:.1}" height="{lh:.1}" fill="white" fill-opacity="0.85" stroke="#bbb"/>"##
-        );
-        for (i, e) in entries.iter().enumerate() {
-            let y = ly + 14.0 + i as f64 * 16.0;
-            let sym = match &e.style {
-                Style::Markers { .. } => format!(
-                    r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#,
-                    lx + 16.0,
-                    y - 4.0,
-                    e.color
-                ),
-                Style::Bars { .. } => format!(
-                    r#"<rect x="{:.1}" y="{:.1}" width="14" height="9" fill="{}" fill-opacity="{}"/>"#,
-                    lx + 9.0,
-                    y - 9.0,
-                    e.color,
-                    e.opacity
-                ),
-                Style::Line { dash, .. } | Style::VRule { dash } => format!(
-                    r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"{}/>"#,
-                    lx + 6.0,
-                    y - 4.0,
-                    lx + 26.0,
-                    y - 4.0,
-                    e.color,
-                    dash.map(|d| format!(r#" stroke-dasharray="{d}""#))
-                        .unwrap_or_default()
-                ),
-                Style::Stems => format!(
-                    r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-width="2"/>"#,
-                    lx + 16.0,
-                    y - 10.0,
-                    y,
-                    e.color
-                ),
-            };
+}
+
+fn dash_attr(dash: Option<&str>) -> String {
+    dash.map(|d| format!(r#" stroke-dasharray="{d}""#))
+        .unwrap_or_default()
+}
+
+/// A polyline, broken where a point cannot be drawn.
+fn line(s: &mut String, f: &Frame, se: &Series, width: f64, dash: Option<&str>) {
+    let dash = dash_attr(dash);
+    let op = se.opacity;
+    let mut run: Vec<String> = Vec::new();
+    let flush = |run: &mut Vec<String>, s: &mut String| {
+        if run.len() >= 2 {
             let _ = writeln!(
                 s,
-                r#"{sym}<text x="{:.1}" y="{y:.1}">{}</text>"#,
-                lx + 32.0,
-                esc(&e.label)
+                r#"<polyline fill="none" stroke="{}" stroke-opacity="{op}" stroke-width="{width}"{dash} stroke-linejoin="round" points="{}"/>"#,
+                se.color,
+                run.join(" ")
             );
         }
+        run.clear();
+    };
+    for &(x, y) in &se.points {
+        if f.ok(x, y) {
+            run.push(format!(
+                "{:.1},{:.1}",
+                f.px(x),
+                f.py(y).clamp(f.oy - 2.0 * f.h, f.oy + 3.0 * f.h)
+            ));
+        } else {
+            flush(&mut run, s);
+        }
+    }
+    flush(&mut run, s);
+}
+
+fn markers(s: &mut String, f: &Frame, se: &Series, radius: f64) {
+    for &(x, y) in se.points.iter().filter(|&&(x, y)| f.ok(x, y)) {
+        let _ = writeln!(
+            s,
+            r#"<circle cx="{:.1}" cy="{:.1}" r="{radius}" fill="{}" fill-opacity="{}"/>"#,
+            f.px(x),
+            f.py(y),
+            se.color,
+            se.opacity
+        );
+    }
+}
+
+fn bars(s: &mut String, f: &Frame, se: &Series, width: f64) {
+    let base = f.base();
+    for &(x, y) in &se.points {
+        if f.ok(x, y) && f.ok(x - width / 2.0, y) {
+            let (xa, xb) = (f.px(x - width / 2.0), f.px(x + width / 2.0));
+            let (ya, yb) = (f.py(y), f.py(base));
+            let _ = writeln!(
+                s,
+                r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{}" fill-opacity="{}" stroke="white" stroke-width="0.5"/>"#,
+                xa.min(xb),
+                ya.min(yb),
+                (xb - xa).abs(),
+                (yb - ya).abs(),
+                se.color,
+                se.opacity
+            );
+        }
+    }
+}
+
+fn vrules(s: &mut String, f: &Frame, se: &Series, dash: Option<&str>) {
+    let dash = dash_attr(dash);
+    for &(x, _) in &se.points {
+        if x.is_finite() && (!f.xa.log || x > 0.0) {
+            let _ = writeln!(
+                s,
+                r#"<line x1="{0:.1}" y1="{1}" x2="{0:.1}" y2="{2}" stroke="{3}" stroke-opacity="{4}" stroke-width="2"{dash}/>"#,
+                f.px(x),
+                f.oy,
+                f.oy + f.h,
+                se.color,
+                se.opacity
+            );
+        }
+    }
+}
+
+fn stems(s: &mut String, f: &Frame, se: &Series) {
+    let base = f.base();
+    for &(x, y) in se.points.iter().filter(|&&(x, y)| f.ok(x, y)) {
+        let _ = writeln!(
+            s,
+            r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-opacity="{4}" stroke-width="2"/><circle cx="{0:.1}" cy="{1:.1}" r="3.5" fill="{3}" fill-opacity="{4}"/>"#,
+            f.px(x),
+            f.py(y),
+            f.py(base),
+            se.color,
+            se.opacity
+        );
+    }
+}
+
+/// The legend, in the corner that hides the fewest points.
+fn legend(s: &mut String, p: &Panel, f: &Frame) {
+    let entries: Vec<&Series> = p.series.iter().filter(|se| !se.label.is_empty()).collect();
+    if entries.is_empty() {
+        return;
+    }
+    let lw = entries
+        .iter()
+        .map(|e| e.label.chars().count())
+        .max()
+        .unwrap_or(0) as f64
+        * 6.8
+        + 40.0;
+    let lh = entries.len() as f64 * 16.0 + 8.0;
+    let (lx, ly) = legend_corner(p, f, lw, lh);
+    let _ = writeln!(
+        s,
+        r##"<rect x="{lx:.1}" y="{ly:.1}" width="{lw:.1}" height="{lh:.1}" fill="white" fill-opacity="0.85" stroke="#bbb"/>"##
+    );
+    for (i, e) in entries.iter().enumerate() {
+        let y = ly + 14.0 + i as f64 * 16.0;
+        let _ = writeln!(
+            s,
+            r#"{}<text x="{:.1}" y="{y:.1}">{}</text>"#,
+            legend_symbol(e, lx, y),
+            lx + 32.0,
+            esc(&e.label)
+        );
+    }
+}
+
+/// Top right, top left, bottom right, bottom left: the first that hides the fewest points.
+fn legend_corner(p: &Panel, f: &Frame, lw: f64, lh: f64) -> (f64, f64) {
+    let (ox, oy, w, h) = (f.ox, f.oy, f.w, f.h);
+    let corners = [
+        (ox + w - lw - 8.0, oy + 8.0),
+        (ox + 8.0, oy + 8.0),
+        (ox + w - lw - 8.0, oy + h - lh - 8.0),
+        (ox + 8.0, oy + h - lh - 8.0),
+    ];
+    let hides = |se: &Series, (cx, cy): (f64, f64), x: f64, y: f64| -> bool {
+        if !f.ok(x, y) && !matches!(se.style, Style::VRule { .. }) {
+            return false;
+        }
+        let gx = f.px(x);
+        let inside_x = gx >= cx - 4.0 && gx <= cx + lw + 4.0;
+        match se.style {
+            Style::VRule { .. } => inside_x,
+            Style::Bars { .. } | Style::Stems => inside_x && f.py(y) <= cy + lh + 4.0,
+            _ => {
+                let gy = f.py(y);
+                inside_x && gy >= cy - 4.0 && gy <= cy + lh + 4.0
+            }
+        }
+    };
+    let hidden = |c: (f64, f64)| -> usize {
+        p.series
+            .iter()
+            .map(|se| {
+                se.points
+                    .iter()
+                    .filter(|&&(x, y)| hides(se, c, x, y))
+                    .count()
+            })
+            .sum()
+    };
+    corners
+        .iter()
+        .copied()
+        .enumerate()
+        .min_by_key(|(i, c)| (hidden(*c), *i))
+        .map_or(corners[0], |x| x.1)
+}
+
+/// The legend's sample of a series' style, ending at the baseline `y`.
+fn legend_symbol(e: &Series, lx: f64, y: f64) -> String {
+    match &e.style {
+        Style::Markers { .. } => format!(
+            r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="{}"/>"#,
+            lx + 16.0,
+            y - 4.0,
+            e.color
+        ),
+        Style::Bars { .. } => format!(
+            r#"<rect x="{:.1}" y="{:.1}" width="14" height="9" fill="{}" fill-opacity="{}"/>"#,
+            lx + 9.0,
+            y - 9.0,
+            e.color,
+            e.opacity
+        ),
+        Style::Line { dash, .. } | Style::VRule { dash } => format!(
+            r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="{}" stroke-width="2"{}/>"#,
+            lx + 6.0,
+            y - 4.0,
+            lx + 26.0,
+            y - 4.0,
+            e.color,
+            dash_attr(*dash)
+        ),
+        Style::Stems => format!(
+            r#"<line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}" stroke="{3}" stroke-width="2"/>"#,
+            lx + 16.0,
+            y - 10.0,
+            y,
+            e.color
+        ),
     }
 }
 

@@ -49,7 +49,12 @@ fn empty_dir() -> PathBuf {
 }
 
 fn check_toml(text: &str) {
-    if let Err(e) = experiment::parse("fuzz.toml", text, &empty_dir()) {
+    if let Err(e) = experiment::parse(
+        "fuzz.toml",
+        text,
+        &empty_dir(),
+        experiment::Purpose::Simulate,
+    ) {
         let m = e.message();
         assert!(
             !m.contains('\n') && !m.contains('\r'),

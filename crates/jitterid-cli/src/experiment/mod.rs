@@ -1,0 +1,135 @@
+//! Experiment files (TOML): read once, validated once, into an [`Experiment`].
+//!
+//! The way in runs one direction: `raw` holds the file as written (serde types),
+//! the section parsers judge each value and build the library's models, `method` checks
+//! that the method can fit what is marked as estimated, and the result is an [`Experiment`]
+//! that no command has to question again. Every error is one line that names the file, the
+//! line and the key, and says what was expected (`diagnostics`). The key names are
+//! documented in `docs/experiments.md`.
+
+mod checks;
+mod diagnostics;
+mod estimate;
+mod input;
+mod jitter;
+mod method;
+mod noise;
+pub mod range;
+mod raw;
+mod sampling;
+mod spec;
+mod system;
+
+pub use input::MAX_SWITCHES;
+pub use sampling::MAX_SAMPLES;
+pub use spec::{
+    EstimateSpec, Experiment, InputSpec, JitterSpec, Method, NoiseSpec, SolverKind, SystemKind,
+    SystemSpec,
+};
+
+use crate::cli_err;
+use crate::csvio;
+use crate::error::CliResult;
+use crate::models::AnyNoise;
+use diagnostics::{shape_error, toml_error, Source};
+use jitterid::estimate::Frequencies;
+use raw::RawExperiment;
+use std::path::{Path, PathBuf};
+
+/// What the experiment is read for: what it must be fit for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Purpose {
+    /// Simulation only: the `[estimate]` section is read but not held against the rest.
+    Simulate,
+    /// Estimation with the file's method, or with this one (from the command line).
+    Estimate(Option<Method>),
+}
+
+/// Reads and validates an experiment file for `purpose`.
+pub fn read(path: &Path, purpose: Purpose) -> CliResult<Experiment> {
+    let file = path.display().to_string();
+    csvio::check_regular_file(path, &file)?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| cli_err!("{file}: cannot read: {}", csvio::io_reason(&e)))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        cli_err!(
+            "{file}: not UTF-8 text (invalid byte at offset {}); expected a TOML experiment file",
+            e.utf8_error().valid_up_to()
+        )
+    })?;
+    let dir = path
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."));
+    parse(&file, &text, &dir, purpose)
+}
+
+/// Parses and validates experiment text for `purpose`; `file` names it in messages, `dir`
+/// resolves relative paths.
+pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<Experiment> {
+    // TOML knows LF and CRLF only; a lone CR would be reported as a stray character on line 1.
+    let bytes = text.as_bytes();
+    if (0..bytes.len()).any(|i| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
+        return Err(cli_err!(
+            "{file}: line endings are CR only; expected LF or CRLF line endings (a TOML file)"
+        ));
+    }
+    if let Some(e) = shape_error(file, text) {
+        return Err(e);
+    }
+    let raw: RawExperiment = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
+    let cx = Source::new(file, text, dir.to_path_buf());
+    let r_sampling = raw.sampling.as_ref().ok_or_else(|| {
+        cli_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
+    })?;
+    let r_system = raw.system.as_ref().ok_or_else(|| {
+        cli_err!("{file}: missing section [system]; expected kind = \"zpk\", \"tf\" or \"sinusoid\" and its keys")
+    })?;
+    let grid = sampling::parse_sampling(&cx, r_sampling)?;
+    let system = system::parse_system(&cx, r_system, &grid)?;
+    let input = input::parse_input_section(&cx, raw.input.as_ref(), &system.kind, &grid)?;
+    let jitter = match &raw.jitter {
+        Some(r) => jitter::parse_jitter(&cx, r, &grid)?,
+        None => jitter::no_jitter(),
+    };
+    let noise = match &raw.noise {
+        Some(r) => noise::parse_noise(&cx, r)?,
+        None => NoiseSpec {
+            std: 0.0,
+            shape: AnyNoise::White,
+            estimate: false,
+        },
+    };
+    let mut estimate = match &raw.estimate {
+        Some(r) => estimate::parse_estimate(&cx, r, &grid)?,
+        None => EstimateSpec {
+            method: Method::Bcls,
+            frequencies: Frequencies::Dft,
+            solver: SolverKind::Lm,
+            multistart: 0,
+            multistart_radius: 0.5,
+            perturb: 0.2,
+            max_iterations: None,
+        },
+    };
+    if let Purpose::Estimate(chosen) = purpose {
+        estimate.method = chosen.unwrap_or(estimate.method);
+        let parts = method::Estimated {
+            system: &system,
+            jitter: &jitter,
+            noise: &noise,
+        };
+        method::check_method(&cx, &raw, &parts, estimate.method, chosen.is_some())?;
+    }
+    Ok(Experiment {
+        file: file.to_string(),
+        dir: cx.dir.clone(),
+        title: raw.title.clone(),
+        grid,
+        input,
+        system,
+        jitter,
+        noise,
+        estimate,
+    })
+}

@@ -1,0 +1,66 @@
+//! `[noise]`: the measurement noise's level and shape.
+
+use super::diagnostics::Source;
+use super::range;
+use super::raw::RawNoise;
+use super::spec::NoiseSpec;
+use crate::error::CliResult;
+use crate::models::AnyNoise;
+use jitterid::estimate::ArmaNoise;
+
+const S: &str = "noise";
+
+pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
+    let present = r.present();
+    let std = match &r.std {
+        Some(v) => {
+            let x = cx.checked(S, "std", v, range::level)?;
+            if x < 0.0 {
+                return Err(cx.err(
+                    S,
+                    "std",
+                    &v.span(),
+                    format!("expected a standard deviation >= 0, found {x}"),
+                ));
+            }
+            x
+        }
+        None => 0.0,
+    };
+    let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
+    let model = r.model.as_ref().map_or("white", |m| m.get_ref().as_str());
+    let shape = match model {
+        "white" => {
+            cx.only(S, &present, "model", &["std", "model", "estimate"], "white")?;
+            AnyNoise::White
+        }
+        "arma" => {
+            let c = match &r.c {
+                Some(v) => cx.finite_list(S, "c", v)?,
+                None => Vec::new(),
+            };
+            let d = match &r.d {
+                Some(v) => cx.finite_list(S, "d", v)?,
+                None => Vec::new(),
+            };
+            AnyNoise::Arma(ArmaNoise::new(c, d).map_err(|e| {
+                let span = r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
+                cx.err(S, "model", &span, e)
+            })?)
+        }
+        other => {
+            let span = r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
+            return Err(cx.err(
+                S,
+                "model",
+                &span,
+                format!("unknown noise model \"{other}\"; expected \"white\" or \"arma\""),
+            ));
+        }
+    };
+    Ok(NoiseSpec {
+        std,
+        shape,
+        estimate,
+    })
+}

@@ -1,0 +1,121 @@
+//! The file as written: one serde type per section, every key optional and spanned, unknown
+//! keys rejected. Nothing here judges a value; that is the section parsers' job.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::ops::Range;
+use toml::Spanned;
+
+/// A section whose keys depend on a choice made in it (`[jitter]`: the family's keys): every
+/// value spanned, the keys judged by the section's parser.
+pub(super) type RawTable = BTreeMap<String, Spanned<toml::Value>>;
+
+macro_rules! section {
+    ($name:ident, $title:literal { $($field:ident : $ty:ty),* $(,)? }) => {
+        #[derive(Debug, Deserialize)]
+        #[serde(deny_unknown_fields, rename = $title)]
+        pub(super) struct $name {
+            $( #[serde(default)] pub(super) $field: Option<Spanned<$ty>>, )*
+        }
+        impl $name {
+            pub(super) const KEYS: &'static [&'static str] = &[$(stringify!($field)),*];
+            // Only sections whose `kind`/`family` excludes keys ask which keys are present.
+            #[allow(dead_code)]
+            pub(super) fn present(&self) -> Vec<(&'static str, Range<usize>)> {
+                #[allow(unused_mut)]
+                let mut v = Vec::new();
+                $( if let Some(s) = &self.$field { v.push((stringify!($field), s.span())); } )*
+                v
+            }
+        }
+    };
+}
+
+section!(RawSampling, "table [sampling]" {
+    interval: f64,
+    samples: i64,
+    start: f64,
+});
+
+section!(RawInput, "table [input]" {
+    kind: String,
+    mean_dwell: f64,
+    low: f64,
+    high: f64,
+    frequency: f64,
+    amplitude: f64,
+    phase: f64,
+    frequencies: Vec<f64>,
+    amplitudes: Vec<f64>,
+    phases: Vec<f64>,
+    times: Vec<f64>,
+    values: Vec<f64>,
+    path: String,
+    time_column: String,
+    value_column: String,
+});
+
+section!(RawSystem, "table [system]" {
+    kind: String,
+    gain: f64,
+    zeros: Vec<toml::Value>,
+    poles: Vec<toml::Value>,
+    num: Vec<f64>,
+    den: Vec<f64>,
+    amplitude: f64,
+    frequency: f64,
+    phase: f64,
+    estimate: bool,
+});
+
+section!(RawNoise, "table [noise]" {
+    std: f64,
+    model: String,
+    c: Vec<f64>,
+    d: Vec<f64>,
+    estimate: bool,
+});
+
+section!(RawEstimate, "table [estimate]" {
+    method: String,
+    frequencies: toml::Value,
+    solver: String,
+    multistart: i64,
+    multistart_radius: f64,
+    perturb: f64,
+    max_iterations: i64,
+});
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename = "experiment file")]
+pub(super) struct RawExperiment {
+    #[serde(default)]
+    pub(super) title: Option<String>,
+    #[serde(default)]
+    pub(super) sampling: Option<RawSampling>,
+    #[serde(default)]
+    pub(super) input: Option<RawInput>,
+    #[serde(default)]
+    pub(super) system: Option<RawSystem>,
+    #[serde(default)]
+    pub(super) jitter: Option<RawTable>,
+    #[serde(default)]
+    pub(super) noise: Option<RawNoise>,
+    #[serde(default)]
+    pub(super) estimate: Option<RawEstimate>,
+}
+
+pub(super) const SECTIONS: &[&str] = &[
+    "title", "sampling", "input", "system", "jitter", "noise", "estimate",
+];
+
+pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
+    match section {
+        "sampling" => RawSampling::KEYS,
+        "input" => RawInput::KEYS,
+        "system" => RawSystem::KEYS,
+        "noise" => RawNoise::KEYS,
+        "estimate" => RawEstimate::KEYS,
+        _ => SECTIONS,
+    }
+}

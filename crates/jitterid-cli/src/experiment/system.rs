@@ -1,0 +1,118 @@
+//! `[system]`: zeros, poles and gain, a transfer function, or a sinusoid.
+
+use super::checks::{describe, number};
+use super::diagnostics::Source;
+use super::range;
+use super::raw::RawSystem;
+use super::spec::{SystemKind, SystemSpec};
+use crate::error::CliResult;
+use jitterid::signal::{Root, SampleGrid, Sinusoid, TransferFunction, Zpk};
+use toml::Spanned;
+
+const S: &str = "system";
+const KINDS: &str = "\"zpk\", \"tf\" or \"sinusoid\"";
+
+pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemSpec> {
+    let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
+    let name = kind.get_ref().as_str();
+    let allowed: &[&str] = match name {
+        "zpk" => &["kind", "gain", "zeros", "poles", "estimate"],
+        "tf" => &["kind", "num", "den", "estimate"],
+        "sinusoid" => &["kind", "amplitude", "frequency", "phase", "estimate"],
+        other => {
+            return Err(cx.err(
+                S,
+                "kind",
+                &kind.span(),
+                format!("unknown system kind \"{other}\"; expected {KINDS}"),
+            ))
+        }
+    };
+    cx.only(S, &r.present(), "kind", allowed, name)?;
+    let kind = match name {
+        "zpk" => zpk(cx, r, grid)?,
+        "tf" => tf(cx, r, grid)?,
+        _ => sinusoid(cx, r, grid)?,
+    };
+    let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
+    Ok(SystemSpec { kind, estimate })
+}
+
+fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
+    let why = "kind = \"zpk\" needs gain, poles and optionally zeros";
+    let g = cx.required(S, "gain", &r.gain, why)?;
+    let gain = cx.checked(S, "gain", g, range::gain)?;
+    let p = cx.required(S, "poles", &r.poles, why)?;
+    let poles = parse_roots(cx, "poles", p)?;
+    range::poles(range::root_moduli(&poles), grid).map_err(|m| cx.err(S, "poles", &p.span(), m))?;
+    let zeros = match &r.zeros {
+        Some(z) => {
+            let zeros = parse_roots(cx, "zeros", z)?;
+            range::zeros(&zeros, grid).map_err(|m| cx.err(S, "zeros", &z.span(), m))?;
+            zeros
+        }
+        None => Vec::new(),
+    };
+    let zpk = Zpk::new(gain, zeros, poles).map_err(|e| cx.err(S, "poles", &p.span(), e))?;
+    range::response(&zpk, grid).map_err(|m| cx.err(S, "gain", &g.span(), m))?;
+    Ok(SystemKind::Zpk(zpk))
+}
+
+fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
+    let why = "kind = \"tf\" needs num and den (highest power first)";
+    let n = cx.required(S, "num", &r.num, why)?;
+    let d = cx.required(S, "den", &r.den, why)?;
+    let num = cx.finite_list(S, "num", n)?;
+    let den = cx.finite_list(S, "den", d)?;
+    let tf = TransferFunction::new(&num, &den).map_err(|e| cx.err(S, "den", &d.span(), e))?;
+    range::response(&tf, grid).map_err(|m| cx.err(S, "den", &d.span(), m))?;
+    if tf.num().iter().all(|b| *b == 0.0) {
+        return Err(cx.err(
+            S,
+            "num",
+            &n.span(),
+            "expected a nonzero numerator (a zero gain gives no signal to identify)",
+        ));
+    }
+    Ok(SystemKind::Tf(tf))
+}
+
+fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
+    let why = "kind = \"sinusoid\" needs amplitude, frequency and optionally phase";
+    let a = cx.required(S, "amplitude", &r.amplitude, why)?;
+    let f = cx.required(S, "frequency", &r.frequency, why)?;
+    let amplitude = cx.checked(S, "amplitude", a, range::gain)?;
+    let frequency = cx.checked(S, "frequency", f, |f| range::frequency(f, grid))?;
+    let phase = cx.opt_finite(S, "phase", &r.phase, 0.0)?;
+    let s = Sinusoid::new(amplitude, frequency, phase)
+        .map_err(|e| cx.err(S, "frequency", &f.span(), e))?;
+    Ok(SystemKind::Sinusoid(s))
+}
+
+fn parse_roots(cx: &Source, key: &str, v: &Spanned<Vec<toml::Value>>) -> CliResult<Vec<Root>> {
+    let mut out = Vec::new();
+    for (i, e) in v.get_ref().iter().enumerate() {
+        let bad = |what: String| {
+            cx.err("system", key, &v.span(), format!(
+                "element {}: expected a number (a real root) or [re, im] with im > 0 (a complex pair), found {what}",
+                i + 1
+            ))
+        };
+        let root = match e {
+            toml::Value::Array(a) if a.len() == 2 => match (number(&a[0]), number(&a[1])) {
+                (Some(re), Some(im)) if re.is_finite() && im.is_finite() && im > 0.0 => {
+                    Root::Pair { re, im }
+                }
+                (Some(re), Some(im)) => return Err(bad(format!("[{re}, {im}]"))),
+                _ => return Err(bad(describe(e))),
+            },
+            other => match number(other) {
+                Some(x) if x.is_finite() => Root::Real(x),
+                Some(x) => return Err(bad(format!("{x}"))),
+                None => return Err(bad(describe(other))),
+            },
+        };
+        out.push(root);
+    }
+    Ok(out)
+}
