@@ -9,7 +9,7 @@ use crate::fingerprint::experiment_fingerprint;
 use crate::fitting::{self, Fit, Structure};
 use crate::output::{self, OutputSet};
 use crate::plots;
-use crate::progress::Progress;
+use crate::progress::{Progress, Ticker};
 use jitterid::estimate::montecarlo::{realization_rng, realization_seed, run as mc_run, Summary};
 use jitterid::signal::Input;
 use serde::{Deserialize, Serialize};
@@ -59,6 +59,13 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
     let sim = fitting::simulate_record(&exp, &signal, &mut rng)?;
     let n = exp.grid.len();
+    if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
+        return Err(cli_err!(
+            "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
+            exp.file,
+            sim.y[k]
+        ));
+    }
     let k: Vec<usize> = (0..n).collect();
     let t: Vec<f64> = exp.grid.times().collect();
     let u: Option<Vec<f64>> = input
@@ -250,7 +257,9 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
             method.as_str()
         )
     };
+    let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let f: Fit = fitting::fit(&exp, &s, &record, method, 0, true).map_err(fit_err)?;
+    drop(ticker);
 
     let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {

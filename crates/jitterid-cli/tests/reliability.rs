@@ -563,3 +563,17 @@ fn data_files_with_cr_line_endings_are_read() {
         &["cr.csv:6:7:", "column `y`", "oops"],
     );
 }
+
+#[test]
+fn simulate_never_writes_samples_that_are_not_numbers() {
+    let dir = scratch("non-finite-samples");
+    let exp = dir.join("tiny-pole.toml");
+    // A pole of magnitude 1e-300 with a random-binary input used to give NaN samples.
+    std::fs::write(&exp, SMALL.replace("poles = [-0.5]", "poles = [-1e-300]")).unwrap();
+    let data = dir.join("d.csv");
+    refused(
+        &["simulate", s(&exp), "--out", s(&data)],
+        &["tiny-pole.toml"],
+    );
+    assert_eq!(names_in(&dir), ["tiny-pole.toml"]);
+}
