@@ -321,4 +321,80 @@ mod tests {
             Target::Replace(missing.to_path_buf())
         );
     }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// A failure after the checks (a destination changed meanwhile) rolls back the renames.
+    #[test]
+    fn a_late_failure_restores_the_files_already_renamed() {
+        let dir = tempfile::tempdir().unwrap();
+        let (old, new, blocked) = (
+            dir.path().join("old.csv"),
+            dir.path().join("new.csv"),
+            dir.path().join("blocked"),
+        );
+        std::fs::write(&old, "previous").unwrap();
+        // A non-empty directory cannot be renamed over; it stands for a target that became
+        // one after the checks.
+        std::fs::create_dir(&blocked).unwrap();
+        std::fs::write(blocked.join("inside"), "x").unwrap();
+        let files = vec![
+            (old.clone(), b"replaced".to_vec()),
+            (new.clone(), b"created".to_vec()),
+            (blocked.clone(), b"never".to_vec()),
+        ];
+        let targets: Vec<Target> = files
+            .iter()
+            .map(|(p, _)| Target::Replace(p.clone()))
+            .collect();
+        let e = write_all(&files, &targets).unwrap_err();
+        assert!(e.message().contains("blocked"), "{e}");
+        assert_eq!(std::fs::read_to_string(&old).unwrap(), "previous");
+        assert_eq!(names(dir.path()), ["blocked", "old.csv"]);
+        // A stream that cannot be opened rolls back the renamed files too.
+        let files = vec![
+            (old.clone(), b"replaced".to_vec()),
+            (dir.path().join("pipe"), b"never".to_vec()),
+        ];
+        let targets = vec![
+            Target::Replace(old.clone()),
+            Target::Stream(dir.path().join("no/such/pipe")),
+        ];
+        assert!(write_all(&files, &targets).is_err());
+        assert_eq!(std::fs::read_to_string(&old).unwrap(), "previous");
+        assert_eq!(names(dir.path()), ["blocked", "old.csv"]);
+        // And when nothing fails, every file is there.
+        let files = vec![
+            (old.clone(), b"replaced".to_vec()),
+            (new.clone(), b"created".to_vec()),
+        ];
+        let targets: Vec<Target> = files
+            .iter()
+            .map(|(p, _)| Target::Replace(p.clone()))
+            .collect();
+        write_all(&files, &targets).unwrap();
+        assert_eq!(std::fs::read_to_string(&old).unwrap(), "replaced");
+        assert_eq!(std::fs::read_to_string(&new).unwrap(), "created");
+        assert_eq!(names(dir.path()), ["blocked", "new.csv", "old.csv"]);
+    }
+
+    #[test]
+    fn a_figure_directory_is_removed_again_when_the_set_fails() {
+        let dir = tempfile::tempdir().unwrap();
+        let figs = dir.path().join("figs/deeper");
+        let mut set = OutputSet::new();
+        set.dir(&figs);
+        set.file(&figs.join("a.svg"), "<svg/>");
+        set.file(&dir.path().join("nodir/r.json"), "{}");
+        let e = set.commit().unwrap_err();
+        assert!(e.message().contains("does not exist"), "{e}");
+        assert!(names(dir.path()).is_empty(), "{:?}", names(dir.path()));
+    }
 }
