@@ -41,6 +41,11 @@ fn read_part(path: &Path) -> CliResult<Part> {
     let (Some(shard), Some(runs)) = (json.shard.clone(), json.realizations.clone()) else {
         return Err(cli_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json"));
     };
+    if json.fingerprint.is_empty() || json.program.is_empty() {
+        return Err(cli_err!(
+            "{name}: has no `fingerprint` and `program` (written by an older jitterid?); its study cannot be identified, so run the shard again"
+        ));
+    }
     Ok(Part {
         name,
         json,

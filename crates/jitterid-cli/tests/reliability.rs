@@ -380,6 +380,14 @@ fn hand_edited_shards_do_not_merge() {
     two_shards(&dir);
     edited_shard_is_refused(
         &dir,
+        "no-fingerprint",
+        |v| {
+            v.as_object_mut().unwrap().remove("fingerprint");
+        },
+        &["no `fingerprint`"],
+    );
+    edited_shard_is_refused(
+        &dir,
         "true-value",
         |v| v["parameters"][0]["true"] = Value::from(3.0),
         &["true value", "gain"],
