@@ -130,6 +130,11 @@ impl OutputSet {
                     ));
                 }
             }
+            if targets.contains(&target) {
+                return Err(cli_err!(
+                    "{name}: cannot write: the command would write this file twice (check --out against --plot)"
+                ));
+            }
             targets.push(target);
         }
         let created = create_dirs(&self.dirs)?;
@@ -383,6 +388,17 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&old).unwrap(), "replaced");
         assert_eq!(std::fs::read_to_string(&new).unwrap(), "created");
         assert_eq!(names(dir.path()), ["blocked", "new.csv", "old.csv"]);
+    }
+
+    #[test]
+    fn a_file_written_twice_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut set = OutputSet::new();
+        set.file(&dir.path().join("a.svg"), "one");
+        set.file(&dir.path().join("./a.svg"), "two");
+        let e = set.commit().unwrap_err();
+        assert!(e.message().contains("twice"), "{e}");
+        assert!(names(dir.path()).is_empty());
     }
 
     #[test]
