@@ -128,6 +128,32 @@ fn a_fifo_given_to_out_is_written_through_not_replaced() {
     assert!(is_fifo(&fifo));
 }
 
+/// A character device given to `--out` (a null device made for the test with `mknod`, which
+/// needs root, so the machine's `/dev/null` is never at stake) stays a device and has no side
+/// file written beside it. Where `mknod` is not allowed, the FIFO test above covers the path.
+#[cfg(unix)]
+#[test]
+fn a_character_device_given_to_out_stays_a_device() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = scratch("char-device");
+    let exp = small(&dir);
+    let null = dir.join("null");
+    let made = Command::new("mknod")
+        .args([s(&null), "c", "1", "3"])
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|st| st.success());
+    if !made {
+        eprintln!("mknod not permitted here (not root): character-device case not run");
+        return;
+    }
+    let report = status(&["simulate", s(&exp), "--out", s(&null)], 0);
+    assert!(report.contains("not written"), "{report}");
+    let kind = std::fs::symlink_metadata(&null).unwrap().file_type();
+    assert!(kind.is_char_device(), "the device was replaced");
+    assert_eq!(names_in(&dir), ["null", "small.toml"]);
+}
+
 #[cfg(unix)]
 #[test]
 fn a_symlink_given_to_out_is_followed_and_kept() {
