@@ -2,6 +2,7 @@
 //! same experiment under two paths is one study and an edited file is another.
 
 use crate::experiment::Experiment;
+use std::fmt::Write as _;
 use std::hash::Hasher;
 
 /// The fingerprint of `exp`: a 64-bit FNV-1a hash (16 hexadecimal digits) of the canonical text
@@ -9,13 +10,25 @@ use std::hash::Hasher;
 /// enter with their shortest round-trip text, so two values give the same fingerprint only if
 /// they are equal; the file's name, comments, layout and key order do not enter.
 pub fn experiment_fingerprint(exp: &Experiment) -> String {
-    let canonical = format!(
+    let mut h = HashWriter(fnv::FnvHasher::default());
+    // Writing into a hasher cannot fail.
+    let _ = write!(
+        h,
         "title={:?}\ngrid={:?}\ninput={:?}\nsystem={:?}\njitter={:?}\nnoise={:?}\nestimate={:?}",
         exp.title, exp.grid, exp.input, exp.system, exp.jitter, exp.noise, exp.estimate
     );
-    let mut h = fnv::FnvHasher::default();
-    h.write(canonical.as_bytes());
-    format!("{:016x}", h.finish())
+    format!("{:016x}", h.0.finish())
+}
+
+/// Feeds formatted text straight into the hash, so that a long measured input is hashed
+/// without first being written out as one string.
+struct HashWriter(fnv::FnvHasher);
+
+impl std::fmt::Write for HashWriter {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0.write(s.as_bytes());
+        Ok(())
+    }
 }
 
 #[cfg(test)]
