@@ -9,6 +9,7 @@
 
 use crate::criterion::{Criterion, FrequencyData};
 use crate::noise::NoiseModel;
+use crate::parseval::{edge_bins, moment_sensitivities, parseval_gram, parseval_weight};
 use crate::structure::ModelStructure;
 use faer::linalg::solvers::DenseSolveCore;
 use faer::{Mat, Side};
@@ -20,38 +21,85 @@ use std::f64::consts::TAU;
 
 /// The sandwich covariance and the noise standard deviation it used (known, or estimated by
 /// moments from the residuals). `None` when `JᵀJ` is singular or not finite.
+///
+/// In the Parseval case ([`parseval_weight`]) with white noise, `JᵀJ` and the meat are sums over
+/// samples of the time-domain sensitivities and the Jacobian is never formed; otherwise the
+/// explicit Jacobian is mapped back to time.
+///
+/// Parameters in `held` (on the boundary of their domain, see [`crate::boundary`]) get zero
+/// rows and columns; the others their covariance conditional on the held ones.
 pub(crate) fn sandwich<S, J, N, C, W>(
     data: &FrequencyData<W>,
     model: &ModelStructure<S, J, N>,
     criterion: &C,
-    jac: &Mat<f64>,
+    held: &[usize],
 ) -> (Option<Vec<Vec<f64>>>, f64)
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion,
+    W: Window,
+{
+    let (jitter_var, noise_var) = sample_variances(data, model);
+    let white = model.noise.is_white();
+    let (gram, meat) = match parseval_weight(criterion, data, model) {
+        Some(weight) if white => {
+            let cols = moment_sensitivities(criterion, data, model);
+            let meat = time_domain_meat(&cols, weight, &jitter_var, noise_var);
+            (parseval_gram(&cols, weight), meat)
+        }
+        _ => {
+            let jac = criterion.jacobian(data, model);
+            let meat = projected_meat(data, model, criterion, &jac, &jitter_var, noise_var);
+            (crate::solver::gram(&jac), meat)
+        }
+    };
+    let p = gram.nrows();
+    let free: Vec<usize> = (0..p).filter(|i| !held.contains(i)).collect();
+    let block = |m: &Mat<f64>| Mat::from_fn(free.len(), free.len(), |a, b| m[(free[a], free[b])]);
+    let Some(hinv) = inverse_gram(&block(&gram)) else {
+        return (None, noise_var.sqrt());
+    };
+    let cov = &hinv * &block(&meat) * &hinv;
+    let mut out = vec![vec![0.0; p]; p];
+    for (a, &i) in free.iter().enumerate() {
+        for (b, &j) in free.iter().enumerate() {
+            out[i][j] = cov[(a, b)];
+        }
+    }
+    let finite = out.iter().flatten().all(|v| v.is_finite());
+    (finite.then_some(out), noise_var.sqrt())
+}
+
+/// The jitter part of each sample's variance, `E[s(t_k+τ)²] − m_k²`, and the measurement-noise
+/// variance (known, or estimated by moments from the residuals).
+fn sample_variances<S, J, N, W>(
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+) -> (Vec<f64>, f64)
 where
     S: Signal,
     J: JitterModel,
     N: NoiseModel,
-    C: Criterion,
     W: Window,
 {
     let record = data.record();
     let grid = record.grid();
     let n = grid.len();
-    let p = jac.ncols();
     // The data's true variance always involves the jitter, whatever the criterion models.
     let m = model.signal.expected_values(grid, &model.jitter);
-    let sq = model.signal.expected_squares(grid, &model.jitter);
-    let jitter_var: Vec<f64> = sq
-        .iter()
+    let mut jitter_var = model.signal.expected_squares(grid, &model.jitter);
+    jitter_var
+        .iter_mut()
         .zip(&m)
-        .map(|(s, m)| (s - m * m).max(0.0))
-        .collect();
+        .for_each(|(s, m)| *s = (*s - m * m).max(0.0));
     let mean_jitter_var = jitter_var.iter().sum::<f64>() / n as f64;
     let freqs = data.frequencies();
     let t = grid.interval();
-    let white = model.noise.is_white();
     let noise_var = match model.noise_std {
         Some(s) => s * s,
-        None if white => {
+        None if model.noise.is_white() => {
             let mse = record
                 .y()
                 .iter()
@@ -72,6 +120,64 @@ where
             acc / freqs.len() as f64
         }
     };
+    (jitter_var, noise_var)
+}
+
+/// `Jᵀ Σ_r J` for white noise in the Parseval case, accumulated sample by sample: the row of
+/// `G = Aᵀ√W J` at sample `k` is `−w (N a_k + S(a) + [N even] (−1)^k Alt(a)) / 2` for each
+/// sensitivity `a` (the real part of the half-grid inverse transform, as in
+/// [`parseval`](crate::parseval)).
+fn time_domain_meat(
+    cols: &[Vec<f64>],
+    weight: f64,
+    jitter_var: &[f64],
+    noise_var: f64,
+) -> Mat<f64> {
+    let p = cols.len();
+    let n = jitter_var.len();
+    let edges: Vec<(f64, f64)> = cols.iter().map(|c| edge_bins(c)).collect();
+    let even = n % 2 == 0;
+    let mut meat = Mat::<f64>::zeros(p, p);
+    let mut gk = vec![0.0; p];
+    for (k, &jv) in jitter_var.iter().enumerate() {
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        for (a, g) in gk.iter_mut().enumerate() {
+            let nyquist = if even { sign * edges[a].1 } else { 0.0 };
+            *g = -0.5 * weight * (n as f64 * cols[a][k] + edges[a].0 + nyquist);
+        }
+        let lambda = jv + noise_var;
+        for a in 0..p {
+            for b in 0..p {
+                meat[(a, b)] += lambda * gk[a] * gk[b];
+            }
+        }
+    }
+    meat
+}
+
+/// `Jᵀ Σ_r J` from the explicit Jacobian, mapped back to time (any window, frequency set and
+/// weights; coloured noise adds its asymptotic diagonal per frequency).
+fn projected_meat<S, J, N, C, W>(
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+    criterion: &C,
+    jac: &Mat<f64>,
+    jitter_var: &[f64],
+    noise_var: f64,
+) -> Mat<f64>
+where
+    S: Signal,
+    J: JitterModel,
+    N: NoiseModel,
+    C: Criterion,
+    W: Window,
+{
+    let grid = data.record().grid();
+    let n = grid.len();
+    let p = jac.ncols();
+    let freqs = data.frequencies();
+    let t = grid.interval();
+    let white = model.noise.is_white();
     let w = criterion.weights(freqs, &model.noise);
     let taper = data.window().weights(n);
 
@@ -107,15 +213,7 @@ where
             }
         }
     }
-    let Some(hinv) = inverse_gram(&crate::solver::problem::gram(jac)) else {
-        return (None, noise_var.sqrt());
-    };
-    let cov = &hinv * &meat * &hinv;
-    let out: Vec<Vec<f64>> = (0..p)
-        .map(|a| (0..p).map(|b| cov[(a, b)]).collect())
-        .collect();
-    let finite = out.iter().flatten().all(|v| v.is_finite());
-    (finite.then_some(out), noise_var.sqrt())
+    meat
 }
 
 /// Largest 1-norm condition number of a symmetric positive definite matrix (`JᵀJ` here, the

@@ -228,7 +228,7 @@ fn stack(y: &[Complex64], mu: &[Complex64], w: &[f64]) -> Vec<f64> {
 
 /// Central difference of a vector function of `θ` in coordinate `j`, falling back to a one-sided
 /// difference where a side leaves the model's domain (for example `a ≤ 0`).
-fn central_difference(
+pub(crate) fn central_difference(
     theta: &[f64],
     j: usize,
     f: impl Fn(&[f64]) -> Option<Vec<f64>>,

@@ -1,11 +1,14 @@
 //! The one entry point: [`estimate`] a model structure from a record with a criterion and a
 //! solver, with the asymptotic covariance of the estimate.
 
+use crate::boundary::{bound_params, positive_params, settle_at_bounds};
 use crate::covariance::sandwich;
 use crate::criterion::{Criterion, FrequencyData};
 use crate::data::Record;
 use crate::noise::NoiseModel;
-use crate::solver::{LeastSquares, LevenbergMarquardt, Solver, SolverError, Termination};
+use crate::solver::{
+    LeastSquares, LevenbergMarquardt, NormalEquations, Solver, SolverError, Termination,
+};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
@@ -79,7 +82,9 @@ pub struct Estimate {
     pub params: Vec<f64>,
     /// Asymptotic covariance of `θ̂` (sandwich form), if computed and defined.
     pub covariance: Option<Vec<Vec<f64>>>,
-    /// Standard errors, the square roots of the covariance's diagonal.
+    /// Standard errors, the square roots of the covariance's diagonal. A parameter on the
+    /// boundary of its domain ([`Termination::AtBound`]) has none: its entry is 0, and the
+    /// others are conditional on it.
     pub std_errors: Option<Vec<f64>>,
     /// Final cost `½ Σ r²`.
     pub cost: f64,
@@ -144,6 +149,22 @@ where
             Err(_) => Mat::from_fn(self.num_residuals(), self.num_params(), |_, _| f64::NAN),
         })
     }
+
+    fn normal_equations(
+        &self,
+        theta: &[f64],
+        residuals: &[f64],
+    ) -> Result<NormalEquations, SolverError> {
+        Ok(match self.structure.with_params(theta) {
+            Ok(m) => crate::parseval::criterion_normal_equations(
+                self.criterion,
+                self.data,
+                &m,
+                residuals,
+            ),
+            Err(_) => NormalEquations::not_finite(self.num_params()),
+        })
+    }
 }
 
 /// Estimates the free parameters of `structure` from `record` by minimising `criterion` with
@@ -205,13 +226,15 @@ where
     if let Some((index, &value)) = r0.iter().enumerate().find(|(_, r)| !r.is_finite()) {
         return Err(EstimateError::NonFiniteAtStart { index, value });
     }
+    drop(r0);
     let report = options.solver.minimize(&problem, &start)?;
+    // A width that went to 0 stalls the solver at the domain's edge: that is an answer.
+    let held = bound_params(&report, &start, &positive_params(structure));
+    let report = settle_at_bounds(&problem, &options.solver, report, &held)?;
     let fitted = structure.with_params(&report.params)?;
     let residuals = criterion.residuals(&data, &fitted);
     let (covariance, noise_std) = if options.covariance {
-        let jac = criterion.jacobian(&data, &fitted);
-        let (cov, std) = sandwich(&data, &fitted, criterion, &jac);
-        (cov, std)
+        sandwich(&data, &fitted, criterion, &held)
     } else {
         (None, fitted.noise_std.unwrap_or(f64::NAN))
     };

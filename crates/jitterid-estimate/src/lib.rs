@@ -33,6 +33,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod boundary;
 mod covariance;
 mod criterion;
 mod data;
@@ -43,6 +44,7 @@ mod init;
 pub mod ml;
 pub mod montecarlo;
 mod noise;
+mod parseval;
 mod profile;
 pub mod solver;
 mod structure;

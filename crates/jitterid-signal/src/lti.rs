@@ -774,10 +774,9 @@ mod tests {
         let s = LtiResponse::new(g, u);
         let grid = SampleGrid::new(0.0, 0.1, 20).unwrap();
         let j = ExponentialDelay::new(0.15).unwrap();
-        let t = std::time::Instant::now();
+        // Results only: the cost is timed by `cargo bench -p jitterid --bench wide_jitter`.
         let sq = s.expected_squares(&grid, &j);
         let m = s.expected_values(&grid, &j);
-        assert!(t.elapsed().as_secs_f64() < 1.0, "{:?}", t.elapsed());
         for (k, (q, v)) in sq.iter().zip(&m).enumerate() {
             // E[s²] ≥ (E s)², up to rounding.
             assert!(q.is_finite() && *q >= v * v - 1e-12, "{k}: {q} vs {v}²");

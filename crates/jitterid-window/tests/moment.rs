@@ -369,7 +369,6 @@ fn routes_agree_on_the_table_2_case() {
     let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
     let freqs = FrequencySet::dft(&grid);
-    let start = std::time::Instant::now();
     let worst = compare(
         "table 2",
         &signal,
@@ -379,11 +378,10 @@ fn routes_agree_on_the_table_2_case() {
         &freqs,
         &IntegralOptions::default(),
     );
-    let elapsed = start.elapsed().as_secs_f64();
     // Observed: largest |a − b| ≈ 1.6e-14 · max|μ_Y|, bounds ≤ 8.7e-12 · max|μ_Y|, with
-    // M = 256 aliases and Q = 800 intervals; about 0.5 s in the test profile.
+    // M = 256 aliases and Q = 800 intervals. The cost of route (a) is timed by
+    // `cargo bench -p jitterid --bench table2`, not here.
     assert!(worst < 1e-10, "{worst:e}");
-    assert!(elapsed < 10.0, "{elapsed} s");
 }
 
 proptest! {

@@ -63,14 +63,34 @@ impl FisherInformation {
 
 /// `√(gᵀ C g)`: the delta-method standard deviation of a function with gradient `g` of an
 /// estimate with covariance `C`.
-pub fn delta_method_std(covariance: &[Vec<f64>], gradient: &[f64]) -> f64 {
+///
+/// # Errors
+///
+/// [`MlError::InvalidArgument`] naming `covariance` (with its number of rows) if it does not
+/// have one row per gradient entry, or the first row (by index) of another length.
+pub fn delta_method_std(covariance: &[Vec<f64>], gradient: &[f64]) -> Result<f64, MlError> {
+    let n = gradient.len();
+    if covariance.len() != n {
+        return Err(MlError::InvalidArgument {
+            name: "covariance",
+            value: covariance.len() as f64,
+            reason: "must have one row per gradient entry",
+        });
+    }
+    if let Some(i) = covariance.iter().position(|row| row.len() != n) {
+        return Err(MlError::InvalidArgument {
+            name: "covariance row",
+            value: i as f64,
+            reason: "every row must have one entry per gradient entry",
+        });
+    }
     let mut v = 0.0;
     for (i, gi) in gradient.iter().enumerate() {
         for (j, gj) in gradient.iter().enumerate() {
             v += gi * covariance[i][j] * gj;
         }
     }
-    v.max(0.0).sqrt()
+    Ok(v.max(0.0).sqrt())
 }
 
 fn white_only<N: NoiseModel>(noise: &N, what: &'static str) -> Result<(), MlError> {

@@ -131,6 +131,14 @@ pub struct Bfgs {
     pub cost_tol: f64,
     /// Largest component of the first trial step (unconstrained coordinates). Default 0.2.
     pub initial_step: f64,
+    /// Wall-clock budget in seconds, checked between iterations: the run stops with
+    /// [`Termination::TimeLimit`] once it is spent. Default 600; `f64::INFINITY` for none.
+    #[serde(default = "default_max_seconds")]
+    pub max_seconds: f64,
+}
+
+fn default_max_seconds() -> f64 {
+    600.0
 }
 
 impl Default for Bfgs {
@@ -141,6 +149,7 @@ impl Default for Bfgs {
             step_tol: 1e-10,
             cost_tol: 1e-14,
             initial_step: 0.2,
+            max_seconds: default_max_seconds(),
         }
     }
 }
@@ -172,6 +181,13 @@ impl Bfgs {
                     reason: "must be finite and > 0",
                 });
             }
+        }
+        if !(self.max_seconds >= 0.0) {
+            return Err(SolverError::InvalidOption {
+                option: "max_seconds",
+                value: self.max_seconds,
+                reason: "must be >= 0 (infinity for no limit)",
+            });
         }
         Ok(())
     }
@@ -233,9 +249,13 @@ impl Bfgs {
         };
         let mut small_changes = 0;
         let mut iterations = 0;
+        let started = std::time::Instant::now();
         let termination = loop {
             if iterations >= self.max_iters {
                 break Termination::MaxIterations;
+            }
+            if started.elapsed().as_secs_f64() >= self.max_seconds {
+                break Termination::TimeLimit;
             }
             let hg = mat_vec(&h, &g);
             if 0.5 * dot(&g, &hg) <= self.decrement_tol && updated {

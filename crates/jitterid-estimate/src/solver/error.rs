@@ -50,6 +50,16 @@ pub enum SolverError {
         /// Its value.
         value: f64,
     },
+    /// `JᵀJ` or `Jᵀr` has a NaN or infinite entry at the start (so the Jacobian has one).
+    #[error("the normal equations are not finite at the start: {what} entry {index} is {value}")]
+    NonFiniteNormalEquations {
+        /// `"gram"` (`JᵀJ`, row-major index) or `"gradient"` (`Jᵀr`).
+        what: &'static str,
+        /// Index of the entry.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
     /// The problem has fewer residuals than parameters, so the parameters are not identifiable.
     #[error("{residuals} residuals cannot determine {params} parameters")]
     TooFewResiduals {

@@ -1,9 +1,10 @@
 //! Gauss–Newton with a line search: argmin's `GaussNewtonLS` over [`ArgminFaerProblem`].
 
 use super::error::check_option;
+use super::normal::jt_r;
 use super::problem::{
-    checked_jacobian, checked_residuals, col_to_vec, half_sum_sq, jt_r, start_residuals,
-    validate_start, vec_to_col, ArgminFaerProblem, LeastSquares, Scaled,
+    checked_jacobian, checked_residuals, col_to_vec, half_sum_sq, start_residuals, validate_start,
+    vec_to_col, ArgminFaerProblem, LeastSquares, Scaled,
 };
 use super::{from_argmin_reason, Solver, SolverError, SolverReport, Termination};
 use argmin::core::observers::{Observe, ObserverMode};
@@ -118,7 +119,7 @@ impl GaussNewtonLineSearch {
         let j = checked_jacobian(problem, theta).ok()?;
         let n = theta.len();
         let g = jt_r(&j, &r);
-        let jtj = super::problem::gram(&j);
+        let jtj = super::normal::gram(&j);
         let p = jtj
             .llt(Side::Lower)
             .ok()?

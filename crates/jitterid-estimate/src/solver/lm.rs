@@ -8,11 +8,13 @@
 //! # Requirements on the optimization problem
 //!
 //! The problem is required to implement argmin's [`Operator`] (the residual vector, `Param =
-//! Vec<f64>`, `Output = Vec<f64>`) and [`Jacobian`] (`Jacobian = faer::Mat<f64>`, residuals ×
-//! parameters). [`ArgminProblem`] provides both for every [`LeastSquares`] problem.
+//! Vec<f64>`, `Output = Vec<f64>`) and [`NormalEquationsOperator`] (`JᵀJ` and `Jᵀr`; the
+//! Jacobian itself is never stored, so a fit's memory does not grow with `m × n`).
+//! [`ArgminProblem`] provides both for every [`LeastSquares`] problem.
 //!
 //! The state is argmin's [`IterState`] ([`LmState`]): `param` is the current point, `cost` is
-//! `½ Σ rᵢ²`, and `residuals`, `jacobian` and `gradient` (`Jᵀr`) hold the values at `param`.
+//! `½ Σ rᵢ²`, and `residuals` and `gradient` (`Jᵀr`) hold the values at `param`; its Jacobian
+//! slot stays empty.
 //!
 //! # Algorithm
 //!
@@ -31,7 +33,9 @@
 //!
 //! Stopping tests (see [`LmOptions`]): relative step `‖h‖ ≤ xtol (‖θ‖ + xtol)`; relative cost
 //! reduction (actual and predicted both `≤ ftol · V`); gradient, as the largest cosine between
-//! `r` and a column of `J`, `≤ gtol` (MINPACK's scale-free test); iteration limit. The reason is
+//! `r` and a column of `J`, `≤ gtol` (MINPACK's scale-free test); iteration limit; wall-clock
+//! budget ([`LmOptions::max_seconds`], checked between iterations and damping retries, so one
+//! evaluation may overrun it). The reason is
 //! available from [`LevenbergMarquardt::termination`] and, coarsely, from argmin's
 //! [`TerminationReason`]: convergence tests map to `SolverConverged`, the iteration limit to
 //! `MaxItersReached`, everything else to `SolverExit(text)`.
@@ -80,21 +84,21 @@
 //! ```
 
 use super::error::check_option;
-use super::problem::{
-    check_jacobian_shape, first_non_finite, first_non_finite_entry, half_sum_sq, jt_r,
-    validate_start, ArgminProblem, LeastSquares,
-};
+use super::normal::{NormalEquations, NormalEquationsOperator};
+use super::problem::{first_non_finite, half_sum_sq, validate_start, ArgminProblem, LeastSquares};
+use super::progress::{ProgressHook, ProgressObserver};
 use super::{from_argmin_reason, SolverError, SolverReport, Termination};
+use argmin::core::observers::ObserverMode;
 use argmin::core::{
-    Error, Executor, IterState, Jacobian, Operator, Problem, State, TerminationReason,
-    TerminationStatus, KV,
+    Error, Executor, IterState, Operator, Problem, State, TerminationReason, TerminationStatus, KV,
 };
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use serde::{Deserialize, Serialize};
+use std::time::Instant;
 
 /// argmin state used by [`LevenbergMarquardt`]: parameters, gradient and residuals as
-/// `Vec<f64>`, Jacobian as `faer::Mat<f64>`, no Hessian, `f64` cost.
+/// `Vec<f64>`, no Hessian, `f64` cost (the Jacobian slot, typed `faer::Mat<f64>`, is unused).
 pub type LmState = IterState<Vec<f64>, Vec<f64>, Mat<f64>, (), Vec<f64>, f64>;
 
 /// Damped rejections within one iteration before giving up. With Nielsen's doubling of `ν`,
@@ -112,8 +116,10 @@ pub enum Scaling {
     Marquardt,
 }
 
-/// Options of [`LevenbergMarquardt`].
+/// Options of [`LevenbergMarquardt`]. Deserialization validates them
+/// ([`validate`](LmOptions::validate)).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawLmOptions")]
 pub struct LmOptions {
     /// Maximum number of iterations (accepted steps). Default 500.
     pub max_iters: u64,
@@ -129,6 +135,49 @@ pub struct LmOptions {
     pub initial_lambda: f64,
     /// The damping matrix. Default [`Scaling::Marquardt`].
     pub scaling: Scaling,
+    /// Wall-clock budget in seconds: the run stops with [`Termination::TimeLimit`] at the first
+    /// iteration boundary (or damping retry) after it is spent. Default 600; `f64::INFINITY`
+    /// for none.
+    pub max_seconds: f64,
+}
+
+/// [`LmOptions::max_seconds`] by default: far beyond any fit this crate's criteria need on
+/// records of up to 10⁷ samples, short enough that a runaway fit ends on its own.
+const DEFAULT_MAX_SECONDS: f64 = 600.0;
+
+fn default_max_seconds() -> f64 {
+    DEFAULT_MAX_SECONDS
+}
+
+/// [`LmOptions`] as read, before validation.
+#[derive(Deserialize)]
+struct RawLmOptions {
+    max_iters: u64,
+    xtol: f64,
+    ftol: f64,
+    gtol: f64,
+    initial_lambda: f64,
+    scaling: Scaling,
+    #[serde(default = "default_max_seconds")]
+    max_seconds: f64,
+}
+
+impl TryFrom<RawLmOptions> for LmOptions {
+    type Error = SolverError;
+
+    fn try_from(raw: RawLmOptions) -> Result<Self, SolverError> {
+        let options = LmOptions {
+            max_iters: raw.max_iters,
+            xtol: raw.xtol,
+            ftol: raw.ftol,
+            gtol: raw.gtol,
+            initial_lambda: raw.initial_lambda,
+            scaling: raw.scaling,
+            max_seconds: raw.max_seconds,
+        };
+        options.validate()?;
+        Ok(options)
+    }
 }
 
 impl Default for LmOptions {
@@ -140,6 +189,7 @@ impl Default for LmOptions {
             gtol: 1e-10,
             initial_lambda: 1e-3,
             scaling: Scaling::Marquardt,
+            max_seconds: DEFAULT_MAX_SECONDS,
         }
     }
 }
@@ -155,6 +205,12 @@ impl LmOptions {
         check_option("xtol", self.xtol, tol(self.xtol), "must be finite and >= 0")?;
         check_option("ftol", self.ftol, tol(self.ftol), "must be finite and >= 0")?;
         check_option("gtol", self.gtol, tol(self.gtol), "must be finite and >= 0")?;
+        check_option(
+            "max_seconds",
+            self.max_seconds,
+            self.max_seconds >= 0.0,
+            "must be >= 0 (infinity for no limit)",
+        )?;
         check_option(
             "initial_lambda",
             self.initial_lambda,
@@ -181,6 +237,10 @@ pub struct LevenbergMarquardt {
     jtj: Mat<f64>,
     /// Why the run stopped, once it has.
     stop: Option<Termination>,
+    /// When the run started (set by `init`).
+    started: Option<Instant>,
+    /// Receives the cost after every iteration, when set.
+    progress: Option<ProgressHook>,
 }
 
 impl Default for LevenbergMarquardt {
@@ -199,6 +259,8 @@ impl LevenbergMarquardt {
             diag: Vec::new(),
             jtj: Mat::zeros(0, 0),
             stop: None,
+            started: None,
+            progress: None,
         }
     }
 
@@ -244,6 +306,27 @@ impl LevenbergMarquardt {
         self
     }
 
+    /// Sets [`LmOptions::max_seconds`].
+    #[must_use]
+    pub fn with_max_seconds(mut self, max_seconds: f64) -> Self {
+        self.options.max_seconds = max_seconds;
+        self
+    }
+
+    /// Reports the iteration and cost to `hook` after the start and after every iteration of
+    /// [`minimize`](super::Solver::minimize) (under argmin's executor, attach an observer).
+    #[must_use]
+    pub fn with_progress(mut self, hook: ProgressHook) -> Self {
+        self.progress = Some(hook);
+        self
+    }
+
+    /// Whether the wall-clock budget is spent.
+    fn out_of_time(&self) -> bool {
+        self.started
+            .is_some_and(|t| t.elapsed().as_secs_f64() >= self.options.max_seconds)
+    }
+
     /// The options.
     pub fn options(&self) -> &LmOptions {
         &self.options
@@ -280,8 +363,8 @@ impl LevenbergMarquardt {
     }
 
     /// Stores `JᵀJ` and updates `D` at a new point.
-    fn set_jacobian(&mut self, j: &Mat<f64>) {
-        self.jtj = super::problem::gram(j);
+    fn set_gram(&mut self, gram: Mat<f64>) {
+        self.jtj = gram;
         let n = self.jtj.nrows();
         let diag = (0..n).map(|i| self.jtj[(i, i)]);
         self.diag = match self.options.scaling {
@@ -320,14 +403,24 @@ impl LevenbergMarquardt {
     }
 }
 
+/// The problem's normal equations at `x` with residuals `r`, counted by argmin.
+fn normal_equations<O: NormalEquationsOperator<Param = Vec<f64>>>(
+    problem: &mut Problem<O>,
+    x: &O::Param,
+    r: &[f64],
+) -> Result<NormalEquations, Error> {
+    let ne = problem.problem("normal_equations_count", |p| p.normal_equations(x, r))?;
+    ne.check_shape(x.len())?;
+    Ok(ne)
+}
+
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 impl<O> argmin::core::Solver<O, LmState> for LevenbergMarquardt
 where
-    O: Operator<Param = Vec<f64>, Output = Vec<f64>>
-        + Jacobian<Param = Vec<f64>, Jacobian = Mat<f64>>,
+    O: Operator<Param = Vec<f64>, Output = Vec<f64>> + NormalEquationsOperator<Param = Vec<f64>>,
 {
     fn name(&self) -> &str {
         "Levenberg-Marquardt"
@@ -340,6 +433,7 @@ where
     ) -> Result<(LmState, Option<KV>), Error> {
         self.options.validate()?;
         self.stop = None;
+        self.started = Some(Instant::now());
         self.diag = Vec::new();
         let x = state.get_param().ok_or(SolverError::MissingStart)?.clone();
         if x.is_empty() {
@@ -366,13 +460,12 @@ where
             )
             .into());
         }
-        let j = problem.jacobian(&x)?;
-        check_jacobian_shape(&j, r.len(), x.len())?;
-        if let Some((row, col, value)) = first_non_finite_entry(&j) {
-            return Err(SolverError::NonFiniteJacobian { row, col, value }.into());
+        let ne = normal_equations(problem, &x, &r)?;
+        if let Some((what, index, value)) = ne.first_non_finite() {
+            return Err(SolverError::NonFiniteNormalEquations { what, index, value }.into());
         }
-        self.set_jacobian(&j);
-        let g = jt_r(&j, &r);
+        let NormalEquations { gram, gradient: g } = ne;
+        self.set_gram(gram);
         self.nu = 2.0;
         self.mu = match self.options.scaling {
             Scaling::Identity => {
@@ -385,15 +478,7 @@ where
             self.stop = Some(Termination::SmallGradient);
         }
         let kv = self.kv();
-        Ok((
-            state
-                .param(x)
-                .cost(cost)
-                .residuals(r)
-                .jacobian(j)
-                .gradient(g),
-            kv,
-        ))
+        Ok((state.param(x).cost(cost).residuals(r).gradient(g), kv))
     }
 
     fn next_iter(
@@ -423,6 +508,10 @@ where
         let mut last_rejection_non_finite = false;
 
         for _ in 0..MAX_REJECTIONS {
+            if self.out_of_time() {
+                self.stop = Some(Termination::TimeLimit);
+                return Ok((state, self.kv()));
+            }
             if !self.mu.is_finite() {
                 self.stop = Some(if last_rejection_non_finite {
                     Termination::NonFinite
@@ -472,15 +561,17 @@ where
                 self.raise();
                 continue;
             }
-            let j_new = problem.jacobian(&x_new)?;
-            check_jacobian_shape(&j_new, m, x.len())?;
-            if first_non_finite_entry(&j_new).is_some() {
+            let ne = normal_equations(problem, &x_new, &r_new)?;
+            if !ne.is_finite() {
                 last_rejection_non_finite = true;
                 self.raise();
                 continue;
             }
-            self.set_jacobian(&j_new);
-            let g_new = jt_r(&j_new, &r_new);
+            let NormalEquations {
+                gram,
+                gradient: g_new,
+            } = ne;
+            self.set_gram(gram);
             self.mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
             self.nu = 2.0;
             let ftol = self.options.ftol;
@@ -490,15 +581,15 @@ where
                 self.stop = Some(Termination::SmallGradient);
             }
             let kv = self.kv();
-            return Ok((
-                state
-                    .param(x_new)
-                    .cost(cost_new)
-                    .residuals(r_new)
-                    .jacobian(j_new)
-                    .gradient(g_new),
-                kv,
-            ));
+            let mut state = state
+                .param(x_new)
+                .cost(cost_new)
+                .residuals(r_new)
+                .gradient(g_new);
+            // The previous residuals are never read again: on a long record they are as large
+            // as the data.
+            drop(state.take_prev_residuals());
+            return Ok((state, kv));
         }
         self.stop = Some(Termination::Other(format!(
             "no acceptable step after {MAX_REJECTIONS} damping increases"
@@ -509,6 +600,9 @@ where
     fn terminate(&mut self, state: &LmState) -> TerminationStatus {
         if self.stop.is_none() && state.get_iter() >= self.options.max_iters {
             self.stop = Some(Termination::MaxIterations);
+        }
+        if self.stop.is_none() && self.out_of_time() {
+            self.stop = Some(Termination::TimeLimit);
         }
         match &self.stop {
             None => TerminationStatus::NotTerminated,
@@ -531,7 +625,7 @@ impl super::Solver for LevenbergMarquardt {
     ) -> Result<SolverReport, SolverError> {
         self.options.validate()?;
         validate_start(problem, start)?;
-        let result = Executor::new(
+        let mut executor = Executor::new(
             ArgminProblem::new(problem),
             LevenbergMarquardt::new(self.options.clone()),
         )
@@ -540,9 +634,17 @@ impl super::Solver for LevenbergMarquardt {
                 .param(start.to_vec())
                 .max_iters(self.options.max_iters)
         })
-        .ctrlc(false)
-        .run()
-        .map_err(SolverError::from_argmin)?;
+        .ctrlc(false);
+        if let Some(hook) = &self.progress {
+            executor = executor.add_observer(
+                ProgressObserver {
+                    hook: hook.clone(),
+                    started: Instant::now(),
+                },
+                ObserverMode::Always,
+            );
+        }
+        let result = executor.run().map_err(SolverError::from_argmin)?;
         let mut state = result.state;
         let termination = result.solver.stop.clone().unwrap_or_else(|| {
             from_argmin_reason(&state.termination_status, Termination::SmallStep)

@@ -58,7 +58,9 @@ mod gauss_newton;
 pub mod lm;
 mod multistart;
 mod nelder_mead;
+mod normal;
 pub(crate) mod problem;
+mod progress;
 mod transform;
 
 pub use error::SolverError;
@@ -66,7 +68,10 @@ pub use gauss_newton::GaussNewtonLineSearch;
 pub use lm::{LevenbergMarquardt, LmOptions, Scaling};
 pub use multistart::MultiStart;
 pub use nelder_mead::NelderMead;
+pub(crate) use normal::{dot, gram};
+pub use normal::{NormalEquations, NormalEquationsOperator};
 pub use problem::{fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, DEFAULT_FD_STEP};
+pub use progress::{Progress, ProgressHook};
 pub use transform::{Transform, Transformed};
 
 /// A minimiser of `V(θ) = ½ Σ rᵢ(θ)²`.
@@ -126,6 +131,15 @@ pub enum Termination {
     SmallGradient,
     /// The iteration limit was reached before any convergence test held.
     MaxIterations,
+    /// The wall-clock budget was spent before any convergence test held.
+    TimeLimit,
+    /// Converged with the parameters at these indices on the boundary of their domain (a
+    /// jitter width at 0: the data show no detectable jitter); the others met a convergence
+    /// test with those held there. Set by [`estimate`](crate::estimate).
+    AtBound {
+        /// Indices (into the free parameter vector) of the parameters at their bound.
+        params: Vec<usize>,
+    },
     /// The solver could not leave the current point because the residuals (or the Jacobian)
     /// are not finite at every nearby trial point.
     NonFinite,
@@ -141,11 +155,15 @@ pub enum Termination {
 }
 
 impl Termination {
-    /// Whether this reason is a convergence test (small step, cost change or gradient).
+    /// Whether this reason is a convergence test (small step, cost change or gradient), in the
+    /// interior or at a bound.
     pub fn is_convergence(&self) -> bool {
         matches!(
             self,
-            Termination::SmallStep | Termination::SmallCostChange | Termination::SmallGradient
+            Termination::SmallStep
+                | Termination::SmallCostChange
+                | Termination::SmallGradient
+                | Termination::AtBound { .. }
         )
     }
 }
@@ -157,6 +175,13 @@ impl fmt::Display for Termination {
             Termination::SmallCostChange => f.write_str("small relative cost change"),
             Termination::SmallGradient => f.write_str("small gradient"),
             Termination::MaxIterations => f.write_str("maximum number of iterations reached"),
+            Termination::TimeLimit => f.write_str("wall-clock budget spent"),
+            Termination::AtBound { params } => {
+                write!(
+                    f,
+                    "converged with parameter(s) {params:?} at the bound of their domain"
+                )
+            }
             Termination::NonFinite => {
                 f.write_str("residuals or Jacobian not finite at every nearby trial point")
             }

@@ -1,5 +1,6 @@
 //! The least-squares problem trait, finite differences, and adapters to argmin's problem traits.
 
+use super::normal::{jt_r, NormalEquations, NormalEquationsOperator};
 use super::SolverError;
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
 use faer::Mat;
@@ -42,6 +43,25 @@ pub trait LeastSquares: Send + Sync {
     fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
         fd_jacobian(self, theta, DEFAULT_FD_STEP)
     }
+
+    /// `JᵀJ` and `Jᵀr` at `theta`, where `residuals` are the residuals at `theta`.
+    ///
+    /// Defaults to forming them from [`jacobian`](Self::jacobian). Override it when the
+    /// products can be accumulated without storing the `m × n` Jacobian: the
+    /// [Levenberg–Marquardt](super::LevenbergMarquardt) solver only asks for these, so its
+    /// memory then stays flat in the number of residuals.
+    ///
+    /// # Errors
+    ///
+    /// Those of [`jacobian`](Self::jacobian), a Jacobian of the wrong shape, and
+    /// [`SolverError::ResidualLength`] if `residuals` has the wrong length.
+    fn normal_equations(
+        &self,
+        theta: &[f64],
+        residuals: &[f64],
+    ) -> Result<NormalEquations, SolverError> {
+        NormalEquations::from_jacobian(&checked_jacobian(self, theta)?, residuals)
+    }
 }
 
 impl<P: LeastSquares + ?Sized> LeastSquares for &P {
@@ -56,6 +76,13 @@ impl<P: LeastSquares + ?Sized> LeastSquares for &P {
     }
     fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
         (**self).jacobian(theta)
+    }
+    fn normal_equations(
+        &self,
+        theta: &[f64],
+        residuals: &[f64],
+    ) -> Result<NormalEquations, SolverError> {
+        (**self).normal_equations(theta, residuals)
     }
 }
 
@@ -222,54 +249,6 @@ pub(crate) fn half_sum_sq(r: &[f64]) -> f64 {
     0.5 * r.iter().map(|x| x * x).sum::<f64>()
 }
 
-/// Column `c` of `j` as a slice (a `Mat` stores its columns contiguously).
-fn column(j: &Mat<f64>, c: usize) -> &[f64] {
-    j.col(c)
-        .try_as_col_major()
-        .map_or(&[][..], |col| col.as_slice())
-}
-
-/// `Σ a_i b_i`.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// `Jᵀ r` (the gradient of `½‖r‖²`); `j` must have `r.len()` rows.
-///
-/// Plain sequential dot products rather than faer's product: with a handful of columns and up
-/// to millions of rows the parallel kernel spends its time in barriers, and a fixed summation
-/// order keeps Monte Carlo runs bit-identical whatever the thread count.
-pub(crate) fn jt_r(j: &Mat<f64>, r: &[f64]) -> Vec<f64> {
-    (0..j.ncols()).map(|c| dot(column(j, c), r)).collect()
-}
-
-/// `JᵀJ`, sequential for the reasons given at [`jt_r`].
-pub(crate) fn gram(j: &Mat<f64>) -> Mat<f64> {
-    let p = j.ncols();
-    let mut g = Mat::zeros(p, p);
-    for a in 0..p {
-        for b in 0..=a {
-            let v = dot(column(j, a), column(j, b));
-            g[(a, b)] = v;
-            g[(b, a)] = v;
-        }
-    }
-    g
-}
-
-/// A Jacobian entry that is not finite, if any.
-pub(crate) fn first_non_finite_entry(j: &Mat<f64>) -> Option<(usize, usize, f64)> {
-    for c in 0..j.ncols() {
-        for r in 0..j.nrows() {
-            let v = j[(r, c)];
-            if !v.is_finite() {
-                return Some((r, c, v));
-            }
-        }
-    }
-    None
-}
-
 /// Exposes a [`LeastSquares`] problem through argmin's problem traits with `Vec<f64>`
 /// parameters, so that argmin's solvers (and [`lm::LevenbergMarquardt`](super::lm)) run on it.
 ///
@@ -279,6 +258,7 @@ pub(crate) fn first_non_finite_entry(j: &Mat<f64>) -> Option<(usize, usize, f64)
 /// | [`Jacobian`]     | `Vec<f64>` | `faer::Mat<f64>`, residuals × parameters  |
 /// | [`CostFunction`] | `Vec<f64>` | `½ Σ rᵢ²`                                 |
 /// | [`Gradient`]     | `Vec<f64>` | `Jᵀ r`                                    |
+/// | [`NormalEquationsOperator`] | `Vec<f64>` | `JᵀJ` and `Jᵀ r` ([`NormalEquations`]) |
 ///
 /// Lengths and shapes are checked; violations surface as [`SolverError`]s inside argmin's
 /// error, recoverable with `err.downcast::<SolverError>()`. Pass `&problem` to borrow.
@@ -332,6 +312,29 @@ impl<P: LeastSquares> Jacobian for ArgminProblem<P> {
     fn jacobian(&self, param: &Vec<f64>) -> Result<Mat<f64>, Error> {
         self.check_len(param)?;
         Ok(checked_jacobian(&self.problem, param)?)
+    }
+}
+
+impl<P: LeastSquares> NormalEquationsOperator for ArgminProblem<P> {
+    type Param = Vec<f64>;
+
+    fn normal_equations(
+        &self,
+        param: &Vec<f64>,
+        residuals: &[f64],
+    ) -> Result<NormalEquations, Error> {
+        self.check_len(param)?;
+        let expected = self.problem.num_residuals();
+        if residuals.len() != expected {
+            return Err(SolverError::ResidualLength {
+                expected,
+                got: residuals.len(),
+            }
+            .into());
+        }
+        let ne = self.problem.normal_equations(param, residuals)?;
+        ne.check_shape(param.len())?;
+        Ok(ne)
     }
 }
 

@@ -7,8 +7,9 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// How an external (constrained) parameter `θ` is written in terms of an internal,
-/// unconstrained `φ ∈ ℝ`.
+/// unconstrained `φ ∈ ℝ`. Deserialization rejects `Bounded` without finite `lo < hi`.
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[serde(try_from = "RawTransform")]
 pub enum Transform {
     /// No constraint: `θ = φ`.
     #[default]
@@ -24,6 +25,34 @@ pub enum Transform {
         /// Upper bound (finite, `> lo`).
         hi: f64,
     },
+}
+
+/// [`Transform`] as read, before validation.
+#[derive(Deserialize)]
+enum RawTransform {
+    Free,
+    Positive,
+    Negative,
+    Bounded { lo: f64, hi: f64 },
+}
+
+impl TryFrom<RawTransform> for Transform {
+    type Error = SolverError;
+
+    fn try_from(raw: RawTransform) -> Result<Self, SolverError> {
+        Ok(match raw {
+            RawTransform::Free => Transform::Free,
+            RawTransform::Positive => Transform::Positive,
+            RawTransform::Negative => Transform::Negative,
+            RawTransform::Bounded { lo, hi } => {
+                let t = Transform::Bounded { lo, hi };
+                if !t.is_valid() {
+                    return Err(SolverError::InvalidBounds { index: 0, lo, hi });
+                }
+                t
+            }
+        })
+    }
 }
 
 /// Logistic function, without overflow for either sign of `x`.
