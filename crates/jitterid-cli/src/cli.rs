@@ -68,6 +68,10 @@ pub struct BudgetArgs {
     /// Iteration limit of every fit (overrides [estimate] max_iterations).
     #[arg(long, value_name = "N")]
     pub max_iterations: Option<u64>,
+    /// Wall-clock budget of every fit in seconds [default: 600]; a fit that spends it stops,
+    /// not converged, with the reason (Levenberg–Marquardt and maximum likelihood).
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
     /// Exit 0 even when the fit did not converge (montecarlo, merge: when no fit converged);
     /// by default that exits 1.
     #[arg(long)]
@@ -171,6 +175,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             plot: a.plot,
             accept_unconverged: a.budget.accept_unconverged,
             max_iterations: a.budget.max_iterations,
+            time_limit: a.budget.time_limit,
         }),
         Command::Montecarlo(a) => commands::montecarlo(&MonteCarloOptions {
             experiment: a.experiment,
@@ -184,6 +189,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             out: a.out,
             accept_unconverged: a.budget.accept_unconverged,
             max_iterations: a.budget.max_iterations,
+            time_limit: a.budget.time_limit,
         }),
         Command::Merge(a) => {
             crate::merge::merge(&a.shards, a.json, a.out.as_deref(), a.accept_unconverged)

@@ -143,6 +143,8 @@ pub struct FitOptions {
     pub accept_unconverged: bool,
     /// Iteration limit (overrides `[estimate] max_iterations`).
     pub max_iterations: Option<u64>,
+    /// Wall-clock budget of the fit in seconds.
+    pub time_limit: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -207,9 +209,22 @@ fn fmt_num(x: f64) -> String {
     }
 }
 
-/// The experiment of `path` with the command line's iteration limit, if one is given.
-fn read_experiment(path: &Path, max_iterations: Option<u64>) -> CliResult<Experiment> {
+/// The experiment of `path` with the command line's iteration and wall-clock budgets, where
+/// given.
+fn read_experiment(
+    path: &Path,
+    max_iterations: Option<u64>,
+    time_limit: Option<f64>,
+) -> CliResult<Experiment> {
     let mut exp = experiment::read(path)?;
+    if let Some(t) = time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(cli_err!(
+                "--time-limit: expected a number of seconds >= 0, found {t}"
+            ));
+        }
+        exp.estimate.max_seconds = Some(t);
+    }
     if let Some(n) = max_iterations {
         if n == 0 {
             return Err(cli_err!(
@@ -224,7 +239,7 @@ fn read_experiment(path: &Path, max_iterations: Option<u64>) -> CliResult<Experi
 /// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
 /// not converge (unless `accept_unconverged`).
 pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
-    let exp = read_experiment(&o.experiment, o.max_iterations)?;
+    let exp = read_experiment(&o.experiment, o.max_iterations, o.time_limit)?;
     let method = o.method.unwrap_or(exp.estimate.method);
     fitting::check_method(&exp, method, o.method.is_some())?;
     let table = read_data(&exp, &o.data)?;
@@ -425,6 +440,8 @@ pub struct MonteCarloOptions {
     pub accept_unconverged: bool,
     /// Iteration limit of every fit (overrides `[estimate] max_iterations`).
     pub max_iterations: Option<u64>,
+    /// Wall-clock budget of every fit in seconds.
+    pub time_limit: Option<f64>,
 }
 
 /// One parameter's Monte Carlo summary.
@@ -668,7 +685,7 @@ fn mc_table(j: &McJson) -> String {
 /// `jitterid montecarlo`: the text to print (empty if the JSON is written to `--out`), and exit
 /// status [`Status::NotConverged`] when no fit converged (unless `accept_unconverged`).
 pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
-    let exp = read_experiment(&o.experiment, o.max_iterations)?;
+    let exp = read_experiment(&o.experiment, o.max_iterations, o.time_limit)?;
     let method = o.method.unwrap_or(exp.estimate.method);
     fitting::check_method(&exp, method, o.method.is_some())?;
     if o.runs == 0 || o.runs > MAX_RUNS {

@@ -148,6 +148,9 @@ pub struct EstimateSpec {
     pub perturb: f64,
     /// Iteration limit of the solver (its default if `None`).
     pub max_iterations: Option<u64>,
+    /// Wall-clock budget of each fit in seconds (the solver's default if `None`); set from the
+    /// command line.
+    pub max_seconds: Option<f64>,
 }
 
 /// A validated experiment.
@@ -697,6 +700,7 @@ pub fn parse(file: &str, text: &str, dir: &Path) -> CliResult<Experiment> {
             multistart_radius: 0.5,
             perturb: 0.2,
             max_iterations: None,
+            max_seconds: None,
         },
     };
     Ok(Experiment {
@@ -1384,6 +1388,7 @@ fn parse_estimate(cx: &Ctx, r: &RawEstimate, grid: &SampleGrid) -> CliResult<Est
         multistart_radius,
         perturb,
         max_iterations,
+        max_seconds: None,
     })
 }
 

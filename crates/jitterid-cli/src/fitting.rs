@@ -175,6 +175,12 @@ pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
             if let Some(n) = e.max_iterations {
                 s = s.with_max_iters(n);
             }
+            if let Some(t) = e.max_seconds {
+                s = s.with_max_seconds(t);
+            }
+            if let Some(hook) = crate::progress::active_fit_hook() {
+                s = s.with_progress(hook);
+            }
             AnySolver::Lm(s)
         }
         SolverKind::GaussNewton => {
@@ -470,8 +476,8 @@ fn fit_ml(
     covariance: bool,
 ) -> Result<Raw, String> {
     use jitterid::estimate::ml::{
-        ml_estimate, ml_profile_uniform_sum, ExactMl, LikelihoodCriterion, MlEstimate, MlOptions,
-        QuasiMl,
+        ml_estimate, ml_profile_uniform_sum, Bfgs, ExactMl, LikelihoodCriterion, MlEstimate,
+        MlOptions, MlSolver, QuasiMl,
     };
     fn go<C: LikelihoodCriterion>(
         exp: &Experiment,
@@ -502,6 +508,15 @@ fn fit_ml(
     }
     let opts = MlOptions {
         covariance,
+        // A wall-clock budget other than the default is BFGS's (the automatic choice would
+        // take Brent's method, without a budget, for a single parameter).
+        solver: match exp.estimate.max_seconds {
+            Some(max_seconds) => MlSolver::Bfgs(Bfgs {
+                max_seconds,
+                ..Bfgs::default()
+            }),
+            None => MlSolver::default(),
+        },
         ..MlOptions::default()
     };
     let (e, n, base) = if s.noise.is_white() {

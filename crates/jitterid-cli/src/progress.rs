@@ -1,9 +1,10 @@
 //! Progress on stderr, drawn only when stderr is a terminal: a bar for Monte Carlo runs, the
 //! elapsed time of a single long fit.
 
+use jitterid::estimate::solver::{Progress as SolverProgress, ProgressHook};
 use std::io::{IsTerminal, Write};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{mpsc, Mutex};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// Counts finished realisations and redraws a bar at most ten times a second.
@@ -76,8 +77,26 @@ impl Progress {
     }
 }
 
-/// The elapsed time of one long computation (a fit), drawn on stderr from one second on and
-/// only when stderr is a terminal; the line is cleared when the computation ends.
+/// The latest iteration and cost the solver of the running fit reported.
+type Latest = Arc<Mutex<Option<SolverProgress>>>;
+
+/// Where the solver of the one fit a [`Ticker`] watches reports to (none when no ticker runs,
+/// so the many fits of a Monte Carlo study report nowhere).
+static ACTIVE: Mutex<Option<Latest>> = Mutex::new(None);
+
+/// A hook for the solver of the fit a [`Ticker`] is showing, if one is.
+pub fn active_fit_hook() -> Option<ProgressHook> {
+    let latest = ACTIVE.lock().ok()?.clone()?;
+    Some(ProgressHook::new(move |p| {
+        if let Ok(mut l) = latest.lock() {
+            *l = Some(*p);
+        }
+    }))
+}
+
+/// The elapsed time of one long computation (a fit), with the solver's iteration and cost when
+/// it reports them, drawn on stderr from one second on and only when stderr is a terminal; the
+/// line is cleared when the computation ends.
 #[derive(Debug)]
 pub struct Ticker {
     stop: Option<mpsc::Sender<()>>,
@@ -100,13 +119,20 @@ impl Ticker {
         }
         let (tx, rx) = mpsc::channel::<()>();
         let what = what.to_string();
+        let latest: Latest = Arc::new(Mutex::new(None));
+        if let Ok(mut active) = ACTIVE.lock() {
+            *active = Some(latest.clone());
+        }
         let handle = std::thread::spawn(move || {
             let start = Instant::now();
             if rx.recv_timeout(TICKER_DELAY) != Err(mpsc::RecvTimeoutError::Timeout) {
                 return;
             }
             let drawn = loop {
-                let line = format!("{what}: {:.1} s", start.elapsed().as_secs_f64());
+                let mut line = format!("{what}: {:.1} s", start.elapsed().as_secs_f64());
+                if let Some(p) = latest.lock().ok().and_then(|l| *l) {
+                    line.push_str(&format!(", iteration {}, cost {:.6e}", p.iteration, p.cost));
+                }
                 let mut err = std::io::stderr().lock();
                 let _ = write!(err, "\r{line}");
                 let _ = err.flush();
@@ -133,6 +159,9 @@ impl Drop for Ticker {
         self.stop.take();
         if let Some(h) = self.handle.take() {
             let _ = h.join();
+        }
+        if let Ok(mut active) = ACTIVE.lock() {
+            *active = None;
         }
     }
 }

@@ -611,3 +611,82 @@ fn simulate_never_writes_samples_that_are_not_numbers() {
     );
     assert_eq!(names_in(&dir), ["tiny-pole.toml"]);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Bounded work
+
+/// A budget of zero seconds is spent at the first check: the fit stops there and says why (the
+/// reason is asserted, never a duration).
+#[test]
+fn a_fit_that_spends_its_wall_clock_budget_says_so() {
+    let dir = scratch("time-limit");
+    let exp = small(&dir);
+    let data = dir.join("d.csv");
+    status(&["simulate", s(&exp), "--out", s(&data)], 0);
+    let fit = [
+        "fit",
+        s(&exp),
+        "--data",
+        s(&data),
+        "--json",
+        "--time-limit",
+        "0",
+    ];
+    let json: Value = serde_json::from_str(&status(&fit, 1)).unwrap();
+    assert_eq!(json["converged"], false);
+    assert_eq!(json["termination"], "wall-clock budget spent");
+    let mc = [
+        "montecarlo",
+        s(&exp),
+        "--runs",
+        "2",
+        "--json",
+        "--time-limit",
+        "0",
+    ];
+    let json: Value = serde_json::from_str(&status(&mc, 1)).unwrap();
+    assert_eq!(json["terminations"]["wall-clock budget spent"], 2);
+    for bad in ["--time-limit=-1", "--time-limit=inf", "--time-limit=NaN"] {
+        refused(
+            &["fit", s(&exp), "--data", s(&data), bad],
+            &["--time-limit", "seconds"],
+        );
+    }
+}
+
+/// Maximum likelihood with the system estimated on all-zero data used to run for minutes
+/// without a word; under a budget it ends with its reason.
+#[cfg(feature = "ml")]
+#[test]
+fn ml_on_all_zero_data_ends_with_its_reason() {
+    let dir = scratch("ml-zero");
+    let exp = small(&dir);
+    let data = dir.join("zero.csv");
+    status(&["simulate", s(&exp), "--out", s(&data)], 0);
+    let mut text = String::from("k,y\n");
+    for k in 0..64 {
+        text.push_str(&format!("{k},0\n"));
+    }
+    std::fs::write(&data, text).unwrap();
+    let o = run(&[
+        "fit",
+        s(&exp),
+        "--data",
+        s(&data),
+        "--method",
+        "ml",
+        "--json",
+        "--time-limit",
+        "0",
+    ]);
+    let (out, err) = (stdout(&o), stderr(&o));
+    match o.status.code() {
+        Some(1) => {
+            let json: Value = serde_json::from_str(&out).unwrap();
+            assert_eq!(json["converged"], false, "{json}");
+            assert!(!json["termination"].as_str().unwrap().is_empty(), "{json}");
+        }
+        Some(2) => assert_eq!(err.trim_end().lines().count(), 1, "{err}"),
+        other => panic!("exit {other:?}: {out} {err}"),
+    }
+}
