@@ -298,12 +298,6 @@ pub fn writes_through(path: &Path) -> bool {
     matches!(target_of(path, ""), Ok(Target::Stream(_)))
 }
 
-/// Writes one file as a set of one.
-pub fn write_file(path: &Path, contents: &[u8]) -> CliResult<()> {
-    let mut set = OutputSet::new();
-    set.file(path, contents);
-    set.commit()
-}
 
 #[cfg(test)]
 mod tests {
