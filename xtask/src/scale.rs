@@ -62,8 +62,8 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
         let data = FrequencyData::new(record.clone(), DirichletWindow, FrequencySet::dft(&grid))
             .map_err(|e| e.to_string())?;
         let reps = match n {
-            ..=20_000 => 7,
-            ..=1_000_000 => 3,
+            0..=20_000 => 7,
+            20_001..=1_000_000 => 3,
             _ => 1,
         };
         let problem = FitProblem {

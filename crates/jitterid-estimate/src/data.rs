@@ -2,11 +2,27 @@ use crate::EstimateError;
 use jitterid_signal::SampleGrid;
 
 /// A record of samples `y_k` requested at the instants of a [`SampleGrid`]: validated finite and
-/// of the grid's length.
+/// of the grid's length (also when read with serde).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "RawRecord")]
 pub struct Record {
     grid: SampleGrid,
     y: Vec<f64>,
+}
+
+/// A [`Record`] as read, before validation.
+#[derive(serde::Deserialize)]
+struct RawRecord {
+    grid: SampleGrid,
+    y: Vec<f64>,
+}
+
+impl TryFrom<RawRecord> for Record {
+    type Error = EstimateError;
+
+    fn try_from(raw: RawRecord) -> Result<Self, EstimateError> {
+        Record::new(raw.grid, raw.y)
+    }
 }
 
 impl Record {

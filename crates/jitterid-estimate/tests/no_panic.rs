@@ -138,6 +138,24 @@ proptest! {
 }
 
 #[test]
+fn a_record_is_validated_when_read() {
+    use jitterid_estimate::Record;
+    let round = Record::new(
+        jitterid_signal::SampleGrid::new(0.0, 1.0, 2).expect("grid"),
+        vec![1.0, 2.0],
+    )
+    .expect("record");
+    let back: Record =
+        serde_json::from_str(&serde_json::to_string(&round).expect("writes")).expect("reads");
+    assert_eq!(back, round);
+    // JSON has no non-finite numbers; the length is what a hand-edited file gets wrong.
+    let mut json = serde_json::to_value(&round).expect("writes");
+    json["y"] = serde_json::json!([1.0]);
+    let err = serde_json::from_value::<Record>(json.clone()).expect_err("one value, two instants");
+    assert!(err.to_string().contains('2'), "{err}");
+}
+
+#[test]
 fn invalid_solver_types_are_refused_when_read() {
     let bad = r#"{"max_iters":5,"xtol":-1.0,"ftol":1e-12,"gtol":1e-10,"initial_lambda":0.001,"scaling":"Marquardt"}"#;
     let err = serde_json::from_str::<LmOptions>(bad).expect_err("negative xtol");
