@@ -6,6 +6,7 @@
 
 use crate::commands::{self, FitOptions, MonteCarloOptions, Shard, SimulateOptions, DEFAULT_SEED};
 use crate::error::CliResult;
+use crate::exit::{Outcome, BAD_INPUT};
 use crate::experiment::Method;
 use clap::{Args, Parser, Subcommand};
 use std::ffi::OsString;
@@ -52,12 +53,29 @@ pub struct SimulateArgs {
     #[arg(long, default_value_t = 0)]
     pub run: u64,
     /// The CSV file to write (columns k, t, y and u; a random-binary input also goes to
-    /// <stem>.input.csv).
+    /// <stem>.input.csv). Both appear together or neither does; a device or FIFO (/dev/null) is
+    /// written through, a symbolic link is followed, a directory is refused.
     #[arg(long)]
     pub out: PathBuf,
     /// Also write the drawn jitter `tau` and measurement noise `v`.
     #[arg(long)]
     pub truth: bool,
+}
+
+/// Exit-status and budget options shared by `fit` and `montecarlo`.
+#[derive(Debug, Args)]
+pub struct BudgetArgs {
+    /// Iteration limit of every fit (overrides [estimate] max_iterations).
+    #[arg(long, value_name = "N")]
+    pub max_iterations: Option<u64>,
+    /// Wall-clock budget of every fit in seconds [default: 600]; a fit that spends it stops,
+    /// not converged, with the reason (Levenberg–Marquardt and maximum likelihood).
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Exit 0 even when the fit did not converge (montecarlo, merge: when no fit converged);
+    /// by default that exits 1.
+    #[arg(long)]
+    pub accept_unconverged: bool,
 }
 
 /// Arguments of `fit`.
@@ -81,6 +99,9 @@ pub struct FitArgs {
     /// Write SVG figures into this directory.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub budget: BudgetArgs,
 }
 
 /// Arguments of `montecarlo`.
@@ -109,9 +130,13 @@ pub struct MonteCarloArgs {
     /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml.
     #[arg(long, value_parser = parse_method)]
     pub method: Option<Method>,
-    /// Write the JSON to this file (atomically) instead of standard output.
+    /// Write the JSON to this file (atomically, together with the figures) instead of standard
+    /// output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub budget: BudgetArgs,
 }
 
 /// Arguments of `merge`.
@@ -126,9 +151,12 @@ pub struct MergeArgs {
     /// Write the JSON to this file (atomically) instead of standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Exit 0 even when no fit of the study converged; by default that exits 1.
+    #[arg(long)]
+    pub accept_unconverged: bool,
 }
 
-fn dispatch(cli: Cli) -> CliResult<String> {
+fn dispatch(cli: Cli) -> CliResult<Outcome> {
     match cli.command {
         Command::Simulate(a) => commands::simulate(&SimulateOptions {
             experiment: a.experiment,
@@ -137,7 +165,7 @@ fn dispatch(cli: Cli) -> CliResult<String> {
             out: a.out,
             truth: a.truth,
         })
-        .map(|s| s + "\n"),
+        .map(|s| Outcome::success(s + "\n")),
         Command::Fit(a) => commands::fit(&FitOptions {
             experiment: a.experiment,
             data: a.data,
@@ -145,6 +173,9 @@ fn dispatch(cli: Cli) -> CliResult<String> {
             method: a.method,
             json: a.json,
             plot: a.plot,
+            accept_unconverged: a.budget.accept_unconverged,
+            max_iterations: a.budget.max_iterations,
+            time_limit: a.budget.time_limit,
         }),
         Command::Montecarlo(a) => commands::montecarlo(&MonteCarloOptions {
             experiment: a.experiment,
@@ -156,12 +187,18 @@ fn dispatch(cli: Cli) -> CliResult<String> {
             shard: a.shard,
             method: a.method,
             out: a.out,
+            accept_unconverged: a.budget.accept_unconverged,
+            max_iterations: a.budget.max_iterations,
+            time_limit: a.budget.time_limit,
         }),
-        Command::Merge(a) => commands::merge(&a.shards, a.json, a.out.as_deref()),
+        Command::Merge(a) => {
+            crate::merge::merge(&a.shards, a.json, a.out.as_deref(), a.accept_unconverged)
+        }
     }
 }
 
-/// Runs the command line; returns the exit status (0, or 2 after a one-line error on stderr).
+/// Runs the command line; returns the exit status: 0, 1 when a fit did not converge (see
+/// [`Status`](crate::exit::Status)), or 2 after a one-line error on stderr.
 pub fn run<I, T>(args: I) -> ExitCode
 where
     I: IntoIterator<Item = T>,
@@ -179,7 +216,7 @@ where
             ) {
                 let _ = e.print();
                 return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
-                    ExitCode::from(2)
+                    ExitCode::from(BAD_INPUT)
                 } else {
                     ExitCode::SUCCESS
                 };
@@ -194,20 +231,25 @@ where
                 .collect::<Vec<_>>()
                 .join(" ");
             let first = first.strip_prefix("error: ").unwrap_or(&first).to_string();
-            eprintln!("error: {first} (see jitterid --help)");
-            return ExitCode::from(2);
+            eprintln!(
+                "{}",
+                commands::report(&crate::error::CliError::new(format!(
+                    "{first} (see jitterid --help)"
+                )))
+            );
+            return ExitCode::from(BAD_INPUT);
         }
     };
     match dispatch(cli) {
-        Ok(text) => {
+        Ok(outcome) => {
             let mut out = std::io::stdout().lock();
-            let _ = out.write_all(text.as_bytes());
+            let _ = out.write_all(outcome.text.as_bytes());
             let _ = out.flush();
-            ExitCode::SUCCESS
+            outcome.status.code()
         }
         Err(e) => {
             eprintln!("{}", commands::report(&e));
-            ExitCode::from(2)
+            ExitCode::from(BAD_INPUT)
         }
     }
 }

@@ -3,15 +3,18 @@
 use crate::cli_err;
 use crate::csvio::{self, Column};
 use crate::error::{CliError, CliResult};
+use crate::exit::{Outcome, Status};
 use crate::experiment::{self, Experiment, InputSpec, Method, Purpose};
+use crate::fingerprint::experiment_fingerprint;
 use crate::fitting::{self, Fit, Structure};
 use crate::inputs;
-use crate::output::{ensure_dir, write_atomic, Staged};
+use crate::output::{self, OutputSet};
 use crate::plots;
-use crate::progress::Progress;
+use crate::progress::{Progress, Ticker};
 use jitterid::estimate::montecarlo::{realization_rng, realization_seed, run as mc_run, Summary};
 use jitterid::signal::Input;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -57,6 +60,13 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
     let sim = fitting::simulate_record(&exp, &signal, &mut rng)?;
     let n = exp.grid.len();
+    if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
+        return Err(cli_err!(
+            "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
+            exp.file,
+            sim.y[k]
+        ));
+    }
     let k: Vec<usize> = (0..n).collect();
     let t: Vec<f64> = exp.grid.times().collect();
     let u: Option<Vec<f64>> = input
@@ -74,8 +84,8 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
         cols.push(Column::Real("tau", &sim.tau));
         cols.push(Column::Real("v", &sim.v));
     }
-    let mut staged = Staged::new();
-    staged.add(&o.out, csvio::format(&cols).as_bytes())?;
+    let mut outputs = OutputSet::new();
+    outputs.file(&o.out, csvio::format(&cols));
     let mut report = format!(
         "wrote {}: {n} samples ({})",
         o.out.display(),
@@ -87,22 +97,28 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
             .join(", ")
     );
     if let (InputSpec::RandomBinary(_), Some(Input::Piecewise(p))) = (&exp.input, &input) {
-        let side = input_side_file(&o.out);
-        let edges = p.edges();
-        let mut levels = p.levels().to_vec();
-        levels.push(0.0);
-        staged.add(
-            &side,
-            csvio::format(&[Column::Real("t", edges), Column::Real("u", &levels)]).as_bytes(),
-        )?;
-        let _ = write!(
-            report,
-            "; {}: the input's {} switch times and levels",
-            side.display(),
-            edges.len()
-        );
+        if output::writes_through(&o.out) {
+            report.push_str(
+                "; the input realisation is not written (a device or FIFO has no side file)",
+            );
+        } else {
+            let side = input_side_file(&o.out);
+            let edges = p.edges();
+            let mut levels = p.levels().to_vec();
+            levels.push(0.0);
+            outputs.file(
+                &side,
+                csvio::format(&[Column::Real("t", edges), Column::Real("u", &levels)]),
+            );
+            let _ = write!(
+                report,
+                "; {}: the input's {} switch times and levels",
+                side.display(),
+                edges.len()
+            );
+        }
     }
-    staged.commit()?;
+    outputs.commit()?;
     Ok(report)
 }
 
@@ -124,6 +140,12 @@ pub struct FitOptions {
     pub json: bool,
     /// Plot directory.
     pub plot: Option<PathBuf>,
+    /// Exit 0 even when the fit did not converge.
+    pub accept_unconverged: bool,
+    /// Iteration limit (overrides `[estimate] max_iterations`).
+    pub max_iterations: Option<u64>,
+    /// Wall-clock budget of the fit in seconds.
+    pub time_limit: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -188,9 +210,43 @@ fn fmt_num(x: f64) -> String {
     }
 }
 
-/// `jitterid fit`: returns the text to print.
-pub fn fit(o: &FitOptions) -> CliResult<String> {
-    let exp = experiment::read(&o.experiment, Purpose::Estimate(o.method))?;
+/// The experiment of `path` with the command line's iteration and wall-clock budgets, where
+/// given.
+fn read_experiment(
+    path: &Path,
+    purpose: Purpose,
+    max_iterations: Option<u64>,
+    time_limit: Option<f64>,
+) -> CliResult<Experiment> {
+    let mut exp = experiment::read(path, purpose)?;
+    if let Some(t) = time_limit {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(cli_err!(
+                "--time-limit: expected a number of seconds >= 0, found {t}"
+            ));
+        }
+        exp.estimate.max_seconds = Some(t);
+    }
+    if let Some(n) = max_iterations {
+        if n == 0 {
+            return Err(cli_err!(
+                "--max-iterations: expected at least 1 iteration, found 0"
+            ));
+        }
+        exp.estimate.max_iterations = Some(n);
+    }
+    Ok(exp)
+}
+
+/// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
+/// not converge (unless `accept_unconverged`).
+pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
+    let exp = read_experiment(
+        &o.experiment,
+        Purpose::Estimate(o.method),
+        o.max_iterations,
+        o.time_limit,
+    )?;
     let method = exp.estimate.method;
     let table = read_data(&exp, &o.data)?;
     let y = table.column("y")?.to_vec();
@@ -222,10 +278,12 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
             method.as_str()
         )
     };
+    let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let f: Fit = fitting::fit(&exp, &s, &record, method, 0, true).map_err(fit_err)?;
+    drop(ticker);
 
+    let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
-        ensure_dir(dir)?;
         // The naive LS fit of the system for comparison (when the system is estimated).
         let ls = if exp.system.estimate && method != Method::Ls {
             let mut ls_exp = exp.clone();
@@ -258,11 +316,12 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
             main: (main_label, &f.fitted),
             tau: table.optional("tau"),
         })?;
-        let mut staged = Staged::new();
+        let mut outputs = OutputSet::new();
+        outputs.dir(dir);
         for (name, svg) in figs {
-            staged.add(&dir.join(name), svg.as_bytes())?;
+            outputs.file(&dir.join(name), svg);
         }
-        staged.commit()?;
+        outputs.commit()?;
     }
 
     if o.json {
@@ -276,7 +335,10 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
             parameters: &f.params,
         };
         return serde_json::to_string_pretty(&j)
-            .map(|s| s + "\n")
+            .map(|text| Outcome {
+                text: text + "\n",
+                status,
+            })
             .map_err(|e| cli_err!("JSON: {e}"));
     }
     let mut out = String::new();
@@ -333,7 +395,7 @@ pub fn fit(o: &FitOptions) -> CliResult<String> {
             dir.display()
         );
     }
-    Ok(out)
+    Ok(Outcome { text: out, status })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -380,6 +442,12 @@ pub struct MonteCarloOptions {
     pub method: Option<Method>,
     /// Write the JSON to this file (atomically) instead of stdout.
     pub out: Option<PathBuf>,
+    /// Exit 0 even when no fit converged.
+    pub accept_unconverged: bool,
+    /// Iteration limit of every fit (overrides `[estimate] max_iterations`).
+    pub max_iterations: Option<u64>,
+    /// Wall-clock budget of every fit in seconds.
+    pub time_limit: Option<f64>,
 }
 
 /// One parameter's Monte Carlo summary.
@@ -407,6 +475,9 @@ pub struct Realization {
     pub run: u64,
     /// Whether the fit converged.
     pub converged: bool,
+    /// Why the fit stopped (or `failed: …` with the error when there was no fit).
+    #[serde(default)]
+    pub termination: String,
     /// Reported estimates (null where not finite).
     pub values: Vec<Option<f64>>,
 }
@@ -435,12 +506,21 @@ pub struct McJson {
     pub runs: u64,
     /// Runs that converged.
     pub converged: u64,
+    /// How many runs ended for each reason (the solver's termination, or `failed: …`).
+    #[serde(default)]
+    pub terminations: BTreeMap<String, u64>,
     /// Wall time in seconds (summed over shards after a merge).
     pub seconds: f64,
     /// Master seed.
     pub seed: u64,
-    /// Experiment file.
+    /// Experiment file, as given (for people; the fingerprint identifies it).
     pub experiment: String,
+    /// The experiment's fingerprint by content.
+    #[serde(default)]
+    pub fingerprint: String,
+    /// The program and version that wrote the file.
+    #[serde(default)]
+    pub program: String,
     /// Per parameter.
     pub parameters: Vec<ParamSummary>,
     /// Present in shard files: which runs.
@@ -449,6 +529,20 @@ pub struct McJson {
     /// Present in shard files: every realisation's estimates, for `jitterid merge`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub realizations: Option<Vec<Realization>>,
+}
+
+/// The program and version written into every result (`jitterid 0.1.0`).
+pub fn program() -> String {
+    format!("jitterid {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// How many runs ended for each reason.
+pub fn terminations(runs: &[Realization]) -> BTreeMap<String, u64> {
+    let mut h = BTreeMap::new();
+    for r in runs {
+        *h.entry(r.termination.clone()).or_insert(0) += 1;
+    }
+    h
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -506,22 +600,15 @@ fn one_run(
     rng: &mut jitterid::rand::rngs::StdRng,
     keep: bool,
 ) -> RunOut {
-    let fail = || RunOut {
-        realization: Realization {
-            run: r,
-            converged: false,
-            values: vec![None; n],
-        },
-        fitted: None,
-    };
-    let mut go = || -> Option<Fit> {
-        let input = fitting::realize_input(exp, rng).ok()?;
-        let signal = fitting::signal_of(&exp.system.kind, input.as_ref()).ok()?;
-        let sim = fitting::simulate_record(exp, &signal, rng).ok()?;
-        let s = fitting::structure(exp, signal, method).ok()?;
+    let mut go = || -> Result<Fit, String> {
+        let text = |e: CliError| e.to_string();
+        let input = fitting::realize_input(exp, rng).map_err(text)?;
+        let signal = fitting::signal_of(&exp.system.kind, input.as_ref()).map_err(text)?;
+        let sim = fitting::simulate_record(exp, &signal, rng).map_err(text)?;
+        let s = fitting::structure(exp, signal, method).map_err(text)?;
         let start = fitting::perturb(&s.params(), exp.estimate.perturb, rng);
-        let s0 = s.with_params(&start).ok()?;
-        let record = fitting::record(&exp.grid, sim.y).ok()?;
+        let s0 = s.with_params(&start).map_err(|e| e.to_string())?;
+        let record = fitting::record(&exp.grid, sim.y).map_err(|e| e.to_string())?;
         fitting::fit(
             exp,
             &s0,
@@ -530,18 +617,26 @@ fn one_run(
             realization_seed(seed, r) ^ 0x6d73,
             exp.noise.estimate,
         )
-        .ok()
     };
     match go() {
-        Some(f) => RunOut {
+        Ok(f) => RunOut {
             realization: Realization {
                 run: r,
                 converged: f.converged,
+                termination: f.termination.clone(),
                 values: f.params.iter().map(|p| finite(p.estimate)).collect(),
             },
             fitted: keep.then_some(f.fitted),
         },
-        None => fail(),
+        Err(e) => RunOut {
+            realization: Realization {
+                run: r,
+                converged: false,
+                termination: format!("failed: {e}"),
+                values: vec![None; n],
+            },
+            fitted: None,
+        },
     }
 }
 
@@ -552,6 +647,12 @@ fn mc_table(j: &McJson) -> String {
         "Monte Carlo of {} with {}: {} runs (seed {}), {} converged, {:.2} s",
         j.experiment, j.method, j.runs, j.seed, j.converged, j.seconds
     );
+    let reasons: Vec<String> = j
+        .terminations
+        .iter()
+        .map(|(reason, count)| format!("{count} × {reason}"))
+        .collect();
+    let _ = writeln!(out, "terminations: {}", reasons.join("; "));
     if let Some(s) = &j.shard {
         let _ = writeln!(
             out,
@@ -587,9 +688,15 @@ fn mc_table(j: &McJson) -> String {
     out
 }
 
-/// `jitterid montecarlo`: returns the text to print (empty if written to `--out`).
-pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
-    let exp = experiment::read(&o.experiment, Purpose::Estimate(o.method))?;
+/// `jitterid montecarlo`: the text to print (empty if the JSON is written to `--out`), and exit
+/// status [`Status::NotConverged`] when no fit converged (unless `accept_unconverged`).
+pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
+    let exp = read_experiment(
+        &o.experiment,
+        Purpose::Estimate(o.method),
+        o.max_iterations,
+        o.time_limit,
+    )?;
     let method = exp.estimate.method;
     if o.runs == 0 || o.runs > MAX_RUNS {
         return Err(cli_err!(
@@ -645,9 +752,12 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
         method: method.as_str().to_string(),
         runs: end - first,
         converged,
+        terminations: terminations(&realizations),
         seconds,
         seed: o.seed,
         experiment: exp.file.clone(),
+        fingerprint: experiment_fingerprint(&exp),
+        program: program(),
         parameters,
         shard: sharded.then_some(ShardInfo {
             index: shard.index,
@@ -658,8 +768,8 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
         }),
         realizations: sharded.then_some(realizations.clone()),
     };
+    let mut outputs = OutputSet::new();
     if let Some(dir) = &o.plot {
-        ensure_dir(dir)?;
         let conv: Vec<Vec<f64>> = realizations
             .iter()
             .filter(|r| r.converged)
@@ -679,125 +789,40 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<String> {
             true_signal: &signal0,
             fitted,
         });
-        let mut staged = Staged::new();
+        outputs.dir(dir);
         for (name, svg) in figs {
-            staged.add(&dir.join(name), svg.as_bytes())?;
+            outputs.file(&dir.join(name), svg);
         }
-        staged.commit()?;
     }
-    emit(&j, o.json, o.out.as_deref())
+    let text = emit(&j, o.json, o.out.as_deref(), outputs)?;
+    Ok(Outcome {
+        text,
+        status: Status::of_convergence(converged > 0, o.accept_unconverged),
+    })
 }
 
-fn emit(j: &McJson, json: bool, out: Option<&Path>) -> CliResult<String> {
+/// Writes the JSON to `out` together with the other `outputs`; returns what to print.
+pub fn emit(
+    j: &McJson,
+    json: bool,
+    out: Option<&Path>,
+    mut outputs: OutputSet,
+) -> CliResult<String> {
     let text = serde_json::to_string_pretty(j).map_err(|e| cli_err!("JSON: {e}"))? + "\n";
-    match out {
+    let printed = match out {
         Some(path) => {
-            write_atomic(path, text.as_bytes())?;
-            Ok(if json { String::new() } else { mc_table(j) })
+            outputs.file(path, text);
+            if json {
+                String::new()
+            } else {
+                mc_table(j)
+            }
         }
-        None if json => Ok(text),
-        None => Ok(mc_table(j)),
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// merge
-
-/// `jitterid merge`: combines shard files into the result of the unsharded study.
-pub fn merge(files: &[PathBuf], json: bool, out: Option<&Path>) -> CliResult<String> {
-    let mut parts: Vec<(String, McJson)> = Vec::new();
-    for f in files {
-        let name = f.display().to_string();
-        csvio::check_regular_file(f, &name)?;
-        let text = std::fs::read_to_string(f)
-            .map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
-        let j: McJson = serde_json::from_str(&text).map_err(|e| {
-            cli_err!(
-                "{name}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}",
-                e.line()
-            )
-        })?;
-        parts.push((name, j));
-    }
-    let Some((first_name, first)) = parts.first() else {
-        return Err(cli_err!("merge: expected at least one shard file"));
+        None if json => text,
+        None => mc_table(j),
     };
-    let info = |name: &str, j: &McJson| -> CliResult<(ShardInfo, Vec<Realization>)> {
-        match (&j.shard, &j.realizations) {
-            (Some(s), Some(r)) => Ok((s.clone(), r.clone())),
-            _ => Err(cli_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json")),
-        }
-    };
-    let (s0, _) = info(first_name, first)?;
-    if s0.count > 1_000_000 || s0.runs_total > MAX_RUNS {
-        return Err(cli_err!(
-            "{first_name}: shard count {} or run total {} out of range",
-            s0.count,
-            s0.runs_total
-        ));
-    }
-    let mut all: Vec<Realization> = Vec::new();
-    let mut seconds = 0.0;
-    let mut seen = vec![false; s0.count as usize];
-    for (name, j) in &parts {
-        let (s, r) = info(name, j)?;
-        if j.experiment != first.experiment
-            || j.method != first.method
-            || j.seed != first.seed
-            || s.runs_total != s0.runs_total
-            || s.count != s0.count
-        {
-            return Err(cli_err!(
-                "{name}: belongs to another study than {first_name} (experiment, method, seed, runs and shard count must agree)"
-            ));
-        }
-        if j.parameters
-            .iter()
-            .map(|p| &p.name)
-            .ne(first.parameters.iter().map(|p| &p.name))
-        {
-            return Err(cli_err!(
-                "{name}: its parameters differ from those of {first_name}"
-            ));
-        }
-        let slot = seen
-            .get_mut(s.index as usize)
-            .ok_or_else(|| cli_err!("{name}: shard index {} out of range", s.index))?;
-        if *slot {
-            return Err(cli_err!(
-                "{name}: shard {}/{} given twice",
-                s.index,
-                s.count
-            ));
-        }
-        *slot = true;
-        seconds += j.seconds;
-        all.extend(r);
-    }
-    if let Some(missing) = seen.iter().position(|s| !s) {
-        return Err(cli_err!("merge: shard {missing}/{} is missing", s0.count));
-    }
-    all.sort_by_key(|r| r.run);
-    if all.iter().enumerate().any(|(i, r)| r.run != i as u64) || all.len() as u64 != s0.runs_total {
-        return Err(cli_err!(
-            "merge: the shards do not cover runs 0..{} exactly once",
-            s0.runs_total
-        ));
-    }
-    let names: Vec<String> = first.parameters.iter().map(|p| p.name.clone()).collect();
-    let truth: Vec<Option<f64>> = first.parameters.iter().map(|p| p.truth).collect();
-    let j = McJson {
-        method: first.method.clone(),
-        runs: s0.runs_total,
-        converged: all.iter().filter(|r| r.converged).count() as u64,
-        seconds,
-        seed: first.seed,
-        experiment: first.experiment.clone(),
-        parameters: summarize(&names, &truth, &all),
-        shard: None,
-        realizations: None,
-    };
-    emit(&j, json, out)
+    outputs.commit()?;
+    Ok(printed)
 }
 
 /// Converts a [`CliError`] from a command into the reported line.

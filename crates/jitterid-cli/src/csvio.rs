@@ -3,10 +3,13 @@
 //! The format: a header line of column names, then one line per row of numbers, all separated by
 //! commas. Blank lines and lines starting with `#` are skipped. Every cell must parse as a
 //! finite number (`1`, `-0.25`, `3e-4`); every row has as many cells as the header. There is no
-//! quoting (names may be wrapped in double quotes, which are removed).
+//! quoting (names may be wrapped in double quotes, which are removed). Lines end with LF, CR LF
+//! or a lone CR (old Mac files). Problems are named as `file:line:column:` (both 1-based, the
+//! column counted in characters to the start of the cell).
 
 use crate::cli_err;
 use crate::error::{CliError, CliResult};
+use std::collections::HashSet;
 use std::path::Path;
 
 /// A parsed CSV file: named numeric columns of equal length.
@@ -43,11 +46,7 @@ impl Table {
                 "{}:{}: header: expected a column named `{name}`, found {}",
                 self.name,
                 self.header_line,
-                self.columns
-                    .iter()
-                    .map(|c| format!("`{c}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                some_names(&self.columns)
             )),
         }
     }
@@ -66,6 +65,38 @@ fn clean_name(s: &str) -> &str {
         .trim()
 }
 
+/// The lines of `text`, ending at LF, CR LF or a lone CR.
+fn lines_of(text: &str) -> impl Iterator<Item = &str> {
+    text.split("\r\n").flat_map(|l| l.split(['\n', '\r']))
+}
+
+/// The cells of a line, each with its 1-based column (in characters) where it starts.
+fn cells_of(line: &str) -> Vec<(usize, &str)> {
+    let mut col = 1;
+    line.split(',')
+        .map(|cell| {
+            let start = col + cell.chars().take_while(|c| c.is_whitespace()).count();
+            col += cell.chars().count() + 1;
+            (start, cell)
+        })
+        .collect()
+}
+
+/// At most a few column names, for a message.
+fn some_names(columns: &[String]) -> String {
+    const SHOWN: usize = 8;
+    let mut s = columns
+        .iter()
+        .take(SHOWN)
+        .map(|c| shorten(c))
+        .collect::<Vec<_>>()
+        .join(",");
+    if columns.len() > SHOWN {
+        s.push_str(&format!(",… ({} more)", columns.len() - SHOWN));
+    }
+    s
+}
+
 fn shorten(s: &str) -> String {
     let mut out: String = s.chars().take(40).collect();
     if s.chars().count() > 40 {
@@ -77,10 +108,9 @@ fn shorten(s: &str) -> String {
 /// Parses CSV text; `name` is used in messages.
 pub fn parse(name: &str, text: &str) -> CliResult<Table> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = text
-        .split('\n')
+    let mut lines = lines_of(text)
         .enumerate()
-        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
+        .map(|(i, l)| (i + 1, l))
         .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
     let Some((header_line, header)) = lines.next() else {
         return Err(cli_err!(
@@ -88,23 +118,25 @@ pub fn parse(name: &str, text: &str) -> CliResult<Table> {
         ));
     };
     let mut columns: Vec<String> = Vec::new();
-    for (i, cell) in header.split(',').enumerate() {
+    // A set, so that a header of 200 000 names is checked in linear time.
+    let mut seen: HashSet<&str> = HashSet::new();
+    for (i, (col, cell)) in cells_of(header).into_iter().enumerate() {
         let c = clean_name(cell);
         if c.is_empty() {
             return Err(cli_err!(
-                "{name}:{header_line}: header: column {} has no name; expected a comma-separated list of names such as k,t,y",
+                "{name}:{header_line}:{col}: header: column {} has no name; expected a comma-separated list of names such as k,t,y",
                 i + 1
             ));
         }
         if c.parse::<f64>().is_ok() {
             return Err(cli_err!(
-                "{name}:{header_line}: header: expected column names, found the number `{}` (is the header line missing?)",
+                "{name}:{header_line}:{col}: header: expected column names, found the number `{}` (is the header line missing?)",
                 shorten(c)
             ));
         }
-        if columns.iter().any(|x| x == c) {
+        if !seen.insert(c) {
             return Err(cli_err!(
-                "{name}:{header_line}: header: column `{}` appears twice",
+                "{name}:{header_line}:{col}: header: column `{}` appears twice",
                 shorten(c)
             ));
         }
@@ -113,32 +145,36 @@ pub fn parse(name: &str, text: &str) -> CliResult<Table> {
     let mut values = vec![Vec::new(); columns.len()];
     let mut rows = Vec::new();
     for (line, text) in lines {
-        let cells: Vec<&str> = text.split(',').collect();
+        let cells = cells_of(text);
         if cells.len() != columns.len() {
+            // The column where the row goes wrong: its first extra cell, or its end.
+            let col = cells
+                .get(columns.len())
+                .map_or(text.chars().count() + 1, |(c, _)| *c);
             return Err(cli_err!(
-                "{name}:{line}: expected {} cells ({}), found {}",
+                "{name}:{line}:{col}: expected {} cells ({}), found {}",
                 columns.len(),
-                columns.join(","),
+                some_names(&columns),
                 cells.len()
             ));
         }
-        for (j, cell) in cells.iter().enumerate() {
+        for (j, (col, cell)) in cells.into_iter().enumerate() {
             let cell = cell.trim();
-            let column = &columns[j];
+            let column = shorten(&columns[j]);
             if cell.is_empty() {
                 return Err(cli_err!(
-                    "{name}:{line}: column `{column}`: expected a number, found an empty cell"
+                    "{name}:{line}:{col}: column `{column}`: expected a number, found an empty cell"
                 ));
             }
             let v: f64 = cell.parse().map_err(|_| {
                 cli_err!(
-                    "{name}:{line}: column `{column}`: expected a number, found `{}`",
+                    "{name}:{line}:{col}: column `{column}`: expected a number, found `{}`",
                     shorten(cell)
                 )
             })?;
             if !v.is_finite() {
                 return Err(cli_err!(
-                    "{name}:{line}: column `{column}`: expected a finite number, found `{}`",
+                    "{name}:{line}:{col}: column `{column}`: expected a finite number, found `{}`",
                     shorten(cell)
                 ));
             }
@@ -264,15 +300,23 @@ mod tests {
     #[test]
     fn errors_name_line_and_column() {
         let e = parse("d.csv", "k,y\n0,1\n1,abc\n").unwrap_err();
-        assert!(e.message().starts_with("d.csv:3: column `y`"), "{e}");
+        assert!(e.message().starts_with("d.csv:3:3: column `y`"), "{e}");
+        let e = parse("d.csv", "k,  y\n0, 1\n1,  2,3\n").unwrap_err();
+        assert!(
+            e.message().starts_with("d.csv:3:7: expected 2 cells"),
+            "{e}"
+        );
         let e = parse("d.csv", "k,y\n0,NaN\n").unwrap_err();
         assert!(e.message().contains("finite"), "{e}");
         let e = parse("d.csv", "k,y\n0\n").unwrap_err();
-        assert!(e.message().starts_with("d.csv:2: expected 2 cells"), "{e}");
+        assert!(
+            e.message().starts_with("d.csv:2:2: expected 2 cells"),
+            "{e}"
+        );
         let e = parse("d.csv", "").unwrap_err();
         assert!(e.message().contains("empty"), "{e}");
         let e = parse("d.csv", "k,,y\n").unwrap_err();
-        assert!(e.message().starts_with("d.csv:1: header"), "{e}");
+        assert!(e.message().starts_with("d.csv:1:3: header"), "{e}");
         let e = parse("d.csv", "k,y\n0,1\n")
             .unwrap()
             .column("t")
@@ -282,5 +326,30 @@ mod tests {
                 .starts_with("d.csv:1: header: expected a column named `t`"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn every_line_ending_reads_the_same() {
+        let lf = parse("d.csv", "k,y\n0,1\n# note\n1,2\n").unwrap();
+        for text in ["k,y\r\n0,1\r\n# note\r\n1,2\r\n", "k,y\r0,1\r# note\r1,2\r"] {
+            let t = parse("d.csv", text).unwrap();
+            assert_eq!(t.values, lf.values, "{text:?}");
+            assert_eq!(t.lines, lf.lines, "{text:?}");
+        }
+        let e = parse("d.csv", "k,y\r0,1\r1,x\r").unwrap_err();
+        assert!(e.message().starts_with("d.csv:3:3: column `y`"), "{e}");
+    }
+
+    #[test]
+    fn a_very_wide_file_gives_a_short_error() {
+        let header: Vec<String> = (0..200_004).map(|i| format!("c{i}")).collect();
+        let text = format!("{}\n1,2\n", header.join(","));
+        let e = parse("d.csv", &text).unwrap_err();
+        assert!(e.message().len() < 300, "{} bytes", e.message().len());
+        assert!(
+            e.message().starts_with("d.csv:2:4: expected 200004 cells"),
+            "{e}"
+        );
+        assert!(e.message().contains("199996 more"), "{e}");
     }
 }

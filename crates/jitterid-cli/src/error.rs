@@ -2,6 +2,27 @@
 
 use std::fmt;
 
+/// Longest error line in characters: a longer message keeps its start and its end around a note
+/// of how much was left out (a file with 200 000 columns must not print a megabyte-long "line").
+pub const MAX_MESSAGE_CHARS: usize = 400;
+
+/// Characters kept from the end of a message that is too long.
+const KEPT_TAIL_CHARS: usize = 80;
+
+/// `message` cut to [`MAX_MESSAGE_CHARS`] characters.
+fn capped(message: String) -> String {
+    let total = message.chars().count();
+    if total <= MAX_MESSAGE_CHARS {
+        return message;
+    }
+    // The note's length depends on the number it carries; 40 characters hold any count.
+    let head = MAX_MESSAGE_CHARS - KEPT_TAIL_CHARS - 40;
+    let left_out = total - head - KEPT_TAIL_CHARS;
+    let start: String = message.chars().take(head).collect();
+    let end: String = message.chars().skip(total - KEPT_TAIL_CHARS).collect();
+    format!("{start} … [{left_out} characters left out] … {end}")
+}
+
 /// An error reported to the user as one line on stderr (`error: …`), with exit status 2.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CliError {
@@ -9,7 +30,8 @@ pub struct CliError {
 }
 
 impl CliError {
-    /// An error with this message (newlines are folded into spaces, so the report is one line).
+    /// An error with this message (newlines are folded into spaces, so the report is one line,
+    /// and a message longer than [`MAX_MESSAGE_CHARS`] is shortened in the middle).
     pub fn new(message: impl Into<String>) -> Self {
         let message: String = message.into();
         let message = message
@@ -18,7 +40,9 @@ impl CliError {
             .filter(|s| !s.is_empty())
             .collect::<Vec<_>>()
             .join(" ");
-        Self { message }
+        Self {
+            message: capped(message),
+        }
     }
 
     /// The message.
@@ -49,4 +73,22 @@ macro_rules! cli_err {
     ($($arg:tt)*) => {
         $crate::error::CliError::new(format!($($arg)*))
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_messages_keep_start_and_end() {
+        let long = format!("start {} end", "x".repeat(1_000_000));
+        let e = CliError::new(long);
+        let m = e.message();
+        assert!(m.chars().count() <= MAX_MESSAGE_CHARS, "{}", m.len());
+        assert!(m.starts_with("start xxx"), "{m}");
+        assert!(m.ends_with("xxx end"), "{m}");
+        assert!(m.contains("characters left out"), "{m}");
+        let short = CliError::new("a\nb");
+        assert_eq!(short.message(), "a b");
+    }
 }

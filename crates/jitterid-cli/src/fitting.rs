@@ -152,6 +152,12 @@ pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
             if let Some(n) = e.max_iterations {
                 s = s.with_max_iters(n);
             }
+            if let Some(t) = e.max_seconds {
+                s = s.with_max_seconds(t);
+            }
+            if let Some(hook) = crate::progress::active_fit_hook() {
+                s = s.with_progress(hook);
+            }
             AnySolver::new(s)
         }
         SolverKind::GaussNewton => {
@@ -497,10 +503,15 @@ fn fit_ml(
         }
         Ok((ml_estimate(s, record, c, opts).map_err(e)?, None, s.clone()))
     }
-    let opts = MlOptions {
+    let mut opts = MlOptions {
         covariance,
         ..MlOptions::default()
     };
+    // The wall-clock budget is BFGS's (several parameters); Brent's method for a single
+    // parameter is bounded by its iteration limit.
+    if let Some(max_seconds) = exp.estimate.max_seconds {
+        opts.solver.bfgs.max_seconds = max_seconds;
+    }
     let (e, n, base) = if s.noise.is_white() {
         go(exp, s, record, &ExactMl::default(), &opts)?
     } else {

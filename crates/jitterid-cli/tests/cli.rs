@@ -1,24 +1,10 @@
 //! Runs the built `jitterid` binary on every example experiment and on bad input.
 
+mod common;
+
+use common::{files_in, run, s, scratch, stderr, stdout};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_jitterid"))
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("the binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn ok(args: &[&str]) -> String {
     let o = run(args);
@@ -34,16 +20,6 @@ fn json(args: &[&str]) -> Value {
     let text = ok(args);
     serde_json::from_str(&text)
         .unwrap_or_else(|e| panic!("jitterid {args:?}: not JSON ({e}): {text}"))
-}
-
-/// A fresh, empty directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("jitterid-cli")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn examples() -> Vec<PathBuf> {
@@ -63,21 +39,6 @@ fn example(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map(|r| {
-            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    v.sort();
-    v
 }
 
 #[test]
@@ -657,7 +618,16 @@ fn other_kinds_families_noise_models_and_solvers() {
         std::fs::write(&exp, text).unwrap();
         let data = dir.join(format!("{name}.csv"));
         ok(&["simulate", s(&exp), "--out", s(&data)]);
-        let fit = json(&["fit", s(&exp), "--data", s(&data), "--json"]);
+        // Names are checked here, not convergence (a Laplace width estimated on data with
+        // little jitter runs to its bound), so an unconverged fit is accepted.
+        let fit = json(&[
+            "fit",
+            s(&exp),
+            "--data",
+            s(&data),
+            "--json",
+            "--accept-unconverged",
+        ]);
         let got: Vec<&str> = fit["parameters"]
             .as_array()
             .unwrap()
@@ -665,7 +635,14 @@ fn other_kinds_families_noise_models_and_solvers() {
             .map(|p| p["name"].as_str().unwrap())
             .collect();
         assert_eq!(&got, names, "{name}");
-        let mc = json(&["montecarlo", s(&exp), "--runs", "2", "--json"]);
+        let mc = json(&[
+            "montecarlo",
+            s(&exp),
+            "--runs",
+            "2",
+            "--json",
+            "--accept-unconverged",
+        ]);
         let got: Vec<&str> = mc["parameters"]
             .as_array()
             .unwrap()

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{example, jitterid, scratch};
+use common::{example, jitterid, scratch_in};
 use serde_json::Value;
 
 fn ok(args: &[&str]) -> String {
@@ -26,7 +26,7 @@ fn json(args: &[&str]) -> Value {
 /// Simulates one record, fits it with the family estimated, and checks the fit converged
 /// with the expected parameter names, each estimate finite.
 fn simulate_and_fit(name: &str, names: &[&str]) {
-    let d = scratch("jitterid-families", name);
+    let d = scratch_in("jitterid-families", name);
     let data = d.join("d.csv");
     let exp = example(&format!("{name}.toml"));
     ok(&[

@@ -67,6 +67,7 @@ pub(super) fn parse_estimate(
         )?,
         perturb: relative_size(cx, "perturb", r.perturb.as_ref(), 0.2)?,
         max_iterations,
+        max_seconds: None,
     })
 }
 

@@ -110,6 +110,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
             multistart_radius: 0.5,
             perturb: 0.2,
             max_iterations: None,
+            max_seconds: None,
         },
     };
     if let Purpose::Estimate(chosen) = purpose {

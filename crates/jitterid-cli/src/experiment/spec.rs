@@ -129,6 +129,9 @@ pub struct EstimateSpec {
     pub perturb: f64,
     /// Iteration limit of the solver (its default if `None`).
     pub max_iterations: Option<u64>,
+    /// Wall-clock budget of each fit in seconds (the solver's default if `None`); set from the
+    /// command line.
+    pub max_seconds: Option<f64>,
 }
 
 /// A validated experiment: every value is within the representable range, every model is

@@ -1,8 +1,56 @@
-//! Helpers shared by the command-line test files (each file is its own crate).
-#![allow(dead_code)] // each test file uses some of them
+//! Helpers shared by the command-line test files (each file is its own crate, and uses some
+//! of them): run the built binary, scratch directories, example experiments.
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
+
+/// The built `jitterid` binary.
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_jitterid"))
+}
+
+/// Runs the binary with `args`.
+pub fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("the binary runs")
+}
+
+/// Standard output as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Standard error as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh, empty directory for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("jitterid-cli")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A path as `&str` for an argument list.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The names in a directory, sorted (none if it does not exist).
+pub fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
 
 /// The path of an example experiment file.
 pub fn example(name: &str) -> String {
@@ -14,7 +62,7 @@ pub fn example(name: &str) -> String {
 }
 
 /// A fresh, empty directory `name` of the test group `group`.
-pub fn scratch(group: &str, name: &str) -> PathBuf {
+pub fn scratch_in(group: &str, name: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join(group)
         .join(name);
@@ -25,7 +73,7 @@ pub fn scratch(group: &str, name: &str) -> PathBuf {
 
 /// The built `jitterid` binary.
 pub fn jitterid() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_jitterid"))
+    bin()
 }
 
 /// An example experiment file's text with its first line starting with `from` replaced.

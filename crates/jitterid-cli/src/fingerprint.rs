@@ -1,0 +1,99 @@
+//! The identity of an experiment by content: a fingerprint of every parsed value, so that the
+//! same experiment under two paths is one study and an edited file is another.
+
+use crate::experiment::Experiment;
+use std::fmt::Write as _;
+use std::hash::Hasher;
+
+/// The fingerprint of `exp`: a 64-bit FNV-1a hash (16 hexadecimal digits) of the canonical text
+/// of every parsed value (sampling, input, system, jitter, noise, estimate and title). Numbers
+/// enter with their shortest round-trip text, so two values give the same fingerprint only if
+/// they are equal; the file's name, comments, layout and key order do not enter.
+pub fn experiment_fingerprint(exp: &Experiment) -> String {
+    let mut h = HashWriter(fnv::FnvHasher::default());
+    // Writing into a hasher cannot fail.
+    let _ = write!(
+        h,
+        "title={:?}\ngrid={:?}\ninput={:?}\nsystem={:?}\njitter={:?}\nnoise={:?}\nestimate={:?}",
+        exp.title, exp.grid, exp.input, exp.system, exp.jitter, exp.noise, exp.estimate
+    );
+    format!("{:016x}", h.0.finish())
+}
+
+/// Feeds formatted text straight into the hash, so that a long measured input is hashed
+/// without first being written out as one string.
+struct HashWriter(fnv::FnvHasher);
+
+impl std::fmt::Write for HashWriter {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0.write(s.as_bytes());
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::{parse, Purpose};
+    use std::path::Path;
+
+    const BASE: &str = r#"[sampling]
+interval = 1.0
+samples = 64
+[input]
+kind = "random-binary"
+mean_dwell = 8.0
+[system]
+kind = "zpk"
+gain = 1.0
+poles = [-0.5]
+[jitter]
+family = "gaussian"
+sigma = 0.1
+[noise]
+std = 0.01
+"#;
+
+    fn fp(text: &str) -> String {
+        experiment_fingerprint(&parse("e.toml", text, Path::new("."), Purpose::Simulate).unwrap())
+    }
+
+    #[test]
+    fn every_value_changes_the_fingerprint() {
+        let base = fp(BASE);
+        for (from, to) in [
+            ("interval = 1.0", "interval = 0.5"),
+            ("samples = 64", "samples = 65"),
+            ("mean_dwell = 8.0", "mean_dwell = 9.0"),
+            ("gain = 1.0", "gain = 2.0"),
+            ("poles = [-0.5]", "poles = [-0.25]"),
+            ("sigma = 0.1", "sigma = 0.100000001"),
+            ("std = 0.01", "std = 0.02"),
+            ("[noise]", "[estimate]\nmethod = \"ls\"\n[noise]"),
+            ("[sampling]", "title = \"other\"\n[sampling]"),
+        ] {
+            let edited = BASE.replace(from, to);
+            assert_ne!(edited, BASE, "{from}");
+            assert_ne!(fp(&edited), base, "{from} → {to} kept the fingerprint");
+        }
+    }
+
+    #[test]
+    fn layout_comments_and_number_spelling_do_not() {
+        let base = fp(BASE);
+        let same = BASE
+            .replace(
+                "interval = 1.0",
+                "# the sampling interval\ninterval   =   1",
+            )
+            .replace("gain = 1.0", "gain = 1e0")
+            .replace("std = 0.01", "std = 1.0e-2");
+        assert_eq!(fp(&same), base);
+        let reordered = BASE.replace(
+            "interval = 1.0\nsamples = 64",
+            "samples = 64\ninterval = 1.0",
+        );
+        assert_eq!(fp(&reordered), base);
+        assert_eq!(base.len(), 16);
+    }
+}

@@ -1,0 +1,256 @@
+//! `jitterid merge`: shard files of one study, checked to belong together and to be whole, into
+//! the result of the unsharded study.
+//!
+//! A shard belongs to the study of the first shard when its program version, experiment
+//! fingerprint (by content, not path), seed, method, run count, shard count, parameter names and
+//! true values are the same. A shard is whole when its runs are exactly those of its index, every
+//! realisation has one value per parameter, and its summaries, convergence count and termination
+//! counts are what its realisations give (so a hand-edited value is caught).
+
+use crate::cli_err;
+use crate::commands::{emit, summarize, terminations, McJson, Realization, ShardInfo, MAX_RUNS};
+use crate::csvio;
+use crate::error::CliResult;
+use crate::exit::{Outcome, Status};
+use crate::output::OutputSet;
+use std::path::{Path, PathBuf};
+
+/// Largest number of shards of one study.
+const MAX_SHARDS: u64 = 1_000_000;
+
+/// A shard file, read.
+struct Part {
+    name: String,
+    json: McJson,
+    shard: ShardInfo,
+    runs: Vec<Realization>,
+}
+
+fn read_part(path: &Path) -> CliResult<Part> {
+    let name = path.display().to_string();
+    csvio::check_regular_file(path, &name)?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
+    let json: McJson = serde_json::from_str(&text).map_err(|e| {
+        cli_err!(
+            "{name}:{}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}",
+            e.line(),
+            e.column()
+        )
+    })?;
+    let (Some(shard), Some(runs)) = (json.shard.clone(), json.realizations.clone()) else {
+        return Err(cli_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json"));
+    };
+    if json.fingerprint.is_empty() || json.program.is_empty() {
+        return Err(cli_err!(
+            "{name}: has no `fingerprint` and `program` (written by an older jitterid?); its study cannot be identified, so run the shard again"
+        ));
+    }
+    Ok(Part {
+        name,
+        json,
+        shard,
+        runs,
+    })
+}
+
+/// The first field in which `p` and `first` differ, as (what, this value, first value).
+fn identity_mismatch(p: &Part, first: &Part) -> Option<(&'static str, String, String)> {
+    let fields: [(&'static str, String, String); 6] = [
+        (
+            "program version",
+            p.json.program.clone(),
+            first.json.program.clone(),
+        ),
+        (
+            "experiment (fingerprint of its contents)",
+            p.json.fingerprint.clone(),
+            first.json.fingerprint.clone(),
+        ),
+        ("seed", p.json.seed.to_string(), first.json.seed.to_string()),
+        ("method", p.json.method.clone(), first.json.method.clone()),
+        (
+            "run count",
+            p.shard.runs_total.to_string(),
+            first.shard.runs_total.to_string(),
+        ),
+        (
+            "shard count",
+            p.shard.count.to_string(),
+            first.shard.count.to_string(),
+        ),
+    ];
+    fields.into_iter().find(|(_, a, b)| a != b)
+}
+
+/// Checks that `p` is whole: its runs, value counts, and stored summaries agree.
+fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<()> {
+    let name = &p.name;
+    let s = &p.shard;
+    let first = s.runs_total * s.index / s.count;
+    let end = s.runs_total * (s.index + 1) / s.count;
+    if s.first != first || s.end != end {
+        return Err(cli_err!(
+            "{name}: shard {}/{} of {} runs covers runs {first}..{end}, but the file says {}..{}",
+            s.index,
+            s.count,
+            s.runs_total,
+            s.first,
+            s.end
+        ));
+    }
+    if p.runs.len() as u64 != end - first || p.json.runs != end - first {
+        return Err(cli_err!(
+            "{name}: expected {} realisations (runs {first}..{end}), found {} (`runs` says {})",
+            end - first,
+            p.runs.len(),
+            p.json.runs
+        ));
+    }
+    for (i, r) in p.runs.iter().enumerate() {
+        if r.run != first + i as u64 {
+            return Err(cli_err!(
+                "{name}: realisation {i} is run {}, expected run {} (runs in order, each once)",
+                r.run,
+                first + i as u64
+            ));
+        }
+        if r.values.len() != names.len() {
+            return Err(cli_err!(
+                "{name}: run {}: expected {} values (one per parameter), found {}",
+                r.run,
+                names.len(),
+                r.values.len()
+            ));
+        }
+    }
+    let converged = p.runs.iter().filter(|r| r.converged).count() as u64;
+    if converged != p.json.converged {
+        return Err(cli_err!(
+            "{name}: `converged` says {}, but {converged} of its realisations converged",
+            p.json.converged
+        ));
+    }
+    if terminations(&p.runs) != p.json.terminations {
+        return Err(cli_err!(
+            "{name}: `terminations` do not count its realisations' terminations"
+        ));
+    }
+    let recomputed = summarize(names, truth, &p.runs);
+    if let Some((stored, again)) = p
+        .json
+        .parameters
+        .iter()
+        .zip(&recomputed)
+        .find(|(a, b)| a != b)
+    {
+        return Err(cli_err!(
+            "{name}: the summary of `{}` is not that of its realisations (mean {:?} stored, {:?} computed): was the file edited?",
+            stored.name,
+            stored.mean,
+            again.mean
+        ));
+    }
+    Ok(())
+}
+
+/// `jitterid merge`: combines shard files into the result of the unsharded study; exit status
+/// [`Status::NotConverged`] when no fit of the study converged (unless `accept_unconverged`).
+pub fn merge(
+    files: &[PathBuf],
+    json: bool,
+    out: Option<&Path>,
+    accept_unconverged: bool,
+) -> CliResult<Outcome> {
+    let parts = files
+        .iter()
+        .map(|f| read_part(f))
+        .collect::<CliResult<Vec<Part>>>()?;
+    let Some(first) = parts.first() else {
+        return Err(cli_err!("merge: expected at least one shard file"));
+    };
+    let s0 = &first.shard;
+    if !(1..=MAX_SHARDS).contains(&s0.count) || !(1..=MAX_RUNS).contains(&s0.runs_total) {
+        return Err(cli_err!(
+            "{}: shard count {} or run total {} out of range (1 to {MAX_SHARDS} shards, 1 to {MAX_RUNS} runs)",
+            first.name,
+            s0.count,
+            s0.runs_total
+        ));
+    }
+    let names: Vec<String> = first
+        .json
+        .parameters
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let truth: Vec<Option<f64>> = first.json.parameters.iter().map(|p| p.truth).collect();
+    let mut seen = vec![false; s0.count as usize];
+    for p in &parts {
+        if let Some((what, this, theirs)) = identity_mismatch(p, first) {
+            return Err(cli_err!(
+                "{}: belongs to another study than {}: its {what} is {this:?}, not {theirs:?}",
+                p.name,
+                first.name
+            ));
+        }
+        if p.json.parameters.iter().map(|q| &q.name).ne(names.iter()) {
+            return Err(cli_err!(
+                "{}: its parameters differ from those of {}",
+                p.name,
+                first.name
+            ));
+        }
+        if let Some(q) = p
+            .json
+            .parameters
+            .iter()
+            .zip(&truth)
+            .find(|(q, t)| q.truth.map(f64::to_bits) != t.map(f64::to_bits))
+        {
+            return Err(cli_err!(
+                "{}: the true value of `{}` is {:?}, not {:?} as in {}",
+                p.name,
+                q.0.name,
+                q.0.truth,
+                q.1,
+                first.name
+            ));
+        }
+        let slot = seen
+            .get_mut(p.shard.index as usize)
+            .ok_or_else(|| cli_err!("{}: shard index {} out of range", p.name, p.shard.index))?;
+        if *slot {
+            return Err(cli_err!(
+                "{}: shard {}/{} given twice",
+                p.name,
+                p.shard.index,
+                p.shard.count
+            ));
+        }
+        *slot = true;
+        check_whole(p, &names, &truth)?;
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return Err(cli_err!("merge: shard {missing}/{} is missing", s0.count));
+    }
+    let mut all: Vec<Realization> = parts.iter().flat_map(|p| p.runs.clone()).collect();
+    all.sort_by_key(|r| r.run);
+    let merged = McJson {
+        method: first.json.method.clone(),
+        runs: s0.runs_total,
+        converged: all.iter().filter(|r| r.converged).count() as u64,
+        terminations: terminations(&all),
+        seconds: parts.iter().map(|p| p.json.seconds).sum(),
+        seed: first.json.seed,
+        experiment: first.json.experiment.clone(),
+        fingerprint: first.json.fingerprint.clone(),
+        program: first.json.program.clone(),
+        parameters: summarize(&names, &truth, &all),
+        shard: None,
+        realizations: None,
+    };
+    let status = Status::of_convergence(merged.converged > 0, accept_unconverged);
+    let text = emit(&merged, json, out, OutputSet::new())?;
+    Ok(Outcome { text, status })
+}
