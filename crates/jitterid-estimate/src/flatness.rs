@@ -2,7 +2,7 @@
 //!
 //! For independent samples the noise part of the DTFT, `Σ_k e_k e^{-i2πf kT}`, has the same
 //! variance `Σ_k λ_k` at every frequency whatever the jitter does to each `λ_k`
-//! (`conventions.md`, "Second moments"). At the true parameters the BCLS residual
+//! (`docs/method.md`, "Second moments"). At the true parameters the BCLS residual
 //! `Y(f) − μ_Y(f)` is exactly that noise, so its power is flat across the frequency set (the
 //! Box–Jenkins residual is flat after division by the noise model's shape). A fit stuck in a
 //! local minimum, or a model that cannot describe the data, leaves its misfit where the input

@@ -132,7 +132,7 @@ impl NoiseModel for ArmaNoise {
 /// logarithm (the parameter is `log_floor = ln ρ`, so every parameter vector is valid).
 ///
 /// Jittered samples carry their own noise, `E[s(t_k+τ)²] − m_k²`, which is independent from
-/// sample to sample and so has a flat spectrum (`conventions.md`: `Var Y(f) = Σ_k λ_k` at every
+/// sample to sample and so has a flat spectrum (`docs/method.md`: `Var Y(f) = Σ_k λ_k` at every
 /// `f`). The residual spectrum of a Box–Jenkins fit to jittered data is therefore
 /// `σ_e²|H(f)|² + λ̄ = σ_e² (|H(f)|² + ρ)`; without the floor the noise model absorbs it and its
 /// parameters are biased towards white noise. With it, `σ_e²` still concentrates out of the

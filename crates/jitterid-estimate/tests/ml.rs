@@ -1,4 +1,4 @@
-//! Tests of the maximum-likelihood layer (issue 4) through the public API.
+//! Tests of the maximum-likelihood layer through the public API.
 #![allow(clippy::needless_range_loop)]
 
 use jitterid_estimate::ml::*;

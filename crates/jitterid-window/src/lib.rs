@@ -4,7 +4,7 @@
 //!
 //! # Conventions
 //!
-//! These follow the project's `conventions.md`:
+//! These follow the conventions of `docs/method.md`:
 //!
 //! * Time in seconds, frequency in **Hz**; there is no `1/(2π)` anywhere (the paper's factor in
 //!   eqs. (11), (13), (14b) belongs to an angular-frequency convention).

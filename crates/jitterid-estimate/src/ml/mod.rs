@@ -1,9 +1,9 @@
 //! Maximum likelihood with the second moment, the exact per-sample likelihood, Fisher
-//! information and Cramér–Rao bounds (beyond the paper; issue 4).
+//! information and Cramér–Rao bounds (beyond the paper).
 //!
 //! The first moment `m_k = E[s(t_k + τ)]` carries little information about the jitter; the
 //! variance `λ_k = σ_v² + E[s(t_k+τ)²] − m_k²` carries much more, because it is large exactly
-//! where the signal moves fast (`conventions.md`, "Second moments"). This module uses it:
+//! where the signal moves fast (`docs/method.md`, "Second moments"). This module uses it:
 //!
 //! * [`second_moments`]: `m_k`, `λ_k` and their gradients; [`dtft_covariance`]: the covariance
 //!   of the residual DTFT over a frequency set that follows from them.

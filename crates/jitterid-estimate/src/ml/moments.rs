@@ -1,4 +1,4 @@
-//! Second moments of jittered samples (`conventions.md`, "Second moments"):
+//! Second moments of jittered samples (`docs/method.md`, "Second moments"):
 //!
 //! ```text
 //! m_k = E[s(t_k + τ)],   λ_k = Var y_k = σ_v² + E[s(t_k + τ)²] − m_k²
