@@ -62,11 +62,6 @@ fn identity_mismatch(p: &Part, first: &Part) -> Option<(&'static str, String, St
             p.json.program.clone(),
             first.json.program.clone(),
         ),
-        (
-            "experiment (fingerprint of its contents)",
-            p.json.fingerprint.clone(),
-            first.json.fingerprint.clone(),
-        ),
         ("seed", p.json.seed.to_string(), first.json.seed.to_string()),
         ("method", p.json.method.clone(), first.json.method.clone()),
         (
@@ -78,6 +73,13 @@ fn identity_mismatch(p: &Part, first: &Part) -> Option<(&'static str, String, St
             "shard count",
             p.shard.count.to_string(),
             first.shard.count.to_string(),
+        ),
+        // Last: the method is part of the parsed experiment too, so a more specific field
+        // above names the difference when there is one.
+        (
+            "experiment (fingerprint of its contents)",
+            p.json.fingerprint.clone(),
+            first.json.fingerprint.clone(),
         ),
     ];
     fields.into_iter().find(|(_, a, b)| a != b)
