@@ -94,9 +94,3 @@ pub use shifted::Shifted;
 pub use sum::Sum;
 pub use two_point::TwoPoint;
 pub use uniform_sum::UniformSum;
-
-// Compiles and runs the worked example of `docs/extending.md` with the doctests, so that the
-// guide cannot drift from the trait.
-#[cfg(doctest)]
-#[doc = include_str!("../../../docs/extending.md")]
-struct ExtendingGuide;

@@ -68,3 +68,9 @@ pub mod prelude {
 #[cfg(doctest)]
 #[doc = include_str!("../../../README.md")]
 struct ReadmeDoctests;
+
+// The extension guide's examples (a jitter family, a signal, a criterion) are compiled and run
+// with the doctests, so that the guide cannot drift from the traits.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/extending.md")]
+struct ExtendingGuide;
