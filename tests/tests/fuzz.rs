@@ -21,9 +21,9 @@ use jitterid::estimate::solver::{
     AnySolver, LevenbergMarquardt, LmOptions, MultiStart, NelderMead, Scaling,
 };
 use jitterid::estimate::{
-    estimate, initialize, ArmaNoise, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
-    Fit, Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, Record,
-    WeightedBcls,
+    estimate, initialize, AnyCriterion, ArmaNoise, Bcls, Criterion, CriterionRegistry,
+    EstimateError, EstimateOptions, Fit, Frequencies, InitOptions, InitialModel, Ls,
+    ModelStructure, NoiseModel, Record,
 };
 use jitterid::jitter::registry::{JitterRegistry, Spec};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel};
@@ -236,20 +236,21 @@ fn jitter() -> impl Strategy<Value = JitterSpec> {
         })
 }
 
-#[derive(Debug, Clone)]
-enum CriterionSpec {
-    Ls,
-    Bcls,
-    Weighted(Vec<f64>),
-    Bj,
+/// The spec table naming one criterion of the registry.
+fn named_criterion(name: &str) -> Spec {
+    let mut t = Spec::new();
+    t.insert("criterion".into(), name.into());
+    t
 }
 
-fn criterion() -> impl Strategy<Value = CriterionSpec> {
+/// A first-moment criterion as a registry spec table; weighted BCLS gets weights that are
+/// occasionally invalid (negative, or non-finite, which JSON holds as null).
+fn criterion() -> impl Strategy<Value = Spec> {
     prop_oneof![
-        Just(CriterionSpec::Ls),
-        Just(CriterionSpec::Bcls),
+        Just(named_criterion("ls")),
+        Just(named_criterion("bcls")),
         (1usize..40, values(40, 3.0), any::<bool>()).prop_map(|(n, w, plain)| {
-            CriterionSpec::Weighted(if plain {
+            let weights: Vec<f64> = if plain {
                 w[..n]
                     .iter()
                     .map(|x| if x.is_finite() { x.abs() } else { 1.0 })
@@ -259,9 +260,12 @@ fn criterion() -> impl Strategy<Value = CriterionSpec> {
                     .iter()
                     .map(|x| if x.is_finite() { x.abs() } else { *x })
                     .collect()
-            })
+            };
+            let mut t = named_criterion("weighted-bcls");
+            t.insert("weights".into(), serde_json::json!(weights));
+            t
         }),
-        Just(CriterionSpec::Bj),
+        Just(named_criterion("bj")),
     ]
 }
 
@@ -342,7 +346,7 @@ struct Case {
     estimated: Option<(bool, bool, bool)>,
     arma: (Vec<f64>, Vec<f64>),
     noise_std: Option<f64>,
-    criterion: CriterionSpec,
+    criterion: Spec,
     frequencies: FreqSpec,
     hann: bool,
     solver: SolverSpec,
@@ -493,19 +497,11 @@ fn build_input(spec: &InputSpec) -> Option<Input> {
     }
 }
 
-fn build_criterion(spec: &CriterionSpec) -> Option<Box<dyn Criterion>> {
-    Some(match spec {
-        CriterionSpec::Ls => Box::new(Ls),
-        CriterionSpec::Bcls => Box::new(Bcls),
-        CriterionSpec::Weighted(w) => match WeightedBcls::new(w.clone()) {
-            Ok(c) => Box::new(c),
-            Err(e) => {
-                note_error(&e);
-                return None;
-            }
-        },
-        CriterionSpec::Bj => Box::new(BoxJenkins),
-    })
+fn build_criterion(spec: &Spec) -> Option<AnyCriterion> {
+    CriterionRegistry::builtin()
+        .build(spec)
+        .map_err(|e| note_error(&e))
+        .ok()
 }
 
 fn build_solver(spec: &SolverSpec) -> AnySolver {
@@ -725,7 +721,11 @@ fn run_case_inner(case: &Case) -> Result<(), TestCaseError> {
         Ok(j) => j,
         Err(e) => return reject(&e),
     };
-    let Some(criterion) = build_criterion(&case.criterion) else {
+    let Some(any_criterion) = build_criterion(&case.criterion) else {
+        bump(&TALLY.rejected_setup);
+        return Ok(());
+    };
+    let Some(criterion) = any_criterion.as_first_moment() else {
         bump(&TALLY.rejected_setup);
         return Ok(());
     };
@@ -736,12 +736,12 @@ fn run_case_inner(case: &Case) -> Result<(), TestCaseError> {
                 z.iter().map(RootSpec::root).collect(),
                 p.iter().map(RootSpec::root).collect(),
             ) {
-                Ok(m) => run_model(case, m, input, jitter, &record, &criterion),
+                Ok(m) => run_model(case, m, input, jitter, &record, criterion),
                 Err(e) => reject(&e),
             }
         }
         ModelSpec::Tf(num, den) => match TransferFunction::new(num, den) {
-            Ok(m) => run_model(case, m, input, jitter, &record, &criterion),
+            Ok(m) => run_model(case, m, input, jitter, &record, criterion),
             Err(e) => reject(&e),
         },
     }

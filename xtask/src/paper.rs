@@ -59,9 +59,15 @@ pub fn rng(seed: u64, r: u64) -> StdRng {
     realization_rng(seed, r)
 }
 
-/// `√(3(n+1))`: the ratio `a/σ` of the uniform-sum family with `n + 1` terms.
-fn uniform_sum_ratio(n: f64) -> f64 {
-    (3.0 * (n + 1.0)).sqrt()
+/// `√(3(n+1))`: the ratio `a/σ` of the uniform-sum family with `n + 1` terms, read from the
+/// registry as the half-width of its unit-σ member (`1 · √(3(n+1))`, the same number); NaN
+/// for an `n` the family refuses, which every constructor then rejects.
+pub fn uniform_sum_ratio(n: i64) -> f64 {
+    let mut spec = serde_json::Map::new();
+    spec.insert("n".into(), n.into());
+    JitterRegistry::builtin()
+        .from_std_dev("uniform-sum", 1.0, &spec)
+        .map_or(f64::NAN, |j| j.params()[0])
 }
 
 /// The start of every `n` of a uniform-sum profile: `n + 1` terms and standard deviation
@@ -69,10 +75,10 @@ fn uniform_sum_ratio(n: f64) -> f64 {
 pub fn uniform_sum_with_std(
     sigma: f64,
 ) -> impl Fn(i64) -> Result<UniformSum, jitterid::jitter::JitterError> + Sync {
-    move |n| UniformSum::new(n as u32, sigma * uniform_sum_ratio(n as f64))
+    move |n| UniformSum::new(n as u32, sigma * uniform_sum_ratio(n))
 }
 
 /// `σ = a/√(3(n+1))` of a uniform sum (and the same scaling of a standard error of `a`).
 pub fn uniform_sum_sigma(n: i64, a: f64) -> f64 {
-    a / uniform_sum_ratio(n as f64)
+    a / uniform_sum_ratio(n)
 }

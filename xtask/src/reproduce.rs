@@ -408,7 +408,7 @@ fn table1(o: &Options) -> Result<(), String> {
                 let record = Record::new(grid, data.y).ok()?;
                 // Start: the truth's σ perturbed by 1 + U(−0.2, 0.2); n is profiled.
                 let s0 = paper::perturb(&[*sigma], 0.2, rng)[0];
-                let start = UniformSum::new(0, s0 * 3f64.sqrt()).ok()?;
+                let start = paper::uniform_sum_with_std(s0)(0).ok()?;
                 let structure =
                     ModelStructure::oe(signal, start).with_estimated(false, true, false);
                 let p = profile(

@@ -174,7 +174,7 @@ fn bounds(signal: &LtiResponse<Zpk>, truth: Truth) -> (Option<f64>, Option<f64>)
                 .with_noise_std(NOISE_STD)
                 .expect("valid noise");
             // σ = a/√(3(n+1)): the delta method is a constant factor.
-            let f = 1.0 / (3.0 * (f64::from(j.n()) + 1.0)).sqrt();
+            let f = 1.0 / paper::uniform_sum_ratio(i64::from(j.n()));
             let e = exact_fisher(&s, &grid, NOISE_STD, &fo)
                 .ok()
                 .and_then(|i| i.crb_std())
@@ -222,7 +222,7 @@ fn one_record(
     .ok()?;
     let record = Record::new(grid, data.y).ok()?;
     let s0 = paper::perturb(&[sigma], 0.2, rng)[0];
-    let start = UniformSum::new(0, s0 * 3f64.sqrt()).ok()?;
+    let start = paper::uniform_sum_with_std(s0)(0).ok()?;
     let structure = ModelStructure::oe(signal.clone(), start).with_estimated(false, true, false);
     let mut rec = Rec::default();
     if let Ok(p) = profile(
@@ -250,7 +250,7 @@ fn one_record(
             let s_bc = 2.0 * sigma - mean;
             rec.corrected = Some([
                 f64::from(n),
-                s_bc * (3.0 * (f64::from(n) + 1.0)).sqrt(),
+                s_bc * paper::uniform_sum_ratio(i64::from(n)),
                 s_bc,
             ]);
         }

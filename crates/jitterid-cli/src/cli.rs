@@ -38,7 +38,7 @@ pub enum Command {
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
-    Method::parse(s).ok_or_else(|| format!("expected ls, bcls, bj or ml, found `{s}`"))
+    Method::parse(s).ok_or_else(|| format!("expected {}, found `{s}`", Method::names()))
 }
 
 /// Arguments of `simulate`.
@@ -90,7 +90,7 @@ pub struct FitArgs {
     /// [default: <data stem>.input.csv].
     #[arg(long)]
     pub input: Option<PathBuf>,
-    /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml.
+    /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml, quasi-ml.
     #[arg(long, value_parser = parse_method)]
     pub method: Option<Method>,
     /// Print JSON instead of a table.
@@ -127,7 +127,7 @@ pub struct MonteCarloArgs {
     /// Run only shard i of n (runs R·i/n .. R·(i+1)/n); merge shard JSON files with `merge`.
     #[arg(long, value_name = "i/n")]
     pub shard: Option<Shard>,
-    /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml.
+    /// Estimation method (overrides [estimate] method): ls, bcls, bj, ml, quasi-ml.
     #[arg(long, value_parser = parse_method)]
     pub method: Option<Method>,
     /// Write the JSON to this file (atomically, together with the figures) instead of standard

@@ -285,20 +285,20 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
     let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
         // The naive LS fit of the system for comparison (when the system is estimated).
-        let ls = if exp.system.estimate && method != Method::Ls {
+        let ls = if exp.system.estimate && method != Method::LS {
             let mut ls_exp = exp.clone();
             ls_exp.jitter.estimate = false;
             ls_exp.noise.estimate = false;
-            fitting::structure(&ls_exp, signal.clone(), Method::Ls)
+            fitting::structure(&ls_exp, signal.clone(), Method::LS)
                 .ok()
-                .and_then(|ls_s| fitting::fit(&ls_exp, &ls_s, &record, Method::Ls, 0, false).ok())
+                .and_then(|ls_s| fitting::fit(&ls_exp, &ls_s, &record, Method::LS, 0, false).ok())
                 .map(|f| f.fitted)
-        } else if method == Method::Ls {
+        } else if method == Method::LS {
             Some(f.fitted.clone())
         } else {
             None
         };
-        let main_label = if method == Method::Ls {
+        let main_label = if method == Method::LS {
             "naive LS"
         } else {
             method.as_str()
@@ -308,7 +308,7 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
             y: &y,
             input: input.as_ref(),
             file_model: &signal,
-            ls: if method == Method::Ls {
+            ls: if method == Method::LS {
                 None
             } else {
                 ls.as_ref()

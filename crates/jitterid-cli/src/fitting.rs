@@ -2,46 +2,69 @@
 
 use crate::cli_err;
 use crate::error::CliResult;
-use crate::experiment::{Experiment, InputSpec, Method, SolverKind, SystemKind};
+use crate::experiment::{name_table, Experiment, InputSpec, Method, SystemKind};
 use crate::inputs::input_span;
-use crate::models::{AnyNoise, AnySignal};
 use jitterid::estimate::solver::{
-    AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
+    AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead, SolverRegistry,
 };
 use jitterid::estimate::{
-    estimate, profile, Bcls, BoxJenkins, Criterion, EstimateError, EstimateOptions,
-    Fit as Estimate, Ls, ModelStructure, NoiseModel, Record,
+    AnyCriterion, AnyNoise, EstimateError, Fit as Estimate, FitOptions, ModelStructure, NoiseModel,
+    Record,
 };
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
-use jitterid::signal::{simulate, Input, LtiResponse, SampleGrid, Signal};
-use jitterid::window::DirichletWindow;
+use jitterid::signal::registry::{roots_json, SignalRegistry};
+use jitterid::signal::{simulate, AnySignal, Input, SampleGrid, Signal};
+use serde_json::{json, Map, Value};
 
-/// The uniform-sum jitter with `n + 1` terms and standard deviation `sigma`: the start of every
-/// `n` of a profile.
-fn uniform_sum_with_std(
-    sigma: f64,
-) -> impl Fn(i64) -> Result<UniformSum, jitterid::jitter::JitterError> + Sync {
-    move |n| UniformSum::new(n as u32, sigma * (3.0 * (n as f64 + 1.0)).sqrt())
+/// The uniform-sum jitter with `n + 1` terms and standard deviation `sigma`, through the
+/// registry: the start of every `n` of a profile.
+fn uniform_sum_with_std(sigma: f64) -> impl Fn(i64) -> Result<AnyJitter, JitterError> + Sync {
+    move |n| {
+        let mut spec = Map::new();
+        spec.insert("n".into(), n.into());
+        JitterRegistry::builtin().from_std_dev("uniform-sum", sigma, &spec)
+    }
 }
 
 /// The model structure of the command line.
 pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
 
-/// The signal of a system kind driven by `input` (rational systems need one).
+/// The signal of a system kind driven by `input` (rational systems need one), built through the
+/// signal registry.
 pub fn signal_of(kind: &SystemKind, input: Option<&Input>) -> CliResult<AnySignal> {
-    let input = || {
-        input
-            .cloned()
-            .ok_or_else(|| cli_err!("a rational system needs an input"))
+    let pairs = match kind {
+        SystemKind::Zpk(z) => vec![
+            ("kind", json!("zpk")),
+            ("gain", json!(z.gain())),
+            ("zeros", roots_json(z.zeros())),
+            ("poles", roots_json(z.poles())),
+        ],
+        SystemKind::Tf(t) => vec![
+            ("kind", json!("tf")),
+            ("num", json!(t.num())),
+            ("den", json!(t.den())),
+        ],
+        SystemKind::Sinusoid(s) => vec![
+            ("kind", json!("sinusoid")),
+            ("amplitude", json!(s.amplitude())),
+            ("frequency", json!(s.frequency())),
+            ("phase", json!(s.phase())),
+        ],
     };
-    Ok(match kind {
-        SystemKind::Zpk(z) => AnySignal::Zpk(LtiResponse::new(z.clone(), input()?)),
-        SystemKind::Tf(t) => AnySignal::Tf(LtiResponse::new(t.clone(), input()?)),
-        SystemKind::Sinusoid(s) => AnySignal::Sinusoid(*s),
-    })
+    let spec: Map<String, Value> = pairs.into_iter().map(|(k, v)| (k.into(), v)).collect();
+    if kind_needs_input(kind) && input.is_none() {
+        return Err(cli_err!("a rational system needs an input"));
+    }
+    SignalRegistry::builtin()
+        .build(&spec, input)
+        .map_err(|e| cli_err!("[system]: {e}"))
+}
+
+fn kind_needs_input(kind: &SystemKind) -> bool {
+    !matches!(kind, SystemKind::Sinusoid(_))
 }
 
 /// The input of one realisation: a random binary input is drawn from `rng`, others are fixed.
@@ -77,17 +100,18 @@ pub fn simulate_record(
 ) -> CliResult<Simulated> {
     let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
         .map_err(|e| cli_err!("{}: simulation: {e}", exp.file))?;
-    let v = match &exp.noise.shape {
-        AnyNoise::White => sim.noise.clone(),
-        AnyNoise::Arma(a) => {
-            let p = a.params();
-            let nc = a
-                .param_names()
-                .iter()
-                .filter(|n| n.starts_with('c'))
-                .count();
-            arma_filter(&p[..nc], &p[nc..], &sim.noise)
-        }
+    let shape = &exp.noise.shape;
+    let v = if shape.is_white() {
+        sim.noise.clone()
+    } else {
+        // The ARMA model's parameters are `c1…` then `d1…`.
+        let p = shape.params();
+        let nc = shape
+            .param_names()
+            .iter()
+            .filter(|n| n.starts_with('c'))
+            .count();
+        arma_filter(&p[..nc], &p[nc..], &sim.noise)
     };
     let y = sim
         .y
@@ -131,7 +155,7 @@ pub fn arma_filter(c: &[f64], d: &[f64], e: &[f64]) -> Vec<f64> {
 /// The model structure for `signal` as the experiment says (free parts, noise, method).
 pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResult<Structure> {
     let shape_free = exp.noise.estimate
-        && matches!(method, Method::Bj | Method::Ml)
+        && (method.as_str() == "bj" || method.is_likelihood())
         && !exp.noise.shape.is_white();
     let s = ModelStructure::bj(signal, exp.jitter.model.clone(), exp.noise.shape.clone())
         .with_estimated(exp.system.estimate, exp.jitter.estimate, shape_free);
@@ -146,8 +170,8 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
 /// The solver of the experiment; `seed` seeds multistart perturbations.
 pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
     let e = &exp.estimate;
-    let base = match e.solver {
-        SolverKind::Lm => {
+    let base = match e.solver.as_str() {
+        "lm" => {
             let mut s = LevenbergMarquardt::default();
             if let Some(n) = e.max_iterations {
                 s = s.with_max_iters(n);
@@ -160,20 +184,24 @@ pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
             }
             AnySolver::new(s)
         }
-        SolverKind::GaussNewton => {
+        "gauss-newton" => {
             let mut s = GaussNewtonLineSearch::default();
             if let Some(n) = e.max_iterations {
                 s.max_iters = n;
             }
             AnySolver::new(s)
         }
-        SolverKind::NelderMead => {
+        "nelder-mead" => {
             let mut s = NelderMead::default();
             if let Some(n) = e.max_iterations {
                 s.max_iters = n;
             }
             AnySolver::new(s)
         }
+        // A name validated at the door that takes no budget: the registry's defaults.
+        other => SolverRegistry::builtin()
+            .build(&name_table(SolverRegistry::builtin().key(), other))
+            .unwrap_or_default(),
     };
     if e.multistart > 0 {
         AnySolver::new(MultiStart::new(
@@ -294,16 +322,12 @@ pub fn truth_values(
     Ok(out)
 }
 
-fn options(
-    exp: &Experiment,
-    seed: u64,
-    covariance: bool,
-) -> EstimateOptions<AnySolver, DirichletWindow> {
-    EstimateOptions {
+fn options(exp: &Experiment, seed: u64, covariance: bool) -> FitOptions {
+    FitOptions {
         frequencies: exp.estimate.frequencies.clone(),
-        window: DirichletWindow,
-        solver: solver(exp, seed),
+        solver: Some(solver(exp, seed)),
         covariance,
+        noise_std_start: None,
     }
 }
 
@@ -314,35 +338,20 @@ fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
     JitterRegistry::builtin().build(&spec)
 }
 
-fn run_criterion<C: Criterion>(
+fn run_criterion(
     exp: &Experiment,
     s: &Structure,
     record: &Record,
-    criterion: &C,
-    opts: &EstimateOptions<AnySolver, DirichletWindow>,
+    criterion: &AnyCriterion,
+    opts: &FitOptions,
 ) -> Result<(Estimate, Structure, Option<u32>), EstimateError> {
     if profiled(exp) {
         if let (Some(u), Some((lo, hi))) =
             (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
         {
-            let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
-                signal: s.signal.clone(),
-                jitter: *u,
-                noise: s.noise.clone(),
-                estimate_signal: s.estimate_signal,
-                estimate_jitter: s.estimate_jitter,
-                estimate_noise: s.estimate_noise,
-                noise_std: s.noise_std,
-            };
             let values = i64::from(lo)..=i64::from(hi);
-            let p = profile(
-                &us,
-                record,
-                criterion,
-                opts,
-                values,
-                uniform_sum_with_std(u.std_dev()),
-            )?;
+            let build = uniform_sum_with_std(u.std_dev());
+            let p = criterion.profile(s, record, opts, values, build)?;
             let n = p.value as u32;
             let mut base = s.clone();
             base.jitter = with_n(&s.jitter, n)?;
@@ -350,7 +359,7 @@ fn run_criterion<C: Criterion>(
             return Ok((p.estimate, fitted, Some(n)));
         }
     }
-    let e = estimate(s, record, criterion, opts)?;
+    let e = criterion.fit(s, record, opts)?;
     let fitted = s.with_params(&e.params)?;
     Ok((e, fitted, None))
 }
@@ -395,11 +404,11 @@ pub fn fit(
                 n,
             })
         };
-    let e = match method {
-        Method::Ls => raw(run_criterion(exp, s, record, &Ls, &opts))?,
-        Method::Bcls => raw(run_criterion(exp, s, record, &Bcls, &opts))?,
-        Method::Bj => raw(run_criterion(exp, s, record, &BoxJenkins, &opts))?,
-        Method::Ml => fit_ml(exp, s, record, covariance)?,
+    let criterion = method.criterion();
+    let e = if criterion.is_likelihood() {
+        fit_ml(exp, s, record, method, covariance)?
+    } else {
+        raw(run_criterion(exp, s, record, &criterion, &opts))?
     };
     let names = report_names(exp, s);
     let se = |i: usize| {
@@ -424,7 +433,10 @@ pub fn fit(
     }
     if let Some(n) = e.n {
         let a = at(ns);
-        let k = (3.0 * (f64::from(n) + 1.0)).sqrt();
+        // σ = a/√(3(n+1)); the divisor is the half-width of the unit-σ member.
+        let k = uniform_sum_with_std(1.0)(i64::from(n))
+            .map_err(|e| e.to_string())?
+            .params()[0];
         push(f64::from(n), None);
         push(a, se(ns));
         push(a / k, se(ns).map(|s| s / k));
@@ -455,17 +467,18 @@ pub fn fit(
 }
 
 #[cfg(not(feature = "ml"))]
-fn fit_ml(_: &Experiment, _: &Structure, _: &Record, _: bool) -> Result<Raw, String> {
+fn fit_ml(_: &Experiment, _: &Structure, _: &Record, _: Method, _: bool) -> Result<Raw, String> {
     Err("maximum likelihood is not available in this build of jitterid".into())
 }
 
-/// Maximum likelihood: the exact likelihood for white noise, the Gaussian (quasi) likelihood
-/// of the first two moments for an ARMA noise model.
+/// Maximum likelihood: `"ml"` is the exact likelihood for white noise and the Gaussian (quasi)
+/// likelihood of the first two moments for an ARMA noise model; `"quasi-ml"` is the latter.
 #[cfg(feature = "ml")]
 fn fit_ml(
     exp: &Experiment,
     s: &Structure,
     record: &Record,
+    method: Method,
     covariance: bool,
 ) -> Result<Raw, String> {
     use jitterid::estimate::ml::{
@@ -483,18 +496,9 @@ fn fit_ml(
             if let (Some(u), Some((lo, hi))) =
                 (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
             {
-                let us: ModelStructure<AnySignal, UniformSum, AnyNoise> = ModelStructure {
-                    signal: s.signal.clone(),
-                    jitter: *u,
-                    noise: s.noise.clone(),
-                    estimate_signal: s.estimate_signal,
-                    estimate_jitter: s.estimate_jitter,
-                    estimate_noise: s.estimate_noise,
-                    noise_std: s.noise_std,
-                };
                 let values = i64::from(lo)..=i64::from(hi);
                 let build = uniform_sum_with_std(u.std_dev());
-                let p = ml_profile(&us, record, c, opts, values, build).map_err(e)?;
+                let p = ml_profile(s, record, c, opts, values, build).map_err(e)?;
                 let n = p.value as u32;
                 let mut base = s.clone();
                 base.jitter = with_n(&s.jitter, n).map_err(|x| x.to_string())?;
@@ -512,7 +516,7 @@ fn fit_ml(
     if let Some(max_seconds) = exp.estimate.max_seconds {
         opts.solver.bfgs.max_seconds = max_seconds;
     }
-    let (e, n, base) = if s.noise.is_white() {
+    let (e, n, base) = if s.noise.is_white() && method.as_str() == "ml" {
         go(exp, s, record, &ExactMl::default(), &opts)?
     } else {
         go(exp, s, record, &QuasiMl, &opts)?

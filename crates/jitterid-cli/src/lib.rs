@@ -15,7 +15,6 @@ pub mod fingerprint;
 pub mod fitting;
 pub mod inputs;
 pub mod merge;
-pub mod models;
 pub mod output;
 pub mod plots;
 pub mod progress;

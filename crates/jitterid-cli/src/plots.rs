@@ -3,12 +3,14 @@
 use crate::error::CliResult;
 use crate::experiment::Experiment;
 use crate::fitting::Structure;
-use crate::models::AnySignal;
 use crate::svg::{self, figure, Panel, Series, Style, BLACK, BLUE, GREEN, GREY, ORANGE, RED};
 use jitterid::jitter::AnyJitter;
 use jitterid::jitter::{JitterModel, NoJitter};
 use jitterid::num_complex::Complex64;
-use jitterid::signal::{Input, SampleGrid, Signal};
+use jitterid::signal::registry::{SignalRegistry, SpecReader};
+use jitterid::signal::{
+    AnySignal, Input, RationalModel, SampleGrid, Signal, SignalError, TransferFunction, Zpk,
+};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 
 /// `|X(f)|` of a sequence on the grid at the DFT frequencies (zero excluded).
@@ -52,13 +54,35 @@ fn log_band(grid: &SampleGrid) -> Vec<f64> {
 /// Points of a curve.
 type Curve = Vec<(f64, f64)>;
 
+/// `G(i2πf)` of a rational system (rebuilt from the signal's spec table), `None` for other
+/// signals.
+fn frequency_response(signal: &AnySignal, f: f64) -> Option<Complex64> {
+    let spec = signal.spec();
+    let kind = SignalRegistry::builtin().kind(signal.kind())?;
+    let rebuilt = || -> Result<Option<Complex64>, SignalError> {
+        let r = SpecReader::new(kind, &spec)?;
+        Ok(match signal.kind() {
+            "zpk" => Some(
+                Zpk::new(r.f64("gain")?, r.roots("zeros")?, r.roots("poles")?)?
+                    .frequency_response(f),
+            ),
+            "tf" => Some(
+                TransferFunction::new(&r.f64_list("num")?, &r.f64_list("den")?)?
+                    .frequency_response(f),
+            ),
+            _ => None,
+        })
+    };
+    rebuilt().ok().flatten()
+}
+
 /// Magnitude and unwrapped phase (degrees) of `G(i2πf)`.
 fn bode_points(signal: &AnySignal, fs: &[f64]) -> Option<(Curve, Curve)> {
     let mut mag = Vec::with_capacity(fs.len());
     let mut phase = Vec::with_capacity(fs.len());
     let mut prev: Option<f64> = None;
     for &f in fs {
-        let g = signal.frequency_response(f)?;
+        let g = frequency_response(signal, f)?;
         mag.push((f, g.norm()));
         // Unwrapped phase in degrees.
         let mut p = g.arg().to_degrees();
@@ -164,7 +188,7 @@ pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
     let mut out = Vec::new();
     let data = spectrum(grid, p.y);
     let title = exp.title.clone().unwrap_or_else(|| exp.file.clone());
-    if p.file_model.frequency_response(0.0).is_some() {
+    if frequency_response(p.file_model, 0.0).is_some() {
         out.push(("bode.svg".to_string(), fit_bode(p, &data, &title)));
     }
     out.push(("spectrum.svg".to_string(), fit_spectrum(p, &data, &title)));
@@ -451,7 +475,7 @@ pub fn montecarlo_figures(p: &McPlots<'_>) -> Vec<(String, String)> {
     let exp = p.exp;
     let title = exp.title.clone().unwrap_or_else(|| exp.file.clone());
     let mut out = vec![("histograms.svg".to_string(), mc_histograms(p, &title))];
-    if exp.system.estimate && p.true_signal.frequency_response(0.0).is_some() {
+    if exp.system.estimate && frequency_response(p.true_signal, 0.0).is_some() {
         out.push(("bode.svg".to_string(), mc_bode(p, &title)));
     }
     if exp.jitter.estimate {

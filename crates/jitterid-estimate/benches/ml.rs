@@ -14,6 +14,7 @@ use jitterid_estimate::ml::{
     ml_estimate, ml_profile, ExactMl, LikelihoodObjective, MlOptions, QuasiMl,
 };
 use jitterid_estimate::{ModelStructure, Objective, Record};
+use jitterid_jitter::registry::JitterRegistry;
 use jitterid_jitter::UniformSum;
 use jitterid_jitter::{JitterError, JitterModel};
 use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Zpk};
@@ -21,10 +22,18 @@ use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::hint::black_box;
 
-/// The uniform-sum jitter with `n` terms and the standard deviation of `start`.
+/// The uniform-sum jitter with `n + 1` terms and the standard deviation of `start`, through the
+/// registry.
 fn keep_std_dev(start: &UniformSum) -> impl Fn(i64) -> Result<UniformSum, JitterError> + Sync {
     let sigma = start.std_dev();
-    move |n| UniformSum::new(n as u32, sigma * (3.0 * (n as f64 + 1.0)).sqrt())
+    move |n| {
+        let mut spec = serde_json::Map::new();
+        spec.insert("n".into(), n.into());
+        let j = JitterRegistry::builtin().from_std_dev("uniform-sum", sigma, &spec)?;
+        Ok(*j
+            .downcast_ref::<UniformSum>()
+            .expect("the uniform-sum family holds a UniformSum"))
+    }
 }
 
 fn table1_setup(seed: u64) -> (ModelStructure<LtiResponse<Zpk>, UniformSum>, Record) {

@@ -3,7 +3,7 @@
 use super::checks::{describe, number};
 use super::diagnostics::Source;
 use super::raw::RawEstimate;
-use super::spec::{EstimateSpec, Method, SolverKind};
+use super::spec::{EstimateSpec, Method, SolverName};
 use crate::error::CliResult;
 use jitterid::estimate::Frequencies;
 use jitterid::signal::SampleGrid;
@@ -17,15 +17,16 @@ pub(super) fn parse_estimate(
     grid: &SampleGrid,
 ) -> CliResult<EstimateSpec> {
     let method = match &r.method {
-        None => Method::Bcls,
+        None => Method::BCLS,
         Some(m) => Method::parse(m.get_ref()).ok_or_else(|| {
             cx.err(
                 S,
                 "method",
                 &m.span(),
                 format!(
-                    "unknown method \"{}\"; expected \"ls\", \"bcls\", \"bj\" or \"ml\"",
-                    m.get_ref()
+                    "unknown method \"{}\"; expected {}",
+                    m.get_ref(),
+                    Method::names()
                 ),
             )
         })?,
@@ -35,7 +36,7 @@ pub(super) fn parse_estimate(
         Some(v) => parse_frequencies(cx, v, grid)?,
     };
     let solver = match &r.solver {
-        None => SolverKind::Lm,
+        None => SolverName::LM,
         Some(s) => parse_solver(cx, s)?,
     };
     let multistart = whole_number(
@@ -71,21 +72,18 @@ pub(super) fn parse_estimate(
     })
 }
 
-fn parse_solver(cx: &Source, s: &Spanned<String>) -> CliResult<SolverKind> {
-    Ok(match s.get_ref().as_str() {
-        "lm" | "levenberg-marquardt" => SolverKind::Lm,
-        "gauss-newton" => SolverKind::GaussNewton,
-        "nelder-mead" => SolverKind::NelderMead,
-        other => {
-            return Err(cx.err(
-                S,
-                "solver",
-                &s.span(),
-                format!(
-                "unknown solver \"{other}\"; expected \"lm\", \"gauss-newton\" or \"nelder-mead\""
+fn parse_solver(cx: &Source, s: &Spanned<String>) -> CliResult<SolverName> {
+    SolverName::parse(s.get_ref()).ok_or_else(|| {
+        cx.err(
+            S,
+            "solver",
+            &s.span(),
+            format!(
+                "unknown solver \"{}\"; expected {}",
+                s.get_ref(),
+                SolverName::names()
             ),
-            ))
-        }
+        )
     })
 }
 

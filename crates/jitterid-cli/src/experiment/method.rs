@@ -33,12 +33,12 @@ pub(super) fn check_method(
     };
     let flag = raw.system.as_ref().and_then(|s| s.estimate.as_ref());
     let at_system = |msg: &str| cx.err_at("system", "estimate", flag, msg);
-    if method == Method::Ml && !cfg!(feature = "ml") {
+    if method.is_likelihood() && !cfg!(feature = "ml") {
         return Err(blame(
             "maximum likelihood is not available in this build of jitterid (built without the `ml` feature); use \"bcls\" (or \"ls\", \"bj\")",
         ));
     }
-    if method == Method::Ls && parts.jitter.estimate {
+    if method == Method::LS && parts.jitter.estimate {
         return Err(blame(
             "naive least squares ignores the jitter and cannot estimate it; use \"bcls\" or set [jitter] estimate = false",
         ));
@@ -58,7 +58,7 @@ pub(super) fn check_method(
             "only the noise level is marked for estimation; it is estimated together with the system or the jitter, so set estimate = true in [system] or [jitter]",
         ));
     }
-    if method == Method::Ls && !system {
+    if method == Method::LS && !system {
         return Err(blame(
             "naive least squares has nothing to estimate when the system is known",
         ));

@@ -23,16 +23,15 @@ mod system;
 pub use input::MAX_SWITCHES;
 pub use sampling::MAX_SAMPLES;
 pub use spec::{
-    EstimateSpec, Experiment, InputSpec, JitterSpec, Method, NoiseSpec, SolverKind, SystemKind,
-    SystemSpec,
+    name_table, EstimateSpec, Experiment, InputSpec, JitterSpec, Method, NoiseSpec, SolverName,
+    SystemKind, SystemSpec,
 };
 
 use crate::cli_err;
 use crate::csvio;
 use crate::error::CliResult;
-use crate::models::AnyNoise;
 use diagnostics::{shape_error, toml_error, Source};
-use jitterid::estimate::Frequencies;
+use jitterid::estimate::{AnyNoise, Frequencies};
 use raw::RawExperiment;
 use std::path::{Path, PathBuf};
 
@@ -96,16 +95,17 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
         Some(r) => noise::parse_noise(&cx, r)?,
         None => NoiseSpec {
             std: 0.0,
-            shape: AnyNoise::White,
+            model: "white".into(),
+            shape: AnyNoise::default(),
             estimate: false,
         },
     };
     let mut estimate = match &raw.estimate {
         Some(r) => estimate::parse_estimate(&cx, r, &grid)?,
         None => EstimateSpec {
-            method: Method::Bcls,
+            method: Method::BCLS,
             frequencies: Frequencies::Dft,
-            solver: SolverKind::Lm,
+            solver: SolverName::LM,
             multistart: 0,
             multistart_radius: 0.5,
             perturb: 0.2,

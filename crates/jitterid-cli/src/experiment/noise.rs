@@ -5,8 +5,7 @@ use super::range;
 use super::raw::RawNoise;
 use super::spec::NoiseSpec;
 use crate::error::CliResult;
-use crate::models::AnyNoise;
-use jitterid::estimate::ArmaNoise;
+use jitterid::estimate::{AnyNoise, ArmaNoise, WhiteNoise};
 
 const S: &str = "noise";
 
@@ -32,7 +31,7 @@ pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
     let shape = match model {
         "white" => {
             cx.only(S, &present, "model", &["std", "model", "estimate"], "white")?;
-            AnyNoise::White
+            AnyNoise::new(WhiteNoise)
         }
         "arma" => {
             let c = match &r.c {
@@ -43,7 +42,7 @@ pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
                 Some(v) => cx.finite_list(S, "d", v)?,
                 None => Vec::new(),
             };
-            AnyNoise::Arma(ArmaNoise::new(c, d).map_err(|e| {
+            AnyNoise::new(ArmaNoise::new(c, d).map_err(|e| {
                 let span = r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
                 cx.err(S, "model", &span, e)
             })?)
@@ -60,6 +59,7 @@ pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
     };
     Ok(NoiseSpec {
         std,
+        model: model.to_string(),
         shape,
         estimate,
     })

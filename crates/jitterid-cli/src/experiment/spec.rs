@@ -1,9 +1,12 @@
 //! The validated experiment: what every command reads, with nothing left to check.
 
-use crate::models::AnyNoise;
-use jitterid::estimate::Frequencies;
+use jitterid::estimate::solver::SolverRegistry;
+use jitterid::estimate::{
+    AnyCriterion, AnyNoise, CriterionRegistry, Frequencies, NoiseModel, SpecTable,
+};
 use jitterid::jitter::AnyJitter;
 use jitterid::signal::{Input, RandomBinary, SampleGrid, Sinusoid, TransferFunction, Zpk};
+use std::fmt;
 use std::path::PathBuf;
 
 /// How the input is obtained.
@@ -55,61 +58,182 @@ pub struct JitterSpec {
 }
 
 /// The `[noise]` section.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone)]
 pub struct NoiseSpec {
     /// Standard deviation of the white noise `e_k` (of `v_k` itself for white noise).
     pub std: f64,
+    /// The registry name of the noise model (`"white"`, `"arma"`).
+    pub model: String,
     /// The noise shape `H`.
     pub shape: AnyNoise,
     /// Whether the noise level (and, with method `bj`, the shape) is estimated.
     pub estimate: bool,
 }
 
-/// Estimation method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// Naive least squares (jitter ignored).
-    Ls,
-    /// Bias-compensated least squares.
-    Bcls,
-    /// The Box–Jenkins frequency-domain criterion (BCLS weighted by the noise shape).
-    Bj,
-    /// Maximum likelihood.
-    Ml,
-}
-
-impl Method {
-    /// The name used in files and on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Method::Ls => "ls",
-            Method::Bcls => "bcls",
-            Method::Bj => "bj",
-            Method::Ml => "ml",
+impl NoiseSpec {
+    /// The shape by name and parameters, which is what identifies it (`White`,
+    /// `Arma(["c1", "d1"], [0.5, -0.3])`).
+    fn shape_text(&self) -> String {
+        let name = upper_camel(&self.model);
+        let names = self.shape.param_names();
+        if names.is_empty() {
+            name
+        } else {
+            format!("{name}({names:?}, {:?})", self.shape.params())
         }
     }
+}
 
-    /// Parses a method name.
-    pub fn parse(s: &str) -> Option<Self> {
-        Some(match s {
-            "ls" => Method::Ls,
-            "bcls" => Method::Bcls,
-            "bj" => Method::Bj,
-            "ml" => Method::Ml,
-            _ => return None,
-        })
+impl fmt::Debug for NoiseSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("NoiseSpec")
+            .field("std", &self.std)
+            .field("shape", &format_args!("{}", self.shape_text()))
+            .field("estimate", &self.estimate)
+            .finish()
     }
 }
 
-/// Solver kind.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SolverKind {
-    /// Levenberg–Marquardt.
-    Lm,
-    /// Gauss–Newton with line search.
-    GaussNewton,
-    /// Nelder–Mead.
-    NelderMead,
+impl PartialEq for NoiseSpec {
+    fn eq(&self, other: &Self) -> bool {
+        self.std == other.std
+            && self.estimate == other.estimate
+            && self.model == other.model
+            && self.shape.params() == other.shape.params()
+    }
+}
+
+/// An estimation method: the name of a [`CriterionRegistry`] entry that the command line can
+/// build from its name alone (`"ls"`, `"bcls"`, `"bj"`, `"ml"`, `"quasi-ml"`), validated where
+/// it enters. `"ml"` is the exact likelihood for white noise and the quasi-likelihood for a
+/// shaped noise model.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct Method(&'static str);
+
+impl Method {
+    /// Naive least squares (jitter ignored): the comparison fit of `fit --plot`.
+    pub const LS: Method = Method("ls");
+    /// Bias-compensated least squares: the default.
+    pub const BCLS: Method = Method("bcls");
+
+    /// The name used in files and on the command line.
+    pub fn as_str(self) -> &'static str {
+        self.0
+    }
+
+    /// The registry's method of this name, if the command line can run it.
+    pub fn parse(s: &str) -> Option<Self> {
+        let registry = CriterionRegistry::builtin();
+        let entry = registry.entry(s)?;
+        registry
+            .build(&name_table(registry.key(), entry.name))
+            .ok()
+            .map(|_| Method(entry.name))
+    }
+
+    /// The names [`parse`](Self::parse) accepts, quoted, for messages.
+    pub fn names() -> String {
+        let registry = CriterionRegistry::builtin();
+        let names: Vec<&str> = registry
+            .entries()
+            .iter()
+            .map(|e| e.name)
+            .filter(|n| Method::parse(n).is_some())
+            .collect();
+        quoted_list(&names)
+    }
+
+    /// The criterion, built through the registry.
+    pub fn criterion(self) -> AnyCriterion {
+        // Only names that built at the door are held.
+        let registry = CriterionRegistry::builtin();
+        registry
+            .build(&name_table(registry.key(), self.0))
+            .unwrap_or_else(|_| AnyCriterion::first_moment(jitterid::estimate::Bcls))
+    }
+
+    /// Whether the method is a likelihood (its cost is `−log L`).
+    pub fn is_likelihood(self) -> bool {
+        self.criterion().is_likelihood()
+    }
+}
+
+impl fmt::Debug for Method {
+    /// The name in upper camel case (`bcls` → `Bcls`), the spelling the fingerprint has always
+    /// hashed.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&upper_camel(self.0))
+    }
+}
+
+/// A solver: the name of a [`SolverRegistry`] entry the command line offers (`"lm"`, also
+/// spelled `"levenberg-marquardt"`; `"gauss-newton"`; `"nelder-mead"`), validated where it
+/// enters.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct SolverName(&'static str);
+
+impl SolverName {
+    /// Levenberg–Marquardt: the default.
+    pub const LM: SolverName = SolverName("lm");
+    /// The solvers that take the command line's iteration budget and progress bar.
+    const OFFERED: [&'static str; 3] = ["lm", "gauss-newton", "nelder-mead"];
+
+    /// The registry name.
+    pub fn as_str(self) -> &'static str {
+        self.0
+    }
+
+    /// The registry's solver of this name (or alias), if the command line offers it.
+    pub fn parse(s: &str) -> Option<Self> {
+        let s = if s == "levenberg-marquardt" { "lm" } else { s };
+        let registry = SolverRegistry::builtin();
+        let entry = registry.entry(s)?;
+        Self::OFFERED
+            .contains(&entry.name)
+            .then_some(SolverName(entry.name))
+    }
+
+    /// The names [`parse`](Self::parse) accepts, quoted, for messages.
+    pub fn names() -> String {
+        quoted_list(&Self::OFFERED)
+    }
+}
+
+impl fmt::Debug for SolverName {
+    /// The name in upper camel case (`gauss-newton` → `GaussNewton`), the spelling the
+    /// fingerprint has always hashed.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&upper_camel(self.0))
+    }
+}
+
+/// `{key: name}`: the spec table that names a registry entry without keys.
+pub fn name_table(key: &str, name: &str) -> SpecTable {
+    let mut t = SpecTable::new();
+    t.insert(key.into(), name.into());
+    t
+}
+
+/// `"a", "b" or "c"`.
+fn quoted_list(names: &[&str]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
+    match quoted.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+/// `gauss-newton` → `GaussNewton`.
+pub(crate) fn upper_camel(name: &str) -> String {
+    name.split('-')
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|h| h.to_uppercase().chain(c).collect::<String>())
+                .unwrap_or_default()
+        })
+        .collect()
 }
 
 /// The `[estimate]` section.
@@ -120,7 +244,7 @@ pub struct EstimateSpec {
     /// The frequency set.
     pub frequencies: Frequencies,
     /// The solver.
-    pub solver: SolverKind,
+    pub solver: SolverName,
     /// Number of extra, perturbed starts.
     pub multistart: usize,
     /// Relative radius of the multistart perturbations.

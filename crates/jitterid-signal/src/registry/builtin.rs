@@ -40,7 +40,9 @@ fn input_of(input: Option<&Input>) -> Result<Input, SignalError> {
     })
 }
 
-fn roots_json(roots: &[Root]) -> Value {
+/// Roots as a spec table writes them: a number for a real root, `[re, im]` for a pair
+/// (what [`SpecReader::roots`](super::SpecReader::roots) reads back).
+pub fn roots_json(roots: &[Root]) -> Value {
     roots
         .iter()
         .map(|r| match *r {

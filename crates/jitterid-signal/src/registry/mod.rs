@@ -39,6 +39,7 @@
 mod builtin;
 mod reader;
 
+pub use builtin::roots_json;
 pub use jitterid_jitter::registry::ParamSpec;
 pub use reader::SpecReader;
 
