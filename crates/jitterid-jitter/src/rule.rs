@@ -12,6 +12,7 @@
 use crate::JitterModel;
 
 pub use crate::kernels::gauss::{gauss_legendre, gl16, GL_ORDER};
+use crate::kernels::gauss::{panels, subdivisions};
 
 /// Largest `rate × width` allowed on one sub-interval: with 16 nodes the Gauss–Legendre error
 /// for `e^{zτ}` with `|z|·width ≤ 6` is below `1e-15` relative.
@@ -62,17 +63,7 @@ impl QuadratureRule {
             return;
         }
         let (x, w) = gl16();
-        let width = hi - lo;
-        let pieces = if rate.is_finite() && rate > 0.0 {
-            ((rate * width / MAX_RATE_WIDTH).ceil() as usize).clamp(1, MAX_SUBDIVISIONS)
-        } else {
-            1
-        };
-        let h = width / pieces as f64;
-        for p in 0..pieces {
-            let a = lo + p as f64 * h;
-            let b = if p + 1 == pieces { hi } else { a + h };
-            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        for (mid, half) in panels(lo, hi, subdivisions(rate, hi - lo)) {
             for (xi, wi) in x.iter().zip(w) {
                 let t = mid + half * xi;
                 let d = density(t);

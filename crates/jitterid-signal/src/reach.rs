@@ -36,10 +36,12 @@
 //! moment `E[s(t_k + τ)²]`, and tells when they would still be too large (the response then
 //! expands the square and uses [`InReach`] at sums of poles).
 
-use jitterid_jitter::rule::{gl16, GL_ORDER, MAX_RATE_WIDTH, MAX_SUBDIVISIONS};
+use jitterid_jitter::kernels::chebyshev::ChebyshevBasis;
+use jitterid_jitter::kernels::complex::cexp;
+use jitterid_jitter::kernels::filon::FilonIntegrand;
+use jitterid_jitter::kernels::gauss::{gl16, panels, subdivisions, GL_ORDER};
 use jitterid_jitter::JitterModel;
 use num_complex::Complex64;
-use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 /// Beyond `x = DECAY/|Re p|` a modal term `e^{p x}` is below `e^{−50} ≈ 1.9e-22` of its value
@@ -69,27 +71,6 @@ const MAX_SEGMENTS: usize = 1 << 14;
 
 const ZERO: Complex64 = Complex64::new(0.0, 0.0);
 
-/// `e^w`, exactly zero once the modulus underflows (so that a huge imaginary part cannot turn
-/// `0 · sin(∞)` into a NaN).
-#[inline]
-fn cexp(w: Complex64) -> Complex64 {
-    if w.re < -746.0 {
-        ZERO
-    } else {
-        w.exp()
-    }
-}
-
-/// Sub-intervals of a quadrature over `width` for an integrand varying at `rate`, as in the
-/// jitter crate's rules.
-fn parts(rate: f64, width: f64) -> usize {
-    if rate.is_finite() && rate > 0.0 && width > 0.0 {
-        ((rate * width / MAX_RATE_WIDTH).ceil() as usize).clamp(1, MAX_SUBDIVISIONS)
-    } else {
-        1
-    }
-}
-
 /// Gauss–Legendre quadrature of the density on `τ ∈ [origin + a, origin + b]`, refined for
 /// `rate`: calls `f(x, w)` with `x = τ − origin` and the density folded into `w`, and returns
 /// the number of density evaluations. The nodes are placed in `x` so that `x` (on which the
@@ -106,12 +87,8 @@ fn quadrature(
         return 0;
     }
     let (x, w) = gl16();
-    let n = parts(rate, b - a);
-    let h = (b - a) / n as f64;
-    for p in 0..n {
-        let lo = a + p as f64 * h;
-        let hi = if p + 1 == n { b } else { lo + h };
-        let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+    let n = subdivisions(rate, b - a);
+    for (mid, half) in panels(a, b, n) {
         for (xi, wi) in x.iter().zip(w) {
             let t = mid + half * xi;
             let d = jitter.pdf(origin + t);
@@ -127,82 +104,6 @@ fn quadrature(
 /// (16 density evaluations whatever the rate); below it the plain rule is as cheap and needs
 /// nothing of the density beyond the pieces' contract.
 const FILON_PARTS: usize = 4;
-
-/// `(2k+1)/2 · w_j · P_k(s_j)` at the Gauss–Legendre nodes: the Legendre coefficients of the
-/// degree-15 interpolant through 16 values at the nodes.
-struct Legendre {
-    coef: [[f64; GL_ORDER]; GL_ORDER],
-}
-
-fn legendre() -> &'static Legendre {
-    static L: OnceLock<Legendre> = OnceLock::new();
-    L.get_or_init(|| {
-        let (s, w) = gl16();
-        let mut coef = [[0.0; GL_ORDER]; GL_ORDER];
-        for (j, (&x, &wj)) in s.iter().zip(w).enumerate() {
-            let (mut p0, mut p1) = (1.0, x);
-            for (k, row) in coef.iter_mut().enumerate() {
-                let pk = if k == 0 { p0 } else { p1 };
-                row[j] = (2 * k + 1) as f64 / 2.0 * wj * pk;
-                if k >= 1 {
-                    let p2 = ((2 * k + 1) as f64 * x * p1 - k as f64 * p0) / (k + 1) as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-            }
-        }
-        Legendre { coef }
-    })
-}
-
-/// `N_k = ∫_{−1}^{1} P_k(s) e^{ω(s+1)} ds` for `k = 0..=16`, `Re ω ≤ 0`, `|ω| > 3`.
-///
-/// Integrating `(2k+1) P_k = P'_{k+1} − P'_{k−1}` by parts gives
-/// `N_{k+1} = N_{k−1} − (2k+1) N_k / ω`. Forward from `N_0 = (e^{2ω} − 1)/ω` it is stable while
-/// `k ≲ |ω|`; below, `N_k` is the recurrence's minimal solution, computed backward (Miller)
-/// from well beyond `k = 16` and normalised by the Legendre series of `e^{ω(s+1)}` at `s = −1`,
-/// `Σ (2k+1)/2 (−1)^k N_k = 1`.
-fn exp_legendre_moments(omega: Complex64, n: &mut [Complex64; GL_ORDER + 1]) {
-    let r = omega.norm();
-    if r >= (GL_ORDER + 1) as f64 {
-        let e2 = cexp(2.0 * omega);
-        let inv = omega.inv();
-        n[0] = (e2 - 1.0) * inv;
-        n[1] = (e2 + 1.0 - n[0]) * inv;
-        for k in 1..GL_ORDER {
-            n[k + 1] = n[k - 1] - n[k] * inv * (2 * k + 1) as f64;
-        }
-        return;
-    }
-    // The minimal solution falls like |ω|^k/(2k+1)!!: from this start its truncation error is
-    // far below rounding at k ≤ 16.
-    let top = 2 * GL_ORDER + 2 * (r.ceil() as usize) + 16;
-    let inv = omega.inv();
-    let (mut above, mut cur) = (ZERO, Complex64::new(1.0, 0.0));
-    let sign = |k: usize| if k % 2 == 0 { 1.0 } else { -1.0 };
-    let mut norm = cur * ((2 * top + 1) as f64 / 2.0 * sign(top));
-    n.fill(ZERO);
-    for k in (1..=top).rev() {
-        let below = above + cur * inv * (2 * k + 1) as f64;
-        above = cur;
-        cur = below;
-        if k - 1 <= GL_ORDER {
-            n[k - 1] = cur;
-        }
-        norm += cur * ((2 * k - 1) as f64 / 2.0 * sign(k - 1));
-        if cur.norm() > 1e100 {
-            // The recurrence is linear; keep the moduli far from overflow (also of |z|² in
-            // complex division).
-            above *= 1e-100;
-            cur *= 1e-100;
-            norm *= 1e-100;
-            n.iter_mut().for_each(|x| *x *= 1e-100);
-        }
-    }
-    let m = norm.norm();
-    let unit = (norm / m).conj() / m;
-    n.iter_mut().for_each(|x| *x *= unit);
-}
 
 /// Refinement zones after an origin (a step, or the start of the reach): `(x_end, rate)` with
 /// increasing `x_end`; on `[previous x_end, x_end)` the poles still alive vary at most at
@@ -401,7 +302,7 @@ impl<'a> InReach<'a> {
             }
             let end = x_end.min(len);
             if end > start {
-                count += if parts(rate, end - start) > FILON_PARTS {
+                count += if subdivisions(rate, end - start) > FILON_PARTS {
                     self.filon(c, start, end, out)
                 } else {
                     quadrature(self.jitter, c, start, end, rate, |x, w| {
@@ -453,38 +354,12 @@ impl<'a> InReach<'a> {
             *fj = self.jitter.pdf(c + (xm + h * sj));
         }
         out[0] += h * f.iter().zip(w).map(|(f, w)| f * w).sum::<f64>();
-        // Legendre coefficients of the interpolant.
-        let mut fk = [0.0; GL_ORDER];
-        for (fk, row) in fk.iter_mut().zip(&legendre().coef) {
-            *fk = row.iter().zip(&f).map(|(a, b)| a * b).sum();
-        }
-        let mut n = [ZERO; GL_ORDER + 1];
+        let integrand = FilonIntegrand::new(&f);
         for (i, p) in self.poles.iter().enumerate() {
-            let omega = p * h;
             // `∫ e^{px} p(τ) dx = h e^{p xa} ∫ e^{ω(s+1)} f(s) ds` with `|e^{ω(s+1)}| ≤ 1`, and
-            // the same with `x = xa + h(s+1)` for `B`.
-            let (a, m) = if omega.norm() <= 3.0 {
-                // Resolved by the nodes themselves (as in `quadrature`).
-                let mut a = ZERO;
-                let mut m = ZERO;
-                for ((sj, wj), fj) in s.iter().zip(w).zip(&f) {
-                    let e = cexp(omega * (sj + 1.0)) * (wj * fj);
-                    a += e;
-                    m += e * (sj + 1.0);
-                }
-                (a, m)
-            } else {
-                exp_legendre_moments(omega, &mut n);
-                let mut a = ZERO;
-                let mut m = ZERO;
-                for (k, &c) in fk.iter().enumerate() {
-                    a += c * n[k];
-                    // (s + 1) P_k = ((k+1) P_{k+1} + k P_{k−1})/(2k+1) + P_k.
-                    let below = if k > 0 { n[k - 1] * k as f64 } else { ZERO };
-                    m += c * ((n[k + 1] * (k + 1) as f64 + below) / (2 * k + 1) as f64 + n[k]);
-                }
-                (a, m)
-            };
+            // the same with `x = xa + h(s+1)` for `B`; a slow pole (`|ω| ≤ 3`) is resolved by
+            // the nodes themselves, as in `quadrature`.
+            let (a, m) = integrand.integrate(p * h);
             let scale = cexp(p * xa) * h;
             out[1 + i] += scale * a;
             if self.with_b {
@@ -561,7 +436,7 @@ impl<'a> InReach<'a> {
             }
             let end = x_end.min(len);
             if end > start {
-                let k = parts(rate, end - start);
+                let k = subdivisions(rate, end - start);
                 n += if k > FILON_PARTS { 2 } else { k } * GL_ORDER;
                 start = end;
             }
@@ -593,6 +468,7 @@ impl<'a> InReach<'a> {
         // Values at the n nodes, then at the n + 1 test points (from the right end to the left).
         let mut vals = vec![ZERO; (2 * n + 1) * nf];
         let mut coef = vec![ZERO; n * nf];
+        let mut node_vals = [ZERO; CHEB_N];
         let mut anchor = vec![ZERO; nf];
         for m in 0..k.len() - 1 {
             let (k0, k1) = (k[m], k[m + 1]);
@@ -611,14 +487,14 @@ impl<'a> InReach<'a> {
                     // that it carries no rounding error of `c` (the functions vary at `|p|`).
                     let (c, delta) = match i.checked_sub(n) {
                         None => (
-                            b - half * (1.0 - basis.nodes[i]),
-                            half * (1.0 - basis.nodes[i]),
+                            b - half * (1.0 - basis.nodes()[i]),
+                            half * (1.0 - basis.nodes()[i]),
                         ),
                         Some(0) => (b, 0.0),
                         Some(l) if l == n => (a, b - a),
                         Some(l) => (
-                            b - half * (1.0 - basis.tests[l]),
-                            half * (1.0 - basis.tests[l]),
+                            b - half * (1.0 - basis.extrema()[l]),
+                            half * (1.0 - basis.extrema()[l]),
                         ),
                     };
                     v.fill(ZERO);
@@ -635,23 +511,16 @@ impl<'a> InReach<'a> {
                         *sc = sc.max(x.norm());
                     }
                 }
-                for f in 0..nf {
-                    for (j, row) in basis.dct.iter().enumerate() {
-                        coef[f * n + j] = row
-                            .iter()
-                            .zip(vals.chunks(nf))
-                            .map(|(d, v)| *d * v[f])
-                            .sum();
+                for (f, co) in coef.chunks_mut(n).enumerate() {
+                    for (x, v) in node_vals.iter_mut().zip(vals.chunks(nf)) {
+                        *x = v[f];
                     }
+                    basis.coefficients_into(&node_vals, co);
                 }
-                let fits = basis.at_tests.iter().enumerate().all(|(l, row)| {
+                let fits = (0..=n).all(|l| {
                     let want = &vals[(n + l) * nf..(n + l + 1) * nf];
                     (0..nf).all(|f| {
-                        let got: Complex64 = coef[f * n..(f + 1) * n]
-                            .iter()
-                            .zip(row)
-                            .map(|(c, t)| *c * *t)
-                            .sum();
+                        let got = basis.value_at_extremum(&coef[f * n..(f + 1) * n], l);
                         (got - want[f]).norm() <= TABLE_TOL * scale[f]
                     })
                 });
@@ -682,46 +551,10 @@ impl<'a> InReach<'a> {
     }
 }
 
-/// Chebyshev points, the values-to-coefficients transform and the test points, for
-/// [`CHEB_N`] points.
-struct Basis {
-    /// `x_i = cos(π(i + ½)/n)`.
-    nodes: [f64; CHEB_N],
-    /// `a_j = Σ_i dct[j][i] f(x_i)`.
-    dct: [[f64; CHEB_N]; CHEB_N],
-    /// The extrema `y_l = cos(πl/n)`, `l = 0..=n`, ends included.
-    tests: [f64; CHEB_N + 1],
-    /// `T_j(y_l) = cos(πjl/n)` as `[l][j]`.
-    at_tests: [[f64; CHEB_N]; CHEB_N + 1],
-}
-
-fn basis() -> &'static Basis {
-    static B: OnceLock<Basis> = OnceLock::new();
-    B.get_or_init(|| {
-        let n = CHEB_N as f64;
-        let mut b = Basis {
-            nodes: [0.0; CHEB_N],
-            dct: [[0.0; CHEB_N]; CHEB_N],
-            tests: [0.0; CHEB_N + 1],
-            at_tests: [[0.0; CHEB_N]; CHEB_N + 1],
-        };
-        for (i, x) in b.nodes.iter_mut().enumerate() {
-            *x = (PI * (i as f64 + 0.5) / n).cos();
-        }
-        for (j, row) in b.dct.iter_mut().enumerate() {
-            let s = if j == 0 { 1.0 / n } else { 2.0 / n };
-            for (i, d) in row.iter_mut().enumerate() {
-                *d = s * (PI * j as f64 * (i as f64 + 0.5) / n).cos();
-            }
-        }
-        for (l, (y, row)) in b.tests.iter_mut().zip(&mut b.at_tests).enumerate() {
-            *y = (PI * l as f64 / n).cos();
-            for (j, t) in row.iter_mut().enumerate() {
-                *t = (PI * (j * l) as f64 / n).cos();
-            }
-        }
-        b
-    })
+/// The Chebyshev basis of [`CHEB_N`] points, computed once.
+fn basis() -> &'static ChebyshevBasis {
+    static B: OnceLock<ChebyshevBasis> = OnceLock::new();
+    B.get_or_init(|| ChebyshevBasis::new(CHEB_N))
 }
 
 /// Segments `(a, b]` covering the reach, each with the Chebyshev coefficients of every function.
@@ -810,7 +643,7 @@ impl<'a> SquaresRule<'a> {
                 }
                 let end = x_end.min(len);
                 if end > start {
-                    total += parts(rate, end - start);
+                    total += subdivisions(rate, end - start);
                     start = end;
                 }
             }
@@ -1062,48 +895,6 @@ mod tests {
                 prop_assert!(
                     (table.at_start()[f] - want[f]).norm() <= (1e-13 + floor) * scale[f]
                 );
-            }
-        }
-    }
-
-    #[test]
-    fn exp_legendre_moments_match_refined_quadrature() {
-        // Against Gauss–Legendre on sub-intervals of width ≤ 1/|ω| (exact to ~1e-16 there);
-        // the moduli of the integrands are at most 1, so the error bound is absolute.
-        let (s, w) = gl16();
-        for r in [3.01, 5.0, 11.0, 16.99, 17.0, 30.0, 300.0, 3000.0] {
-            for angle in [0.5, 0.55, 0.7, 0.9, 1.0] {
-                let omega = Complex64::from_polar(r, angle * PI);
-                let mut n = [ZERO; GL_ORDER + 1];
-                exp_legendre_moments(omega, &mut n);
-                let parts = (2.0 * r).ceil() as usize;
-                let h = 1.0 / parts as f64;
-                let mut want = [ZERO; GL_ORDER + 1];
-                for q in 0..parts {
-                    let mid = -1.0 + (2 * q + 1) as f64 * h;
-                    for (x, wx) in s.iter().zip(w) {
-                        let t = mid + h * x;
-                        let e = cexp(omega * (t + 1.0)) * (h * wx);
-                        let (mut p0, mut p1) = (1.0, t);
-                        for (k, m) in want.iter_mut().enumerate() {
-                            *m += e * if k == 0 { p0 } else { p1 };
-                            if k >= 1 {
-                                let p2 =
-                                    ((2 * k + 1) as f64 * t * p1 - k as f64 * p0) / (k + 1) as f64;
-                                p0 = p1;
-                                p1 = p2;
-                            }
-                        }
-                    }
-                }
-                for k in 0..=GL_ORDER {
-                    assert!(
-                        (n[k] - want[k]).norm() < 1e-14,
-                        "ω = {omega}, k = {k}: {} vs {}",
-                        n[k],
-                        want[k]
-                    );
-                }
             }
         }
     }

@@ -7,225 +7,92 @@
 //! Chebyshev extrema; a segment whose error exceeds the tolerance is halved, so the table does
 //! not rely on the model's declared rate being right.
 
+use jitterid_jitter::kernels::chebyshev::{
+    clenshaw, to_monomial, ChebyshevBasis, CheckPoints, PiecewiseChebyshev,
+};
 use std::sync::OnceLock;
 
 /// Points per segment.
 pub(crate) const CHEB_POINTS: usize = 16;
 
-/// The interpolation points, the transform from values to coefficients, and the test points.
-pub(crate) struct ChebBasis {
-    /// `x_i = cos(π(i + ½)/16)`.
-    pub(crate) nodes: [f64; CHEB_POINTS],
-    /// `c_j = Σ_i dct[j][i] f(x_i)`.
-    pub(crate) dct: [[f64; CHEB_POINTS]; CHEB_POINTS],
-    /// Interior extrema `cos(π(i + 1)/16)`, `i = 0..15`, halfway between the nodes.
-    pub(crate) tests: [f64; CHEB_POINTS - 1],
-}
-
-pub(crate) fn basis() -> &'static ChebBasis {
-    static B: OnceLock<ChebBasis> = OnceLock::new();
-    B.get_or_init(|| {
-        let n = CHEB_POINTS as f64;
-        let mut nodes = [0.0; CHEB_POINTS];
-        let mut dct = [[0.0; CHEB_POINTS]; CHEB_POINTS];
-        let mut tests = [0.0; CHEB_POINTS - 1];
-        for (i, x) in nodes.iter_mut().enumerate() {
-            *x = (std::f64::consts::PI * (i as f64 + 0.5) / n).cos();
-        }
-        for (j, row) in dct.iter_mut().enumerate() {
-            for (i, d) in row.iter_mut().enumerate() {
-                let scale = if j == 0 { 1.0 / n } else { 2.0 / n };
-                *d = scale * (std::f64::consts::PI * j as f64 * (i as f64 + 0.5) / n).cos();
-            }
-        }
-        for (i, x) in tests.iter_mut().enumerate() {
-            *x = (std::f64::consts::PI * (i as f64 + 1.0) / n).cos();
-        }
-        ChebBasis { nodes, dct, tests }
-    })
+/// The basis of [`CHEB_POINTS`] points, computed once.
+pub(crate) fn basis() -> &'static ChebyshevBasis {
+    static B: OnceLock<ChebyshevBasis> = OnceLock::new();
+    B.get_or_init(|| ChebyshevBasis::new(CHEB_POINTS))
 }
 
 /// Chebyshev coefficients of the values at the 16 nodes.
 pub(crate) fn coefficients(values: &[f64; CHEB_POINTS]) -> [f64; CHEB_POINTS] {
-    let b = basis();
     let mut c = [0.0; CHEB_POINTS];
-    for (cj, row) in c.iter_mut().zip(&b.dct) {
-        *cj = row.iter().zip(values).map(|(d, v)| d * v).sum();
-    }
+    basis().coefficients_into(values, &mut c);
     c
 }
 
-/// `Σ c_j T_j(x)` by Clenshaw's recurrence.
-#[inline]
-pub(crate) fn clenshaw(c: &[f64], x: f64) -> f64 {
-    let x2 = 2.0 * x;
-    let (mut b1, mut b2) = (0.0, 0.0);
-    for &cj in c[1..].iter().rev() {
-        let b0 = cj + x2 * b1 - b2;
-        b2 = b1;
-        b1 = b0;
-    }
-    c[0] + x * b1 - b2
-}
-
 /// A piecewise Chebyshev interpolant of `channels` real functions on sorted, non-overlapping
-/// segments.
-#[derive(Debug, Clone, Default)]
+/// segments (the shared table), with channel 0 also in the monomial basis of the local variable
+/// `x ∈ [−1, 1]`, per segment, for the batched Horner evaluation.
+#[derive(Debug, Clone)]
 pub(crate) struct PiecewiseCheb {
-    starts: Vec<f64>,
-    ends: Vec<f64>,
-    channels: usize,
-    /// Segment-major, then channel, then the 16 coefficients.
-    coefs: Vec<f64>,
-    /// Channel 0 in the monomial basis of the local variable `x ∈ [−1, 1]`, per segment
-    /// (for the batched Horner evaluation).
+    table: PiecewiseChebyshev,
     mono0: Vec<[f64; CHEB_POINTS]>,
-}
-
-/// Monomial coefficients `a_k` with `Σ c_j T_j(x) = Σ a_k x^k`.
-fn chebyshev_to_monomial(c: &[f64]) -> [f64; CHEB_POINTS] {
-    // T_0 = 1, T_1 = x, T_{j+1} = 2x T_j − T_{j−1}, as coefficient rows.
-    let mut out = [0.0; CHEB_POINTS];
-    let mut t_prev = [0.0; CHEB_POINTS];
-    let mut t_cur = [0.0; CHEB_POINTS];
-    t_prev[0] = 1.0;
-    t_cur[1] = 1.0;
-    out[0] += c[0];
-    out[1] += c[1];
-    for &cj in &c[2..] {
-        let mut next = [0.0; CHEB_POINTS];
-        for k in 0..CHEB_POINTS - 1 {
-            next[k + 1] += 2.0 * t_cur[k];
-        }
-        for k in 0..CHEB_POINTS {
-            next[k] -= t_prev[k];
-        }
-        for k in 0..CHEB_POINTS {
-            out[k] += cj * next[k];
-        }
-        t_prev = t_cur;
-        t_cur = next;
-    }
-    out
 }
 
 /// Channels whose Clenshaw recurrences [`PiecewiseCheb::eval_all`] runs side by side.
 const INTERLEAVED: usize = 8;
 
-/// Largest number of halvings of one input interval.
-const MAX_DEPTH: u32 = 12;
-
-/// Errors up to this multiple of the tolerance that halving no longer reduces are taken as the
-/// function's own rounding noise.
-const NOISE_FLOOR: f64 = 1e5;
-
 impl PiecewiseCheb {
     /// Interpolates `f` (which writes `channels` values at `t`) on each of `intervals`,
-    /// halving a segment until the interpolant matches `f` at the test points within
-    /// `rel_tol × (channel's max |f| on the segment + the largest |f| of the channel seen so
-    /// far)`: relative to the function's scale, so that the rounding noise of `f` where it
-    /// nearly cancels does not force endless halving.
+    /// halving a segment until the interpolant matches `f` at the interior Chebyshev extrema
+    /// within `rel_tol × (channel's max |f| on the segment + the largest |f| of the channel
+    /// seen so far)` ([`PiecewiseChebyshev::build_checked`]).
     pub(crate) fn build(
         intervals: &[(f64, f64)],
         channels: usize,
         rel_tol: f64,
-        mut f: impl FnMut(f64, &mut [f64]),
+        f: impl FnMut(f64, &mut [f64]),
     ) -> Self {
-        let mut out = PiecewiseCheb {
+        let table = PiecewiseChebyshev::build_checked(
+            intervals,
+            CHEB_POINTS,
             channels,
-            ..Default::default()
-        };
-        let mut global = vec![0.0f64; channels];
-        let mut vals = vec![0.0; channels];
-        let b = basis();
-        // (a, b, depth, the parent's largest relative error).
-        let mut stack: Vec<(f64, f64, u32, f64)> = Vec::new();
-        let mut node_vals = vec![[0.0; CHEB_POINTS]; channels];
-        for &(a0, b0) in intervals {
-            if !(b0 > a0) || !a0.is_finite() || !b0.is_finite() {
-                continue;
-            }
-            stack.push((a0, b0, 0, f64::INFINITY));
-            // Depth-first, right half pushed first so that segments come out in order.
-            while let Some((a, bb, depth, parent_err)) = stack.pop() {
-                let (mid, half) = (0.5 * (a + bb), 0.5 * (bb - a));
-                let mut seg_max = vec![0.0f64; channels];
-                for (i, &x) in b.nodes.iter().enumerate() {
-                    f(mid + half * x, &mut vals);
-                    for c in 0..channels {
-                        node_vals[c][i] = vals[c];
-                        seg_max[c] = seg_max[c].max(vals[c].abs());
-                    }
+            rel_tol,
+            CheckPoints::InteriorExtrema,
+            f,
+        );
+        let mono0 = (0..table.len())
+            .map(|seg| {
+                let mut m = [0.0; CHEB_POINTS];
+                if let Some(c) = table.coefficients(seg, 0) {
+                    m.copy_from_slice(&to_monomial(c));
                 }
-                let coefs: Vec<[f64; CHEB_POINTS]> = node_vals.iter().map(coefficients).collect();
-                // Largest error relative to the tolerance's scale, over channels and tests.
-                let mut worst = 0.0f64;
-                if depth < MAX_DEPTH {
-                    for &x in &b.tests {
-                        f(mid + half * x, &mut vals);
-                        for c in 0..channels {
-                            let scale = rel_tol * (seg_max[c] + global[c]);
-                            let err = (clenshaw(&coefs[c], x) - vals[c]).abs();
-                            let r = if err == 0.0 { 0.0 } else { err / scale };
-                            worst = if r.is_nan() {
-                                f64::INFINITY
-                            } else {
-                                worst.max(r)
-                            };
-                        }
-                    }
-                }
-                // Halving an analytic piece divides the error by about 2^16; if it no longer
-                // falls by 4, the error is the function's own rounding noise (for example the
-                // phase of a tone at large t), which no interpolant removes.
-                // Only near the rounding level (within `NOISE_FLOOR` of the tolerance): an
-                // under-resolved segment has a large error that halving does not yet reduce.
-                let ok = worst <= 1.0 || (worst <= NOISE_FLOOR && worst > 0.25 * parent_err);
-                if ok {
-                    for c in 0..channels {
-                        global[c] = global[c].max(seg_max[c]);
-                    }
-                    out.starts.push(a);
-                    out.ends.push(bb);
-                    out.mono0.push(chebyshev_to_monomial(&coefs[0]));
-                    for c in &coefs {
-                        out.coefs.extend_from_slice(c);
-                    }
-                } else {
-                    stack.push((mid, bb, depth + 1, worst));
-                    stack.push((a, mid, depth + 1, worst));
-                }
-            }
-        }
-        out
+                m
+            })
+            .collect();
+        PiecewiseCheb { table, mono0 }
     }
 
     /// Number of segments.
     #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
-        self.starts.len()
+        self.table.len()
     }
 
     /// The segment containing `t`, if any.
     #[inline]
     pub(crate) fn segment(&self, t: f64) -> Option<usize> {
-        let i = self.starts.partition_point(|&a| a <= t);
-        if i == 0 {
-            return None;
-        }
-        let i = i - 1;
-        (t <= self.ends[i]).then_some(i)
+        self.table.segment(t)
     }
 
     /// The segment containing `t`, trying `hint` and its successor first (updated).
     #[inline]
     pub(crate) fn segment_near(&self, t: f64, hint: &mut usize) -> Option<usize> {
         let h = *hint;
-        if h < self.starts.len() && self.starts[h] <= t {
-            if t <= self.ends[h] {
+        let (starts, ends) = (self.table.starts(), self.table.ends());
+        if h < self.table.len() && starts[h] <= t {
+            if t <= ends[h] {
                 return Some(h);
             }
-            if h + 1 < self.starts.len() && self.starts[h + 1] <= t && t <= self.ends[h + 1] {
+            if h + 1 < self.table.len() && starts[h + 1] <= t && t <= ends[h + 1] {
                 *hint = h + 1;
                 return Some(h + 1);
             }
@@ -245,7 +112,7 @@ impl PiecewiseCheb {
         out: &mut [f64; 16],
         lanes: std::ops::Range<usize>,
     ) {
-        let (a, b) = (self.starts[seg], self.ends[seg]);
+        let (a, b) = (self.table.starts()[seg], self.table.ends()[seg]);
         let (mid, scale) = (0.5 * (a + b), 2.0 / (b - a));
         let m = &self.mono0[seg];
         let ts = &ts[lanes.clone()];
@@ -279,7 +146,7 @@ impl PiecewiseCheb {
                 i += 1;
                 continue;
             };
-            let end = self.ends[seg];
+            let end = self.table.ends()[seg];
             let mut j = i + 1;
             while j < 16 && ts[j] <= end {
                 j += 1;
@@ -297,7 +164,7 @@ impl PiecewiseCheb {
 
     #[inline]
     fn local(&self, seg: usize, t: f64) -> f64 {
-        let (a, b) = (self.starts[seg], self.ends[seg]);
+        let (a, b) = (self.table.starts()[seg], self.table.ends()[seg]);
         ((2.0 * t - a - b) / (b - a)).clamp(-1.0, 1.0)
     }
 
@@ -305,8 +172,8 @@ impl PiecewiseCheb {
     #[inline]
     pub(crate) fn eval0(&self, seg: usize, t: f64) -> f64 {
         let x = self.local(seg, t);
-        let base = seg * self.channels * CHEB_POINTS;
-        clenshaw(&self.coefs[base..base + CHEB_POINTS], x)
+        let base = seg * self.table.channels() * CHEB_POINTS;
+        clenshaw(&self.table.coefficient_data()[base..base + CHEB_POINTS], x)
     }
 
     /// Every channel at `t` in segment `seg`: [`clenshaw`] for up to [`INTERLEAVED`] channels
@@ -317,9 +184,10 @@ impl PiecewiseCheb {
     pub(crate) fn eval_all(&self, seg: usize, t: f64, out: &mut [f64]) {
         let x = self.local(seg, t);
         let x2 = 2.0 * x;
-        let base = seg * self.channels * CHEB_POINTS;
-        let coefs = &self.coefs[base..base + self.channels * CHEB_POINTS];
-        let n = out.len().min(self.channels);
+        let base = seg * self.table.channels() * CHEB_POINTS;
+        let coefs =
+            &self.table.coefficient_data()[base..base + self.table.channels() * CHEB_POINTS];
+        let n = out.len().min(self.table.channels());
         for (group, outs) in out[..n].chunks_mut(INTERLEAVED).enumerate() {
             let first = group * INTERLEAVED;
             let mut b1 = [0.0; INTERLEAVED];
@@ -413,7 +281,7 @@ mod tests {
             let x = table.local(seg, t);
             for (c, &v) in out.iter().enumerate() {
                 let s = (seg * 11 + c) * CHEB_POINTS;
-                let direct = clenshaw(&table.coefs[s..s + CHEB_POINTS], x);
+                let direct = clenshaw(&table.table.coefficient_data()[s..s + CHEB_POINTS], x);
                 assert_eq!(v.to_bits(), direct.to_bits(), "t = {t}, channel {c}");
             }
         }

@@ -64,28 +64,17 @@
 
 use super::cheb::{basis, coefficients, PiecewiseCheb, CHEB_POINTS};
 use super::MlError;
-use jitterid_jitter::rule::gauss_legendre;
+use jitterid_jitter::kernels::gauss::{gl16, subdivisions};
+use jitterid_jitter::rule::MAX_SUBDIVISIONS;
 use jitterid_jitter::{Atom, JitterModel};
 use jitterid_signal::{local_breaks, SampleGrid, Signal};
 use serde::{Deserialize, Serialize};
-use std::sync::OnceLock;
 
 /// `½ ln 2π`.
 const HALF_LN_2PI: f64 = 0.918_938_533_204_672_8;
 
-/// Largest `rate × width` of one coarse interval (as in the jitter crate's rules).
-const MAX_RATE_WIDTH: f64 = 6.0;
-
-/// Largest number of refined sub-intervals of one coarse interval.
-const MAX_REFINE: usize = 4096;
-
 /// Relative accuracy asked of the signal and density tables.
 const TABLE_TOL: f64 = 1e-13;
-
-fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
-    static R: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    R.get_or_init(|| gauss_legendre(16))
-}
 
 /// The exact (non-Gaussian) maximum-likelihood criterion: the negative log-likelihood
 /// `−Σ_k log p(y_k)` of independent samples `y_k = s(t_k + τ_k) + v_k` with white Gaussian
@@ -157,14 +146,6 @@ pub(crate) struct JitterPrep {
     moments: Option<[f64; CHEB_POINTS]>,
 }
 
-fn split_count(width: f64, rate: f64) -> usize {
-    if rate.is_finite() && rate > 0.0 {
-        ((rate * width / MAX_RATE_WIDTH).ceil() as usize).clamp(1, MAX_REFINE)
-    } else {
-        1
-    }
-}
-
 /// Appends the 16-point rule of `[a, b]` with density `pdf` (at `τ`) folded in.
 fn gl_interval(a: f64, b: f64, mut pdf: impl FnMut(f64) -> f64) -> Coarse {
     let (x, w) = gl16();
@@ -189,7 +170,7 @@ impl JitterPrep {
         let pieces = jitter.pieces();
         let mut coarse = Vec::new();
         for &(a, b) in &pieces {
-            let m = split_count(b - a, rate);
+            let m = subdivisions(rate, b - a);
             let h = (b - a) / m as f64;
             for i in 0..m {
                 let lo_i = a + i as f64 * h;
@@ -438,7 +419,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         // The Chebyshev nodes in increasing order (the basis stores them decreasing).
         let mut taus = [0.0; CHEB_POINTS];
         for i in 0..CHEB_POINTS {
-            taus[i] = mid + half * b.nodes[CHEB_POINTS - 1 - i];
+            taus[i] = mid + half * b.nodes()[CHEB_POINTS - 1 - i];
         }
         let mut sv = [0.0; CHEB_POINTS];
         self.signal
@@ -487,7 +468,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 let mut g = std::mem::take(&mut scratch.node_gradients);
                 g.clear();
                 g.resize(ns, [0.0; CHEB_POINTS]);
-                for (i, &x) in b.nodes.iter().enumerate() {
+                for (i, &x) in b.nodes().iter().enumerate() {
                     self.signal
                         .all(t + mid + half * x, &mut chans, &mut scratch.sig_hint);
                     for j in 0..ns {
@@ -681,7 +662,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             cum[j + 1] = cum[j] + tv[j];
         }
         let total = cum[17];
-        let m = ((total / res).ceil() as usize).clamp(1, MAX_REFINE);
+        let m = ((total / res).ceil() as usize).clamp(1, MAX_SUBDIVISIONS);
         // Boundary i of m, by inverting the piecewise-linear cumulative variation.
         let boundary = |i: usize, gap: &mut usize| -> f64 {
             if i == 0 {

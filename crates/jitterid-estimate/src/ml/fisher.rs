@@ -24,7 +24,7 @@ use crate::finite_diff::{fd_step, LIKELIHOOD_FD_STEP};
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use faer::Mat;
-use jitterid_jitter::rule::gauss_legendre;
+use jitterid_jitter::kernels::gauss::gl16;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::{SampleGrid, Signal};
 use rayon::prelude::*;
@@ -273,7 +273,7 @@ where
         .iter()
         .map(|(up, dn, d)| (up.as_ref().map(model), dn.as_ref().map(model), *d))
         .collect();
-    let (gx, gw) = gauss_legendre(16);
+    let (gx, gw) = gl16();
     let per_sample = |k: usize| -> Result<(Vec<f64>, f64), MlError> {
         let t = grid.time(k);
         let mut scratch = Scratch::default();
@@ -288,7 +288,7 @@ where
         let mut score = vec![0.0; p];
         for i in 0..m {
             let mid = ya + (i as f64 + 0.5) * width;
-            for (x, w) in gx.iter().zip(&gw) {
+            for (x, w) in gx.iter().zip(gw) {
                 let y = mid + 0.5 * width * x;
                 let lp = base.log_p(t, y, Some(&mut g), &mut scratch);
                 if !lp.is_finite() {

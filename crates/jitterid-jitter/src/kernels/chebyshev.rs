@@ -37,6 +37,8 @@ pub struct ChebyshevBasis {
     dct: Vec<f64>,
     /// The extrema of `T_n`, `cos(πl/n)`, `l = 0..=n` (ends included).
     extrema: Vec<f64>,
+    /// Row-major `(n + 1) × n`: `T_j` at extremum `l`, `cos(πjl/n)`.
+    at_extrema: Vec<f64>,
 }
 
 impl ChebyshevBasis {
@@ -53,10 +55,14 @@ impl ChebyshevBasis {
             }
         }
         let extrema = (0..=n).map(|l| (PI * l as f64 / nf).cos()).collect();
+        let at_extrema = (0..=n)
+            .flat_map(|l| (0..n).map(move |j| (PI * (j * l) as f64 / nf).cos()))
+            .collect();
         ChebyshevBasis {
             nodes,
             dct,
             extrema,
+            at_extrema,
         }
     }
 
@@ -79,6 +85,20 @@ impl ChebyshevBasis {
     /// term `a_n T_n` peaks, so the points to check an interpolant at.
     pub fn extrema(&self) -> &[f64] {
         &self.extrema
+    }
+
+    /// `Σ c_j T_j` at extremum `l` of [`extrema`](Self::extrema), summed in increasing `j`
+    /// with `T_j = cos(πjl/n)` exact to rounding (no recurrence): the check of an interpolant
+    /// at the points where its error peaks. Zero for `l > n`.
+    pub fn value_at_extremum<T: ChebValue>(&self, c: &[T], l: usize) -> T {
+        let n = self.len();
+        self.at_extrema
+            .get(l * n..(l + 1) * n)
+            .map_or(T::zero(), |row| {
+                c.iter()
+                    .zip(row)
+                    .fold(T::zero(), |acc, (&c, &t)| acc + c * t)
+            })
     }
 
     /// Chebyshev coefficients of the interpolant through `values` at [`nodes`](Self::nodes),
@@ -162,6 +182,18 @@ pub const MAX_DEPTH: u32 = 12;
 /// function's own rounding noise.
 const NOISE_FLOOR: f64 = 1e5;
 
+/// Where [`PiecewiseChebyshev::build_checked`] compares a segment's interpolant with the
+/// function: at extrema of `T_points`, where the leading error term peaks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CheckPoints {
+    /// Every extremum `cos(πl/n)`, `l = 0..=n`, the segment's ends included.
+    Extrema,
+    /// The interior extrema only, `l = 1..n`: two evaluations of the function fewer per
+    /// segment.
+    InteriorExtrema,
+}
+
 /// A piecewise Chebyshev interpolant of `channels` real functions on sorted, non-overlapping
 /// segments.
 #[derive(Debug, Clone, PartialEq)]
@@ -187,10 +219,34 @@ impl PiecewiseChebyshev {
         points: usize,
         channels: usize,
         rel_tol: f64,
+        f: impl FnMut(f64, &mut [f64]),
+    ) -> Self {
+        Self::build_checked(
+            intervals,
+            points,
+            channels,
+            rel_tol,
+            CheckPoints::Extrema,
+            f,
+        )
+    }
+
+    /// [`build`](Self::build), checking each segment at `checks`.
+    pub fn build_checked(
+        intervals: &[(f64, f64)],
+        points: usize,
+        channels: usize,
+        rel_tol: f64,
+        checks: CheckPoints,
         mut f: impl FnMut(f64, &mut [f64]),
     ) -> Self {
         let basis = ChebyshevBasis::new(points);
         let n = basis.len();
+        let tests = match checks {
+            CheckPoints::Extrema => &basis.extrema[..],
+            CheckPoints::InteriorExtrema => &basis.extrema[1..n],
+        }
+        .to_vec();
         let mut out = PiecewiseChebyshev {
             basis,
             starts: Vec::new(),
@@ -225,7 +281,7 @@ impl PiecewiseChebyshev {
                 }
                 let mut worst = 0.0f64;
                 if depth < MAX_DEPTH {
-                    for &x in &out.basis.extrema {
+                    for &x in &tests {
                         f(mid + half * x, &mut vals);
                         for c in 0..channels {
                             let scale = rel_tol * (seg_max[c] + global[c]);
@@ -262,6 +318,7 @@ impl PiecewiseChebyshev {
     }
 
     /// Number of segments.
+    #[inline]
     pub fn len(&self) -> usize {
         self.starts.len()
     }
@@ -272,8 +329,34 @@ impl PiecewiseChebyshev {
     }
 
     /// Number of channels.
+    #[inline]
     pub fn channels(&self) -> usize {
         self.channels
+    }
+
+    /// The segments' starts, increasing.
+    #[inline]
+    pub fn starts(&self) -> &[f64] {
+        &self.starts
+    }
+
+    /// The segments' ends, increasing (each at or before the next segment's start).
+    #[inline]
+    pub fn ends(&self) -> &[f64] {
+        &self.ends
+    }
+
+    /// Every coefficient: segment-major, then channel, then the [`points`](Self::points)
+    /// coefficients of degree `0, 1, …` (for callers that evaluate many channels at once).
+    #[inline]
+    pub fn coefficient_data(&self) -> &[f64] {
+        &self.coefs
+    }
+
+    /// Interpolation points per segment (degree + 1).
+    #[inline]
+    pub fn points(&self) -> usize {
+        self.basis.len()
     }
 
     /// The segment `[start, end]` of index `seg`.
@@ -282,6 +365,7 @@ impl PiecewiseChebyshev {
     }
 
     /// The segment containing `t`, if any.
+    #[inline]
     pub fn segment(&self, t: f64) -> Option<usize> {
         let i = self.starts.partition_point(|&a| a <= t).checked_sub(1)?;
         (t <= self.ends[i]).then_some(i)
@@ -336,6 +420,10 @@ mod tests {
             assert!((horner - p(x)).abs() < 1e-14);
         }
         assert_eq!(b.extrema().len(), 5);
+        for (l, &y) in b.extrema().iter().enumerate() {
+            assert!((b.value_at_extremum(&c, l) - p(y)).abs() < 1e-14, "{l}");
+        }
+        assert_eq!(b.value_at_extremum(&c, 5), 0.0);
     }
 
     #[test]
@@ -370,6 +458,21 @@ mod tests {
             );
         }
         assert!(!table.eval(-0.1, &mut v) && table.segment(3.1).is_none());
+        // Checking the interior extrema only never asks for more segments.
+        let interior = PiecewiseChebyshev::build_checked(
+            &[(0.0, 1.0), (1.0, 3.0)],
+            16,
+            2,
+            1e-13,
+            CheckPoints::InteriorExtrema,
+            f,
+        );
+        assert!(interior.len() <= table.len() && interior.len() > 8);
+        assert_eq!(interior.starts().len(), interior.ends().len());
+        assert_eq!(
+            interior.coefficient_data().len(),
+            interior.len() * 2 * interior.points()
+        );
         assert!(table.coefficients(table.len(), 0).is_none());
     }
 }

@@ -1,6 +1,7 @@
 //! Gauss–Legendre rules: nodes and weights on `[-1, 1]`, and the cached 16-point rule that the
 //! expectation rules, the signal crate's reach integrals and the exact likelihood share.
 
+use crate::rule::{MAX_RATE_WIDTH, MAX_SUBDIVISIONS};
 use std::sync::OnceLock;
 
 /// Number of Gauss–Legendre nodes per sub-interval of the workspace's rules.
@@ -52,6 +53,41 @@ pub fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
     RULE.get_or_init(|| gauss_legendre(GL_ORDER))
 }
 
+/// Sub-intervals of a composite rule over `width` for an integrand varying at `rate`: enough
+/// that `rate × sub-interval ≤` [`MAX_RATE_WIDTH`], at least one and at most
+/// [`MAX_SUBDIVISIONS`] (one for a rate or width that is not positive and finite).
+///
+/// ```
+/// use jitterid_jitter::kernels::gauss::subdivisions;
+/// assert_eq!((subdivisions(7.0, 1.0), subdivisions(f64::NAN, 1.0)), (2, 1));
+/// ```
+pub fn subdivisions(rate: f64, width: f64) -> usize {
+    if rate.is_finite() && rate > 0.0 && width > 0.0 {
+        ((rate * width / MAX_RATE_WIDTH).ceil() as usize).clamp(1, MAX_SUBDIVISIONS)
+    } else {
+        1
+    }
+}
+
+/// The `parts` equal sub-intervals of `[a, b]` (at least one) as `(midpoint, half-width)`, the
+/// last one ending exactly at `b`: a composite rule maps node `x_i` of `[-1, 1]` to
+/// `mid + half · x_i` with weight `half · w_i`.
+///
+/// ```
+/// use jitterid_jitter::kernels::gauss::panels;
+/// let p: Vec<(f64, f64)> = panels(0.0, 2.0, 2).collect();
+/// assert_eq!(p, vec![(0.5, 0.5), (1.5, 0.5)]);
+/// ```
+pub fn panels(a: f64, b: f64, parts: usize) -> impl Iterator<Item = (f64, f64)> {
+    let parts = parts.max(1);
+    let h = (b - a) / parts as f64;
+    (0..parts).map(move |p| {
+        let lo = a + p as f64 * h;
+        let hi = if p + 1 == parts { b } else { lo + h };
+        (0.5 * (lo + hi), 0.5 * (hi - lo))
+    })
+}
+
 /// `∫_a^b f(t) dt` by the 16-point rule on `parts` equal sub-intervals (at least one).
 ///
 /// ```
@@ -61,13 +97,8 @@ pub fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
 /// ```
 pub fn integrate(a: f64, b: f64, parts: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
     let (x, w) = gl16();
-    let parts = parts.max(1);
-    let h = (b - a) / parts as f64;
     let mut total = 0.0;
-    for p in 0..parts {
-        let lo = a + p as f64 * h;
-        let hi = if p + 1 == parts { b } else { lo + h };
-        let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+    for (mid, half) in panels(a, b, parts) {
         total += half
             * x.iter()
                 .zip(w)
