@@ -61,8 +61,9 @@ impl<W: Window> FrequencyData<W> {
         2 * self.freqs.len()
     }
 
-    /// `μ_Y(f)` for the model's first moment `m_k`, or NaN where `m` is not finite.
-    pub fn transform_moment(&self, m: &[f64]) -> Vec<Complex64> {
+    /// `μ_Y(f)` for the model's first moment `m_k`, or NaN where `m` is not finite. A vector
+    /// passed by value is freed before the FFT runs.
+    pub fn transform_moment(&self, m: impl AsRef<[f64]>) -> Vec<Complex64> {
         transform(self.record.grid(), &self.window, m, &self.freqs)
             .unwrap_or_else(|_| vec![Complex64::new(f64::NAN, f64::NAN); self.freqs.len()])
     }
@@ -89,7 +90,7 @@ impl<W: Window> FrequencyData<W> {
         criterion: &C,
         model: &ModelStructure<S, J, N>,
     ) -> Vec<f64> {
-        let mu = self.transform_moment(&self.first_moment(criterion, model));
+        let mu = self.transform_moment(self.first_moment(criterion, model));
         let w = self.weights(criterion, model, Some(&mu));
         stack(self.dtft(), &mu, &w)
     }

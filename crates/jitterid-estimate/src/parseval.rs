@@ -138,15 +138,15 @@ pub(crate) fn parseval_gram(cols: &[Vec<f64>], weight: f64) -> Mat<f64> {
 }
 
 /// `Jᵀr` with column `a` of `J` the stacked `−√w [Re A_f, Im A_f]` of the transformed
-/// sensitivity, one column transformed at a time.
+/// sensitivity, one column transformed at a time, each freed before its FFT runs.
 fn frequency_gradient<W: Window>(
     data: &FrequencyData<W>,
-    cols: &[Vec<f64>],
+    cols: Vec<Vec<f64>>,
     weight: f64,
     residuals: &[f64],
 ) -> Vec<f64> {
     let sw = weight.sqrt();
-    cols.iter()
+    cols.into_iter()
         .map(|c| {
             let mu = data.transform_moment(c);
             mu.iter()
@@ -181,9 +181,10 @@ where
     match parseval_weight(criterion, data, model) {
         Some(weight) if residuals.len() == data.num_residuals() => {
             let cols = moment_sensitivities(criterion, data, model);
+            let gram = parseval_gram(&cols, weight);
             NormalEquations {
-                gram: parseval_gram(&cols, weight),
-                gradient: frequency_gradient(data, &cols, weight, residuals),
+                gram,
+                gradient: frequency_gradient(data, cols, weight, residuals),
             }
         }
         _ => explicit(),

@@ -202,9 +202,11 @@ impl<M: RationalModel> LtiResponse<M> {
             .collect()
     }
 
-    /// Per sample: `C_k = E[Σ_j Δu_j 1{x ≥ 0}]`, and per representative pole
-    /// `A_ik = E[Σ_j Δu_j e^{p_i x} 1{x ≥ 0}]`, `B_ik = E[Σ_j Δu_j x e^{p_i x} 1{x ≥ 0}]`, with
-    /// `x = t_k + τ − t_j`. `B` only when `with_b`.
+    /// Visits every sample `k` in order with `C_k = E[Σ_j Δu_j 1{x ≥ 0}]` and, per
+    /// representative pole, `A_ik = E[Σ_j Δu_j e^{p_i x} 1{x ≥ 0}]` and
+    /// `B_ik = E[Σ_j Δu_j x e^{p_i x} 1{x ≥ 0}]`, with `x = t_k + τ − t_j` (`B` only when
+    /// `with_b`, empty otherwise). Handing them to the caller sample by sample, instead of
+    /// storing them, keeps the work memory of a long record at `O(poles)`.
     ///
     /// Steps past the reach go through the state recursion of [`walk`](Self::walk); a step
     /// inside it at `c = t_j − t_k` needs `P(τ ≥ c)`, `E[e^{p_i(τ−c)} 1{τ ≥ c}]` and
@@ -216,8 +218,8 @@ impl<M: RationalModel> LtiResponse<M> {
         jitter: &dyn JitterModel,
         reps: &[(usize, f64)],
         with_b: bool,
-    ) -> ModalExpectations {
-        let n = grid.len();
+        mut visit: impl FnMut(f64, &[Complex64], &[Complex64]),
+    ) {
         let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| self.modal().poles[i]).collect();
         let np = poles.len();
         let (lo, hi) = jitter.reach();
@@ -232,43 +234,37 @@ impl<M: RationalModel> LtiResponse<M> {
         let mass = start[0].re;
         let (m0, m1) = start[1..].split_at(np);
 
-        let mut out = ModalExpectations {
-            c: vec![0.0; n],
-            a: vec![vec![Complex64::new(0.0, 0.0); n]; np],
-            b: if with_b {
-                vec![vec![Complex64::new(0.0, 0.0); n]; np]
-            } else {
-                Vec::new()
-            },
-        };
-        let mut v = vec![Complex64::new(0.0, 0.0); reach.width()];
+        let zero = Complex64::new(0.0, 0.0);
+        let mut a = vec![zero; np];
+        let mut b = if with_b { vec![zero; np] } else { Vec::new() };
+        let mut v = vec![zero; reach.width()];
         self.walk(
             grid,
             lo,
             hi,
             &poles,
             with_b,
-            |k, t, u_past, x, y, in_reach| {
-                out.c[k] = u_past * mass;
+            |_, t, u_past, x, y, in_reach| {
+                let mut c = u_past * mass;
                 for i in 0..np {
-                    out.a[i][k] = x[i] * m0[i];
+                    a[i] = x[i] * m0[i];
                     if with_b {
-                        out.b[i][k] = y[i] * m0[i] + x[i] * m1[i];
+                        b[i] = y[i] * m0[i] + x[i] * m1[i];
                     }
                 }
                 for &(tj, du) in in_reach {
                     reach.eval(tj - t, &mut v);
-                    out.c[k] += du * v[0].re;
+                    c += du * v[0].re;
                     for i in 0..np {
-                        out.a[i][k] += du * v[1 + i];
+                        a[i] += du * v[1 + i];
                         if with_b {
-                            out.b[i][k] += du * v[1 + np + i];
+                            b[i] += du * v[1 + np + i];
                         }
                     }
                 }
+                visit(c, &a, &b);
             },
         );
-        out
     }
 
     /// Visits every sample `k` with the state of the steps already fully past its reach,
@@ -593,12 +589,6 @@ struct Prefix {
     y: Vec<Complex64>,
 }
 
-struct ModalExpectations {
-    c: Vec<f64>,
-    a: Vec<Vec<Complex64>>,
-    b: Vec<Vec<Complex64>>,
-}
-
 impl<M: RationalModel> Signal for LtiResponse<M> {
     fn param_names(&self) -> Vec<String> {
         self.model.param_names()
@@ -693,21 +683,22 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         }
         let m = self.modal();
         let reps = self.representatives();
-        let e = self.modal_expectations(grid, jitter, &reps, false);
         let coef: Vec<(Complex64, f64)> = reps
             .iter()
             .map(|&(i, w)| (m.residues[i] / m.poles[i], w))
             .collect();
-        (0..grid.len())
-            .map(|k| {
-                m.dc_gain * e.c[k]
+        let mut out = Vec::with_capacity(grid.len());
+        self.modal_expectations(grid, jitter, &reps, false, |c, a, _| {
+            out.push(
+                m.dc_gain * c
                     + coef
                         .iter()
-                        .zip(&e.a)
-                        .map(|(&(c, w), a)| w * (c * a[k]).re)
-                        .sum::<f64>()
-            })
-            .collect()
+                        .zip(a)
+                        .map(|(&(r, w), a)| w * (r * a).re)
+                        .sum::<f64>(),
+            );
+        });
+        out
     }
 
     fn expected_values_gradient(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Jacobian {
@@ -719,32 +710,32 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         }
         let m = self.modal();
         let reps = self.representatives();
-        let e = self.modal_expectations(grid, jitter, &reps, true);
-        (0..np)
+        // ∂/∂θ_j of G(0)·C + Re Σ (r/p) A, with ∂A/∂p = B.
+        let terms: Vec<Vec<(Complex64, Complex64, f64)>> = (0..np)
             .map(|j| {
-                // ∂/∂θ_j of G(0)·C + Re Σ (r/p) A, with ∂A/∂p = B.
-                let terms: Vec<(Complex64, Complex64, f64)> = reps
-                    .iter()
+                reps.iter()
                     .map(|&(i, w)| {
                         let (p, r) = (m.poles[i], m.residues[i]);
                         let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
                         (dr / p - r * dp / (p * p), r / p * dp, w)
                     })
-                    .collect();
-                (0..grid.len())
-                    .map(|k| {
-                        m.d_dc_gain[j] * e.c[k]
-                            + terms
-                                .iter()
-                                .enumerate()
-                                .map(|(i, &(d_rp, rp_dp, w))| {
-                                    w * (d_rp * e.a[i][k] + rp_dp * e.b[i][k]).re
-                                })
-                                .sum::<f64>()
-                    })
                     .collect()
             })
-            .collect()
+            .collect();
+        let mut cols: Jacobian = (0..np).map(|_| Vec::with_capacity(grid.len())).collect();
+        self.modal_expectations(grid, jitter, &reps, true, |c, a, b| {
+            for ((col, terms), d_dc) in cols.iter_mut().zip(&terms).zip(&m.d_dc_gain) {
+                col.push(
+                    d_dc * c
+                        + terms
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &(d_rp, rp_dp, w))| w * (d_rp * a[i] + rp_dp * b[i]).re)
+                            .sum::<f64>(),
+                );
+            }
+        });
+        cols
     }
 }
 

@@ -190,12 +190,22 @@ fn plan(n: usize) -> Arc<dyn Fft<f64>> {
     guard.plan_fft_forward(n)
 }
 
-/// FFT of `values` (any length ≥ 1), unchecked.
-fn fft_values(values: Vec<f64>) -> Vec<Complex64> {
-    let mut buffer: Vec<Complex64> = values.into_iter().map(|v| Complex64::new(v, 0.0)).collect();
+/// `values` as complex numbers, the buffer an FFT works in.
+fn complex_buffer(values: &[f64]) -> Vec<Complex64> {
+    values.iter().map(|&v| Complex64::new(v, 0.0)).collect()
+}
+
+/// Replaces `buffer` (any length) by its FFT.
+fn fft_in_place(buffer: &mut [Complex64]) {
     if !buffer.is_empty() {
-        plan(buffer.len()).process(&mut buffer);
+        plan(buffer.len()).process(buffer);
     }
+}
+
+/// FFT of `values` (any length ≥ 1), unchecked.
+fn fft_values(values: &[f64]) -> Vec<Complex64> {
+    let mut buffer = complex_buffer(values);
+    fft_in_place(&mut buffer);
     buffer
 }
 
@@ -212,7 +222,10 @@ pub fn fft_grid(data: &[f64], weights: Option<&[f64]>) -> Result<Vec<Complex64>,
         check_len("weights", data.len(), w)?;
         check_finite("weights", w)?;
     }
-    Ok(fft_values(weighted(data, weights)))
+    Ok(match weights {
+        Some(_) => fft_values(&weighted(data, weights)),
+        None => fft_values(data),
+    })
 }
 
 /// Whether the FFT beats `m` direct DTFTs of length `n`.
@@ -225,23 +238,26 @@ fn fft_pays(m: usize, n: usize) -> bool {
 ///
 /// When the set lies on the DFT grid of this record and has more than about `2 log2 N`
 /// frequencies, one FFT is used and only the requested bins are kept; otherwise each frequency
-/// is a direct [`dtft`]. `data` must have length `N` and be finite.
-pub fn transform<W: Window + ?Sized>(
+/// is a direct [`dtft`]. `data` must have length `N` and be finite; a vector passed by value
+/// is freed before the FFT runs, which lowers the peak memory of a long record.
+pub fn transform<W: Window + ?Sized, D: AsRef<[f64]>>(
     grid: &SampleGrid,
     window: &W,
-    data: &[f64],
+    data: D,
     freqs: &FrequencySet,
 ) -> Result<Vec<Complex64>, WindowError> {
     let n = grid.len();
-    check_len("data", n, data)?;
-    check_finite("data", data)?;
+    check_len("data", n, data.as_ref())?;
+    check_finite("data", data.as_ref())?;
     if window.is_rectangular() {
-        return Ok(transform_weighted(grid, data.to_vec(), freqs));
+        return Ok(transform_weighted(grid, data, freqs));
     }
     let w = window.weights(n);
     check_len("weights", n, &w)?;
     check_finite("weights", &w)?;
-    Ok(transform_weighted(grid, weighted(data, Some(&w)), freqs))
+    let values = weighted(data.as_ref(), Some(&w));
+    drop(data);
+    Ok(transform_weighted(grid, values, freqs))
 }
 
 /// [`transform`] without validation: wrong lengths or non-finite values give NaN outputs.
@@ -256,7 +272,7 @@ pub(crate) fn transform_unchecked<W: Window + ?Sized>(
         return vec![Complex64::new(f64::NAN, f64::NAN); freqs.len()];
     }
     if window.is_rectangular() {
-        return transform_weighted(grid, data.to_vec(), freqs);
+        return transform_weighted(grid, data, freqs);
     }
     let w = window.weights(n);
     if w.len() != n {
@@ -266,11 +282,28 @@ pub(crate) fn transform_unchecked<W: Window + ?Sized>(
 }
 
 /// The transform of already weighted values of length `N`.
-fn transform_weighted(grid: &SampleGrid, values: Vec<f64>, freqs: &FrequencySet) -> Vec<Complex64> {
-    let n = values.len();
+///
+/// A set of the first bins in order (the half DFT grid) keeps that prefix of the spectrum in
+/// place rather than copying it, so a long record holds one length-`N` buffer, not two.
+fn transform_weighted<V: AsRef<[f64]>>(
+    grid: &SampleGrid,
+    values: V,
+    freqs: &FrequencySet,
+) -> Vec<Complex64> {
+    let n = values.as_ref().len();
     if let Some(indices) = freqs.dft_indices() {
         if freqs.fits(grid) && fft_pays(freqs.len(), n) {
-            let spectrum = fft_values(values);
+            let mut spectrum = complex_buffer(values.as_ref());
+            // An owned input is no longer needed once copied: free it before the FFT's scratch.
+            drop(values);
+            fft_in_place(&mut spectrum);
+            let prefix =
+                indices.len() <= spectrum.len() && indices.iter().enumerate().all(|(i, &j)| i == j);
+            if prefix {
+                spectrum.truncate(indices.len());
+                spectrum.shrink_to_fit();
+                return spectrum;
+            }
             return indices
                 .iter()
                 .map(|&j| {
@@ -286,7 +319,7 @@ fn transform_weighted(grid: &SampleGrid, values: Vec<f64>, freqs: &FrequencySet)
     freqs
         .frequencies()
         .iter()
-        .map(|&f| dtft_at(&values, Cycles::new(f, t)))
+        .map(|&f| dtft_at(values.as_ref(), Cycles::new(f, t)))
         .collect()
 }
 

@@ -493,7 +493,11 @@ where
                 "Levenberg-Marquardt: state has no gradient; was `init` skipped?".to_string(),
             ))?
             .clone();
-        let m = state.get_residuals().map_or(0, Vec::len);
+        // Only the length of the current residuals is read again: on a long record they are as
+        // large as the data, and the trial point's residuals and normal equations are formed
+        // next, so they are released here.
+        let mut state = state;
+        let m = state.take_residuals().map_or(0, |r| r.len());
         if g.len() != x.len() || self.jtj.nrows() != x.len() || self.diag.len() != x.len() {
             return Err(SolverError::Argmin(
                 "Levenberg-Marquardt: inconsistent state; was `init` skipped?".to_string(),
