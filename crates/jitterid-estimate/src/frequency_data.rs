@@ -109,7 +109,7 @@ impl<W: Window> FrequencyData<W> {
             dtft: &self.y,
             model_dtft: mu,
             lazy_model_dtft: OnceLock::new(),
-            first_moment: &|| self.transform_moment(&self.first_moment(criterion, model)),
+            first_moment: &|| self.transform_moment(self.first_moment(criterion, model)),
             model,
         })
     }
@@ -181,12 +181,12 @@ impl<W: Window> FrequencyData<W> {
         if criterion.model_dependent_weights() {
             // r = √w (Y − μ): add (Y − μ) ∂√w/∂θ, the weights' own dependence on every free
             // parameter, by differences of the residuals at fixed μ.
-            let mu = data.transform_moment(&data.first_moment(criterion, model));
+            let mu = data.transform_moment(data.first_moment(criterion, model));
             let theta = model.params();
             for j in 0..theta.len() {
                 let dr = central_difference_vec(&theta, j, MOMENT_FD_STEP, |p| {
                     let m = model.with_params(p).ok()?;
-                    let mu_m = data.transform_moment(&data.first_moment(criterion, &m));
+                    let mu_m = data.transform_moment(data.first_moment(criterion, &m));
                     Some(stack(
                         data.dtft(),
                         &mu,
@@ -198,7 +198,7 @@ impl<W: Window> FrequencyData<W> {
                 }
             }
         } else if nn > 0 && criterion.uses_noise_model() {
-            let mu = data.transform_moment(&data.first_moment(criterion, model));
+            let mu = data.transform_moment(data.first_moment(criterion, model));
             let theta = model.noise.params();
             for j in 0..nn {
                 let dr = central_difference_vec(&theta, j, MOMENT_FD_STEP, |p| {

@@ -364,7 +364,7 @@ mod tests {
         ));
         let s = FrequencySet::dft(&g);
         assert!(matches!(
-            transform(&g, &HannWindow, &[1.0, f64::INFINITY, 0.0], &s),
+            transform(&g, &HannWindow, [1.0, f64::INFINITY, 0.0], &s),
             Err(WindowError::NonFinite {
                 name: "data",
                 index: 1,
@@ -380,7 +380,7 @@ mod tests {
         let x = dtft(&g, &[1.0, 2.0], None, &[0.5]).unwrap();
         assert!((x[0] - Complex64::new(1.0, -2.0)).norm() < 1e-15);
         let s = FrequencySet::full_dft(&g);
-        let y = transform(&g, &DirichletWindow, &[1.0, 2.0], &s).unwrap();
+        let y = transform(&g, &DirichletWindow, [1.0, 2.0], &s).unwrap();
         assert!((y[1] - Complex64::new(-1.0, 0.0)).norm() < 1e-15);
     }
 }

@@ -155,7 +155,7 @@ fn errors() {
     let grid = SampleGrid::new(0.0, 1.0, 4).unwrap();
     let set = FrequencySet::dft(&grid);
     assert_eq!(
-        transform(&grid, &DirichletWindow, &[1.0; 3], &set),
+        transform(&grid, &DirichletWindow, [1.0; 3], &set),
         Err(WindowError::WrongLength {
             name: "data",
             expected: 4,
