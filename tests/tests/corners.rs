@@ -1,4 +1,4 @@
-//! Numerically hard corners (issue 6, item 4). Each test checks a correct answer against an
+//! Numerically hard corners. Each test checks a correct answer against an
 //! independent route, or a typed error:
 //!
 //! * route (b), the exact fast `m_k` of [`LtiResponse`], against the `Signal` trait's quadrature

@@ -1,4 +1,4 @@
-//! Fuzzing the library's estimation entry points (issue 6, item 5): random model structures,
+//! Fuzzing the library's estimation entry points: random model structures,
 //! parameters, inputs, jitter laws, criteria, frequency sets, solver options and data —
 //! including NaN, infinite, huge and tiny values — through [`estimate`] and the initializer
 //! ([`initialize`], then [`estimate`] from its start with [`MultiStart`]).

@@ -1,4 +1,4 @@
-//! The common setup of the paper's section 4 (`conventions.md`).
+//! The common setup of the paper's section 4 (see `docs/method.md`).
 
 use jitterid::estimate::montecarlo::realization_rng;
 use jitterid::prelude::*;

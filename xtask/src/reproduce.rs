@@ -319,7 +319,7 @@ fn alias(o: &Options) -> Result<(), String> {
     md += "\nBoth fits reach zero cost: on the grid `kT` the first moment of a tone at `f0 + 1/T` with \
            amplitude `A` equals that of a tone at `f0` with amplitude `A·γ(f0+1/T)/γ(f0)`. The first \
            moment identifies the aliased frequency and the damped amplitude, never which alias. The \
-           jitter's second moment does tell them apart (issue #4).\n";
+           jitter's second moment does tell them apart.\n";
     let _ = o.runs;
     write_outputs(
         "alias",

@@ -482,7 +482,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
         md.push('\n');
     }
     let secs = t0.elapsed().as_secs_f64();
-    md += "### Targets (issue 4)\n\n";
+    md += "### Targets\n\n";
     for c in &checks {
         let _ = writeln!(md, "- {c}");
     }
@@ -498,7 +498,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
     )
 }
 
-/// The sine experiment's constants (issue 4).
+/// The sine experiment's constants (an ADC-testing record: a jittered, noisy tone).
 const SINE_A: f64 = 1.0;
 const SINE_F0: f64 = 1.78;
 const SINE_PHI: f64 = 0.3;

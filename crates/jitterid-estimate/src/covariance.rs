@@ -3,7 +3,7 @@
 //! With `r = √W A d`, where `d_k = y_k − m_k` are the independent sample deviations and `A` maps
 //! them to `[Re D(f), Im D(f)]`, the estimate's covariance is
 //! `H⁻¹ (Jᵀ Σ_r J) H⁻¹` with `H = JᵀJ` and `Σ_r = √W A Λ Aᵀ √W`. Jittered samples are
-//! heteroscedastic: `Λ = diag(λ_k)`, `λ_k = σ_v² + E[s(t_k+τ)²] − m_k²` (`conventions.md`),
+//! heteroscedastic: `Λ = diag(λ_k)`, `λ_k = σ_v² + E[s(t_k+τ)²] − m_k²` (`docs/method.md`),
 //! so the simple `σ² H⁻¹` would be wrong. For coloured (Box–Jenkins) noise, its part of `Σ_r`
 //! is the asymptotic diagonal `N Φ_v(f)/2` per real and imaginary part.
 

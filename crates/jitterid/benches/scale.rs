@@ -1,4 +1,4 @@
-//! BCLS cost against the record length (issue 6): one residual + Jacobian evaluation and one fit
+//! BCLS cost against the record length: one residual + Jacobian evaluation and one fit
 //! of the Table 2 system for `N` = 200, 2 000, 20 000, 200 000, with the random binary input's
 //! mean dwell fixed at 8 s so that the number of input steps grows like `N`.
 //!

@@ -13,8 +13,10 @@
 //! [`ArgminProblem`] provides both for every [`LeastSquares`] problem.
 //!
 //! The state is argmin's [`IterState`] ([`LmState`]): `param` is the current point, `cost` is
-//! `½ Σ rᵢ²`, and `residuals` and `gradient` (`Jᵀr`) hold the values at `param`; its Jacobian
-//! slot stays empty.
+//! `½ Σ rᵢ²`, and `gradient` (`Jᵀr`) holds the value at `param`; its Jacobian slot stays empty.
+//! `residuals` hold the values at `param` after an accepted step; they are released while a
+//! trial point is evaluated (on a long record they are as large as the data), so a final
+//! iteration that stops without an accepted step leaves the slot empty.
 //!
 //! # Algorithm
 //!

@@ -135,7 +135,9 @@ fn lm_as_argmin_solver_reports_through_termination_status() {
     assert_eq!(result.solver.termination(), Some(&Termination::SmallStep));
     assert!(result.solver.lambda() > 0.0);
     let state = &result.state;
-    assert_eq!(state.get_residuals().map(Vec::len), Some(2));
+    // Rosenbrock's last iteration stops on a small step without an accepted one, and the
+    // residuals were released while the rejected trial point was evaluated.
+    assert!(state.get_residuals().is_none());
     // The state carries the gradient; the Jacobian is never stored (memory flat in `m`).
     assert!(state.get_jacobian().is_none() && state.get_gradient().is_some());
     let evaluations = result.problem.counts.get("normal_equations_count").copied();
