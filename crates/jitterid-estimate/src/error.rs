@@ -37,6 +37,15 @@ pub enum EstimateError {
     /// Nothing is marked as estimated.
     #[error("the model structure has no free parameter")]
     NothingToEstimate,
+    /// Every sample has the same value: the record carries no information about a system or a
+    /// jitter (both show only through the samples' variation), so there is nothing to fit.
+    #[error(
+        "the data are constant (every sample equals {value}): a constant record carries no information about the system or the jitter"
+    )]
+    ConstantData {
+        /// The value of every sample.
+        value: f64,
+    },
     /// The criterion ignores jitter, so it cannot estimate jitter parameters.
     #[error("criterion `{criterion}` ignores the jitter and cannot estimate its parameters")]
     JitterNotModelled {

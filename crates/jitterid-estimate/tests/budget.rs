@@ -7,7 +7,7 @@ use jitterid_estimate::solver::{
     LeastSquares, LevenbergMarquardt, LmOptions, Progress, ProgressHook, Solver, SolverError,
     Termination,
 };
-use jitterid_estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid_estimate::{estimate, Bcls, EstimateError, EstimateOptions, ModelStructure, Record};
 use jitterid_jitter::UniformSum;
 use jitterid_signal::{LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
 use rand::SeedableRng;
@@ -144,4 +144,22 @@ fn all_zero_data_end_quickly_with_a_reason() {
     assert!(fit.iterations < LmOptions::default().max_iters, "{fit:?}");
     assert_ne!(fit.termination, Termination::TimeLimit);
     assert!(fit.params[0].abs() < 1e-6, "gain {}", fit.params[0]);
+}
+
+#[test]
+fn maximum_likelihood_refuses_constant_data_before_searching() {
+    use jitterid_estimate::ml::{ml_estimate, ExactMl, MlError, MlOptions};
+    let (mut structure, record) = table2_like(64);
+    structure.noise_std = Some(0.05);
+    let err = ml_estimate(
+        &structure,
+        &record,
+        &ExactMl::default(),
+        &MlOptions::default(),
+    )
+    .expect_err("constant data");
+    assert!(
+        matches!(err, MlError::Estimate(EstimateError::ConstantData { value }) if value == 0.0),
+        "{err:?}"
+    );
 }

@@ -112,7 +112,8 @@ pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
 ///
 /// # Errors
 ///
-/// Nothing to estimate; coloured noise with a criterion that needs white noise; a criterion
+/// Nothing to estimate; constant data ([`EstimateError::ConstantData`]); coloured noise with a
+/// criterion that needs white noise; a criterion
 /// not defined at the start (the typed reason: [`MlError::LikelihoodUnderflow`],
 /// [`MlError::VanishingVariance`], [`MlError::ReachExceedsRecord`], …); a start outside the
 /// constraints; invalid solver options. A search that stops without converging is not an
@@ -165,6 +166,13 @@ where
             params: p,
         }
         .into());
+    }
+    // Checked before the search: on constant data the likelihood has no interior optimum
+    // (σ_v and the system's gain drift towards zero), and the search would run to its budget.
+    if let Some(&value) = record.y().first() {
+        if record.y().iter().all(|&y| y == value) {
+            return Err(EstimateError::ConstantData { value }.into());
+        }
     }
     let sigma0 = match structure.noise_std {
         Some(s) => s,
