@@ -159,6 +159,14 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
         && !exp.noise.shape.is_white();
     let s = ModelStructure::bj(signal, exp.jitter.model.clone(), exp.noise.shape.clone())
         .with_estimated(exp.system.estimate, exp.jitter.estimate, shape_free);
+    // The Box–Jenkins criterion sees the jitter's white floor beside the ARMA shape (the
+    // likelihoods add it from the jitter's second moment themselves).
+    let s = if method.as_str() == "bj" {
+        s.with_jitter_floor(&exp.grid, Some(exp.noise.std))
+            .map_err(|e| cli_err!("{}: [noise]: {e}", exp.file))?
+    } else {
+        s
+    };
     if exp.noise.estimate {
         Ok(s)
     } else {
@@ -314,6 +322,10 @@ pub fn truth_values(
     }
     if s.estimate_noise {
         out.extend(exp.noise.shape.params().into_iter().map(Some));
+        // The floor's value depends on each record's input: no single truth.
+        if s.noise.floor() > 0.0 {
+            out.push(None);
+        }
     }
     if exp.noise.estimate {
         out.push(Some(exp.noise.std));

@@ -46,6 +46,7 @@ mod any_noise;
 mod boundary;
 mod covariance;
 mod criterion;
+pub mod csv;
 mod data;
 mod error;
 mod finite_diff;
@@ -53,6 +54,9 @@ mod fit;
 mod flatness;
 mod frequency_data;
 mod init;
+mod jitter_floor;
+mod joint;
+mod measured;
 pub mod ml;
 pub mod montecarlo;
 mod noise;
@@ -77,6 +81,9 @@ pub use frequency_data::FrequencyData;
 pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };
+pub use jitter_floor::mean_jitter_variance;
+pub use joint::{check_joint, estimate_joint, JointProblem};
+pub use measured::{InputLayout, MeasuredRecord};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
 pub use objective::{ArgminObjective, Objective, WithMetric};
 pub use profile::{profile, Profile};

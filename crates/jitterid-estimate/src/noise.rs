@@ -20,6 +20,11 @@ pub trait NoiseModel: fmt::Debug + Clone + Send + Sync {
     fn is_white(&self) -> bool {
         false
     }
+    /// The flat floor `ρ` that [`shape`](Self::shape) includes for the jitter's own noise
+    /// (`0` for a model without one): `shape − floor` is the measurement noise's shape alone.
+    fn floor(&self) -> f64 {
+        0.0
+    }
 }
 
 /// White measurement noise: `|H| ≡ 1`, no shape parameter.
@@ -182,5 +187,8 @@ impl<N: NoiseModel> NoiseModel for WithFloor<N> {
     }
     fn shape(&self, f: f64, interval: f64) -> f64 {
         self.inner.shape(f, interval) + self.floor
+    }
+    fn floor(&self) -> f64 {
+        self.floor
     }
 }
