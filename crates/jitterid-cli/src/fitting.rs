@@ -159,14 +159,6 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
         && !exp.noise.shape.is_white();
     let s = ModelStructure::bj(signal, exp.jitter.model.clone(), exp.noise.shape.clone())
         .with_estimated(exp.system.estimate, exp.jitter.estimate, shape_free);
-    // The Box–Jenkins criterion sees the jitter's white floor beside the ARMA shape (the
-    // likelihoods add it from the jitter's second moment themselves).
-    let s = if method.as_str() == "bj" {
-        s.with_jitter_floor(&exp.grid, Some(exp.noise.std))
-            .map_err(|e| cli_err!("{}: [noise]: {e}", exp.file))?
-    } else {
-        s
-    };
     if exp.noise.estimate {
         Ok(s)
     } else {
@@ -322,10 +314,6 @@ pub fn truth_values(
     }
     if s.estimate_noise {
         out.extend(exp.noise.shape.params().into_iter().map(Some));
-        // The floor's value depends on each record's input: no single truth.
-        if s.noise.floor() > 0.0 {
-            out.push(None);
-        }
     }
     if exp.noise.estimate {
         out.push(Some(exp.noise.std));
@@ -370,6 +358,18 @@ fn run_criterion(
             let fitted = base.with_params(&p.estimate.params)?;
             return Ok((p.estimate, fitted, Some(n)));
         }
+    }
+    // A criterion that weights by the noise model (Box–Jenkins) sees the jitter's white floor
+    // beside the ARMA shape; the likelihoods add it from the jitter's second moment themselves.
+    let sees_noise = criterion
+        .as_first_moment()
+        .is_some_and(|c| c.uses_noise_model());
+    if sees_noise {
+        let guess = (exp.noise.std > 0.0).then_some(exp.noise.std);
+        let (e, fitted) = s.fit_with_jitter_floor(record.grid(), guess, |floored| {
+            criterion.fit(floored, record, opts)
+        })?;
+        return Ok((e, fitted, None));
     }
     let e = criterion.fit(s, record, opts)?;
     let fitted = s.with_params(&e.params)?;

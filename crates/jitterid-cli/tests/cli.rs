@@ -601,7 +601,7 @@ estimate = true
 method = "bj"
 frequencies = [0.01, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4]
 "#,
-        &["gain", "pole0", "noise.d1", "noise.log_floor", "noise.std"],
+        &["gain", "pole0", "noise.d1", "noise.std"],
     ),
 ];
 

@@ -5,10 +5,17 @@
 //! sample, so the residual spectrum of a Box–Jenkins fit is `σ_e²|H(f)|² + λ̄` (`λ̄` the mean
 //! of that jitter variance over the record). An ARMA shape alone absorbs the floor and its
 //! coefficients are biased towards white noise; [`WithFloor`] models `σ_e² (|H|² + ρ)` with
-//! `ρ = λ̄ / σ_e²` estimated with the shape.
+//! `ρ = λ̄ / σ_e²`.
+//!
+//! `λ̄` follows from the signal and jitter models and `σ_e` from the residual spectrum, so the
+//! floor is not searched for: a free `ρ` is poorly determined by one record (on Table 2 with
+//! AR(1) noise its logarithm spreads over ±7 and the AR coefficient stays 6 standard errors
+//! off). [`ModelStructure::fit_with_jitter_floor`] fits with the floor known, sets
+//! `ρ = λ̄(θ̂) / σ̂_e²` from the estimate, and refits from there, a few rounds.
 
 use crate::any_noise::AnyNoise;
 use crate::noise::{NoiseModel, WithFloor};
+use crate::result::Fit;
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use jitterid_jitter::JitterModel;
@@ -16,6 +23,11 @@ use jitterid_signal::{SampleGrid, Signal};
 
 /// The start of the floor `ρ` when the measurement-noise level is not known.
 const FLOOR_START_WITHOUT_LEVEL: f64 = 1.0;
+
+/// Fits of [`ModelStructure::fit_with_jitter_floor`]: the first with the floor's start, then
+/// refits with `ρ` from the estimate. `ρ` depends on the estimate only through `λ̄(θ̂)` and
+/// `σ̂_e`, which the first refit already puts within their sampling error.
+pub const JITTER_FLOOR_ROUNDS: usize = 3;
 
 /// `λ̄ = mean_k (E[s(t_k+τ)²] − m_k²)`: the jitter's mean contribution to a sample's variance.
 pub fn mean_jitter_variance<S: Signal, J: JitterModel>(
@@ -39,10 +51,10 @@ where
     J: JitterModel + Clone,
     N: NoiseModel + 'static,
 {
-    /// The start of the floor `ρ = λ̄ / σ_e²` for this structure's signal and jitter on `grid`,
-    /// with `σ_e` = `noise_std` (`ρ = 1` when the level is unknown or zero). `None` when there
-    /// is nothing to add: white noise (its level already absorbs a flat floor), a shape that
-    /// has a floor already, or a jitter that adds no variance.
+    /// The floor `ρ = λ̄ / σ_e²` for this structure's signal and jitter on `grid`, with
+    /// `σ_e` = `noise_std` (`ρ = 1` when the level is unknown, zero or not finite). `None` when
+    /// there is nothing to add: white noise (its level already absorbs a flat floor), a shape
+    /// that has a floor already, or a jitter that adds no variance.
     pub fn jitter_floor_start(&self, grid: &SampleGrid, noise_std: Option<f64>) -> Option<f64> {
         if self.noise.is_white() || self.noise.floor() > 0.0 {
             return None;
@@ -58,22 +70,16 @@ where
         (rho.is_finite() && rho > 0.0).then_some(rho)
     }
 
-    /// The structure whose noise shape is `|H|² + ρ` ([`WithFloor`]), `ρ` started at
-    /// [`jitter_floor_start`](Self::jitter_floor_start) and estimated with the shape (the
-    /// parameter `log_floor` follows the shape's). The structure is returned with its shape
-    /// unchanged when there is no floor to add. This is the noise model Box–Jenkins and JBJ
-    /// fits of jittered data should use.
+    /// The structure whose noise shape is `|H|² + ρ` with the known floor `ρ` ([`WithFloor::known`],
+    /// no new parameter), or the shape unchanged for `None`.
     ///
     /// # Errors
     ///
-    /// [`EstimateError::Noise`] if the floor's start is not a valid floor (cannot happen for a
-    /// finite positive start).
-    pub fn with_jitter_floor(
+    /// [`EstimateError::Noise`] unless `ρ` is finite and `> 0`.
+    pub fn with_floor(
         self,
-        grid: &SampleGrid,
-        noise_std: Option<f64>,
+        floor: Option<f64>,
     ) -> Result<ModelStructure<S, J, AnyNoise>, EstimateError> {
-        let start = self.jitter_floor_start(grid, noise_std);
         let ModelStructure {
             signal,
             jitter,
@@ -81,10 +87,10 @@ where
             estimate_signal,
             estimate_jitter,
             estimate_noise,
-            noise_std: known_std,
+            noise_std,
         } = self;
-        let noise = match start {
-            Some(rho) => AnyNoise::new(WithFloor::new(noise, rho)?),
+        let noise = match floor {
+            Some(rho) => AnyNoise::new(WithFloor::known(noise, rho)?),
             None => AnyNoise::new(noise),
         };
         Ok(ModelStructure {
@@ -94,7 +100,63 @@ where
             estimate_signal,
             estimate_jitter,
             estimate_noise,
-            noise_std: known_std,
+            noise_std,
         })
+    }
+
+    /// The structure with the jitter's floor at [`jitter_floor_start`](Self::jitter_floor_start)
+    /// (known, not estimated; unchanged when there is no floor to add).
+    ///
+    /// # Errors
+    ///
+    /// Those of [`with_floor`](Self::with_floor).
+    pub fn with_jitter_floor(
+        self,
+        grid: &SampleGrid,
+        noise_std: Option<f64>,
+    ) -> Result<ModelStructure<S, J, AnyNoise>, EstimateError> {
+        let start = self.jitter_floor_start(grid, noise_std);
+        self.with_floor(start)
+    }
+
+    /// A Box–Jenkins or JBJ fit whose noise spectrum is the shape plus the jitter's floor, the
+    /// default way to fit a coloured noise model to jittered data: `fit` (any estimator, called
+    /// with a structure whose parameters are this one's) runs first with the floor's start
+    /// (`noise_std` as the level guess, or the known level), then [`JITTER_FLOOR_ROUNDS`]` − 1`
+    /// times more with `ρ = λ̄(θ̂) / σ̂_e²` from the previous estimate and its noise level, each
+    /// started at that estimate. Returns the last fit and the fitted structure (with its floor).
+    /// Without a floor to add, one fit.
+    ///
+    /// # Errors
+    ///
+    /// Those of `fit` and of the structures' parameters.
+    pub fn fit_with_jitter_floor<F>(
+        &self,
+        grid: &SampleGrid,
+        noise_std: Option<f64>,
+        mut fit: F,
+    ) -> Result<(Fit, ModelStructure<S, J, AnyNoise>), EstimateError>
+    where
+        F: FnMut(&ModelStructure<S, J, AnyNoise>) -> Result<Fit, EstimateError>,
+    {
+        let guess = self.noise_std.or(noise_std);
+        let mut structure = self.clone().with_jitter_floor(grid, guess)?;
+        let mut estimate = fit(&structure)?;
+        if structure.noise.floor() > 0.0 {
+            for _ in 1..JITTER_FLOOR_ROUNDS {
+                let fitted = self.with_params(&estimate.params)?;
+                let level = self.noise_std.unwrap_or(estimate.noise_std);
+                if !(level.is_finite() && level > 0.0) {
+                    break;
+                }
+                let Some(rho) = fitted.jitter_floor_start(grid, Some(level)) else {
+                    break;
+                };
+                structure = fitted.with_floor(Some(rho))?;
+                estimate = fit(&structure)?;
+            }
+        }
+        let fitted = structure.with_params(&estimate.params)?;
+        Ok((estimate, fitted))
     }
 }

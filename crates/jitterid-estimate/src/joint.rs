@@ -2,10 +2,12 @@
 //! with one criterion summed over the records (as a system-identification toolbox's `merge`).
 //!
 //! Each record keeps its own [`FrequencyData`] and its own structure (the same model driven by
-//! that record's input); the parameters are shared. The cost is the sum of the records' costs,
-//! the normal equations the sum of theirs (Levenberg–Marquardt sees one problem), and the
-//! covariance the sandwich of the summed bread and meat: the records are independent, so their
-//! information adds.
+//! that record's input); the parameters are shared. A record's DTFT residuals grow as `√N`
+//! (`E|D(f)|² = Σ_k λ_k`), so each record's residuals are scaled by `1/√N_i`: the summed cost
+//! then weighs every sample alike, as one long record would, whatever the records' lengths.
+//! The normal equations are the scaled sums of the records' (Levenberg–Marquardt sees one
+//! problem), and the covariance the sandwich of the summed bread and meat: the records are
+//! independent, so their information adds.
 
 use crate::covariance::{sandwich_of, sandwich_parts};
 use crate::criterion::Criterion;
@@ -22,10 +24,17 @@ use jitterid_jitter::JitterModel;
 use jitterid_signal::Signal;
 use jitterid_window::Window;
 
+/// `c · m`.
+fn scaled(m: &Mat<f64>, c: f64) -> Mat<f64> {
+    Mat::from_fn(m.nrows(), m.ncols(), |i, j| c * m[(i, j)])
+}
+
 /// The records' problems as one least-squares problem in the shared parameters.
 #[derive(Debug)]
 pub struct JointProblem<'a, S, J, N, C: ?Sized, W> {
     parts: Vec<FitProblem<'a, S, J, N, C, W>>,
+    /// `1/N_i`: the factor on each record's cost.
+    scales: Vec<f64>,
 }
 
 impl<S, J, N, C, W> JointProblem<'_, S, J, N, C, W> {
@@ -53,8 +62,9 @@ where
 
     fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
         let mut r = Vec::with_capacity(self.num_residuals());
-        for part in &self.parts {
-            r.extend(part.residuals(theta)?);
+        for (part, c) in self.parts.iter().zip(&self.scales) {
+            let root = c.sqrt();
+            r.extend(part.residuals(theta)?.into_iter().map(|x| x * root));
         }
         Ok(r)
     }
@@ -68,10 +78,11 @@ where
         let rows: usize = blocks.iter().map(|b| b.nrows()).sum();
         let mut j = Mat::zeros(rows, self.num_params());
         let mut at = 0;
-        for b in &blocks {
+        for (b, scale) in blocks.iter().zip(&self.scales) {
+            let root = scale.sqrt();
             for i in 0..b.nrows() {
                 for c in 0..b.ncols() {
-                    j[(at + i, c)] = b[(i, c)];
+                    j[(at + i, c)] = root * b[(i, c)];
                 }
             }
             at += b.nrows();
@@ -96,13 +107,16 @@ where
             gradient: vec![0.0; p],
         };
         let mut at = 0;
-        for part in &self.parts {
+        for (part, &c) in self.parts.iter().zip(&self.scales) {
             let m = part.num_residuals();
-            let ne = part.normal_equations(theta, &residuals[at..at + m])?;
+            // The record's own residuals are the scaled ones over √c.
+            let root = c.sqrt();
+            let own: Vec<f64> = residuals[at..at + m].iter().map(|r| r / root).collect();
+            let ne = part.normal_equations(theta, &own)?;
             at += m;
-            sum.gram = &sum.gram + &ne.gram;
+            sum.gram = &sum.gram + &scaled(&ne.gram, c);
             for (s, g) in sum.gradient.iter_mut().zip(&ne.gradient) {
-                *s += g;
+                *s += c * g;
             }
         }
         Ok(sum)
@@ -224,6 +238,7 @@ where
                 data,
             })
             .collect(),
+        scales: records.iter().map(|r| 1.0 / r.y().len() as f64).collect(),
     };
     if problem.num_residuals() < p {
         return Err(EstimateError::TooFewData {
@@ -250,10 +265,11 @@ where
         let mut gram = Mat::zeros(p, p);
         let mut meat = Mat::zeros(p, p);
         let mut noise_var = 0.0;
-        for (d, s) in data.iter().zip(&fitted) {
+        for ((d, s), &c) in data.iter().zip(&fitted).zip(&problem.scales) {
             let (g, m, v) = sandwich_parts(d, s, criterion);
-            gram = &gram + &g;
-            meat = &meat + &m;
+            // r scaled by √c: JᵀJ by c, Jᵀ Σ_r J by c² (J on both sides and Σ_r).
+            gram = &gram + &scaled(&g, c);
+            meat = &meat + &scaled(&m, c * c);
             noise_var += v / data.len() as f64;
         }
         sandwich_of(&gram, &meat, &[], noise_var)

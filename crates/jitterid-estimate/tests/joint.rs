@@ -12,21 +12,24 @@ use rand::SeedableRng;
 
 type Structure = ModelStructure<LtiResponse<Zpk>, UniformSum>;
 
-/// A Table 2 record of `n` samples (seed `seed`) and the OE structure on its input, started
-/// 10 % off the truth.
-fn table2(seed: u64, n: usize) -> (Structure, MeasuredRecord) {
+/// A Table 2 record of `n` samples (seed `seed`) with jitter of half-width `a`, and the OE
+/// structure on its input with the noise level known, started 10 % off the truth.
+fn table2(seed: u64, n: usize, a: f64) -> (Structure, MeasuredRecord) {
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     let u = RandomBinary::paper()
         .generate(0.0, n as f64 + 1.0, &mut rng)
         .unwrap();
-    let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
+    let jitter = UniformSum::new(2, a).unwrap();
     let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
     let truth = LtiResponse::new(eq17(0.2, 0.5, -0.25, 0.3).unwrap(), u.clone());
     let data = simulate(&truth, &jitter, &grid, 0.01, &mut rng).unwrap();
     let start = LtiResponse::new(eq17(0.22, 0.45, -0.27, 0.33).unwrap(), u.clone());
     let record = MeasuredRecord::new(format!("seed {seed}"), Record::new(grid, data.y).unwrap())
         .with_input(Input::Piecewise(u));
-    (ModelStructure::oe(start, jitter), record)
+    let structure = ModelStructure::oe(start, jitter)
+        .with_noise_std(0.01)
+        .unwrap();
+    (structure, record)
 }
 
 /// `A⁻¹` of a small symmetric positive definite matrix by Gauss–Jordan elimination.
@@ -61,8 +64,10 @@ fn inverse(a: &[Vec<f64>]) -> Vec<Vec<f64>> {
 
 #[test]
 fn the_joint_covariance_is_the_inverse_of_the_summed_information() {
-    let (s1, r1) = table2(11, 200);
-    let (s2, r2) = table2(12, 150);
+    // Jitter far below the noise: every sample's variance is σ_v², so each record's sandwich
+    // is σ_v² (JᵀJ)⁻¹ and the information of the two records adds exactly (at one θ).
+    let (s1, r1) = table2(11, 200, 1e-4);
+    let (s2, r2) = table2(12, 150, 1e-4);
     let options = EstimateOptions::default();
     let f1 = estimate(&s1, r1.record(), &Bcls, &options).unwrap();
     let f2 = estimate(&s2, r2.record(), &Bcls, &options).unwrap();
@@ -78,12 +83,13 @@ fn the_joint_covariance_is_the_inverse_of_the_summed_information() {
         .map(|(a, b)| a.iter().zip(b).map(|(x, y)| x + y).collect())
         .collect();
     let expected = inverse(&summed);
-    // The sandwich's bread and meat are evaluated at each fit's own estimate and the meat is
-    // only nearly proportional to the bread (heteroscedastic jitter), so the two agree to the
-    // first order: 10 % on each variance.
+    // Each record's information is evaluated at its own estimate, the joint one at the joint
+    // estimate, so the two agree to first order only (the exact identity, at one θ, is
+    // `one_record_twice_halves_the_covariance_exactly`). Measured here: 1.6 % to 9.7 % larger
+    // joint variances; the check allows 15 %.
     for i in 0..4 {
         let ratio = cj[i][i] / expected[i][i];
-        assert!((ratio - 1.0).abs() < 0.10, "parameter {i}: ratio {ratio}");
+        assert!((ratio - 1.0).abs() < 0.15, "parameter {i}: ratio {ratio}");
         // More data, smaller variance than either record alone.
         assert!(cj[i][i] < c1[i][i] && cj[i][i] < c2[i][i], "parameter {i}");
     }
@@ -114,9 +120,33 @@ fn the_joint_covariance_is_the_inverse_of_the_summed_information() {
 }
 
 #[test]
+fn one_record_twice_halves_the_covariance_exactly() {
+    let (s1, r1) = table2(11, 200, 0.1);
+    let options = EstimateOptions::default();
+    let single = estimate(&s1, r1.record(), &Bcls, &options).unwrap();
+    let joint = estimate_joint(&[s1.clone(), s1], &[r1.clone(), r1], &Bcls, &options).unwrap();
+    let (c1, cj) = (single.covariance.unwrap(), joint.covariance.unwrap());
+    for i in 0..4 {
+        // The same minimum (to the solver's tolerance) and half the covariance.
+        let se = c1[i][i].sqrt();
+        assert!(
+            (joint.params[i] - single.params[i]).abs() < 1e-3 * se,
+            "parameter {i}"
+        );
+        for j in 0..4 {
+            let scale = (c1[i][i] * c1[j][j]).sqrt();
+            assert!(
+                (cj[i][j] - c1[i][j] / 2.0).abs() < 1e-3 * scale,
+                "({i}, {j})"
+            );
+        }
+    }
+}
+
+#[test]
 fn records_of_different_systems_are_refused_by_name() {
-    let (s1, r1) = table2(11, 200);
-    let (s2, r2) = table2(12, 150);
+    let (s1, r1) = table2(11, 200, 0.1);
+    let (s2, r2) = table2(12, 150, 0.1);
     let bare = MeasuredRecord::new("no input", r2.record().clone());
     let e = check_joint(&[s1.clone(), s2.clone()], &[r1.clone(), bare]).unwrap_err();
     match &e {
