@@ -50,9 +50,9 @@ fn d1_estimates(with_floor: bool) -> Vec<f64> {
             .zip(&v)
             .map(|((y, e), v)| y - e + v)
             .collect();
-        let record = Record::new(grid.clone(), y).unwrap();
+        let record = Record::new(grid, y).unwrap();
         let noise = ArmaNoise::new(Vec::new(), vec![D1]).unwrap();
-        let s = ModelStructure::bj(truth, jitter.clone(), noise);
+        let s = ModelStructure::bj(truth, jitter, noise);
         let options = EstimateOptions::default();
         let fit = if with_floor {
             let (fit, fitted) = s
@@ -106,7 +106,7 @@ fn the_floor_start_is_the_jitter_variance_over_the_noise_level() {
     assert!(lambda > 0.0);
     let arma = ModelStructure::bj(
         truth.clone(),
-        jitter.clone(),
+        jitter,
         ArmaNoise::new(vec![], vec![D1]).unwrap(),
     );
     let rho = arma.jitter_floor_start(&grid, Some(0.01)).unwrap();

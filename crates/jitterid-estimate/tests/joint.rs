@@ -156,7 +156,7 @@ fn records_of_different_systems_are_refused_by_name() {
         }
         other => panic!("{other:?}"),
     }
-    let e = check_joint(&[s1.clone()], &[r1.clone(), r2.clone()]).unwrap_err();
+    let e = check_joint(std::slice::from_ref(&s1), &[r1.clone(), r2.clone()]).unwrap_err();
     assert!(e.to_string().contains("one structure per record"), "{e}");
     let fixed = s2.with_estimated(false, false, false);
     let e = check_joint(&[s1, fixed], &[r1, r2]).unwrap_err();

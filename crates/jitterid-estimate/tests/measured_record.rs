@@ -32,7 +32,7 @@ proptest! {
             levels.push(*level);
         }
         let input = PiecewiseConstant::new(edges, levels).unwrap();
-        let rec = MeasuredRecord::new("r", Record::new(grid.clone(), y.clone()).unwrap())
+        let rec = MeasuredRecord::new("r", Record::new(grid, y.clone()).unwrap())
             .with_input(Input::Piecewise(input.clone()));
         // The data file alone: samples exact, the grid to rounding, the input held.
         let table = parse("r.csv", &record_to_csv(&rec)).unwrap();
@@ -61,7 +61,7 @@ fn save_and_load_through_files() {
     let input = PiecewiseConstant::new(vec![0.0, 0.7, 3.0], vec![1.0, -2.0]).unwrap();
     let rec = MeasuredRecord::new(
         "a",
-        Record::new(grid.clone(), vec![1.0, 2.0, 3.0, 4.0, 5.5]).unwrap(),
+        Record::new(grid, vec![1.0, 2.0, 3.0, 4.0, 5.5]).unwrap(),
     )
     .with_input(Input::Piecewise(input.clone()))
     .with_noise_std(0.01)

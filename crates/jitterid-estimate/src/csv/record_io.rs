@@ -31,7 +31,7 @@ pub fn input_side_file(data: &Path) -> PathBuf {
 fn grid_of(table: &Table, n: usize, grid: Option<&SampleGrid>) -> Result<SampleGrid, CsvError> {
     let t = table.optional("t");
     let grid = match (grid, t) {
-        (Some(g), _) => g.clone(),
+        (Some(g), _) => *g,
         (None, Some(t)) if n >= 2 => {
             let step = (t[n - 1] - t[0]) / (n - 1) as f64;
             SampleGrid::new(t[0], step, n).map_err(|e| {
