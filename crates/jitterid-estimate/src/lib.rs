@@ -88,7 +88,7 @@ pub use frequency_data::FrequencyData;
 pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };
-pub use jitter_floor::mean_jitter_variance;
+pub use jitter_floor::{mean_jitter_variance, JITTER_FLOOR_ROUNDS};
 pub use joint::{check_joint, estimate_joint, JointProblem};
 pub use measured::{InputLayout, MeasuredRecord};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};

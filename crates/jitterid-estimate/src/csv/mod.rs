@@ -1,4 +1,4 @@
-//! The project's CSV files in the library: numeric tables ([`Table`], [`parse`], [`format`])
+//! The project's CSV files in the library: numeric tables ([`Table`], [`parse`], [`format()`])
 //! and measured records ([`load_record`], [`save_record`]), with errors ([`CsvError`]) that
 //! name the file, the line and the column.
 
