@@ -27,11 +27,7 @@ pub const DEFAULT_SEED: u64 = 20_051_205;
 
 /// The side file holding the input of a simulated record: `data.csv` → `data.input.csv`.
 pub fn input_side_file(data: &Path) -> PathBuf {
-    let stem = data
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "data".into());
-    data.with_file_name(format!("{stem}.input.csv"))
+    jitterid::estimate::csv::input_side_file(data)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -104,12 +100,7 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
         } else {
             let side = input_side_file(&o.out);
             let edges = p.edges();
-            let mut levels = p.levels().to_vec();
-            levels.push(0.0);
-            outputs.file(
-                &side,
-                csvio::format(&[Column::Real("t", edges), Column::Real("u", &levels)]),
-            );
+            outputs.file(&side, jitterid::estimate::csv::input_to_csv(p));
             let _ = write!(
                 report,
                 "; {}: the input's {} switch times and levels",

@@ -359,6 +359,18 @@ fn run_criterion(
             return Ok((p.estimate, fitted, Some(n)));
         }
     }
+    // A criterion that weights by the noise model (Box–Jenkins) sees the jitter's white floor
+    // beside the ARMA shape; the likelihoods add it from the jitter's second moment themselves.
+    let sees_noise = criterion
+        .as_first_moment()
+        .is_some_and(|c| c.uses_noise_model());
+    if sees_noise {
+        let guess = (exp.noise.std > 0.0).then_some(exp.noise.std);
+        let (e, fitted) = s.fit_with_jitter_floor(record.grid(), guess, |floored| {
+            criterion.fit(floored, record, opts)
+        })?;
+        return Ok((e, fitted, None));
+    }
     let e = criterion.fit(s, record, opts)?;
     let fitted = s.with_params(&e.params)?;
     Ok((e, fitted, None))

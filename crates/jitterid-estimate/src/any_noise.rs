@@ -23,6 +23,8 @@ pub trait DynNoise: fmt::Debug + Send + Sync {
     fn shape(&self, f: f64, interval: f64) -> f64;
     /// [`NoiseModel::is_white`].
     fn is_white(&self) -> bool;
+    /// [`NoiseModel::floor`].
+    fn floor(&self) -> f64;
 }
 
 impl<N: NoiseModel + 'static> DynNoise for N {
@@ -40,6 +42,9 @@ impl<N: NoiseModel + 'static> DynNoise for N {
     }
     fn is_white(&self) -> bool {
         NoiseModel::is_white(self)
+    }
+    fn floor(&self) -> f64 {
+        NoiseModel::floor(self)
     }
 }
 
@@ -77,6 +82,9 @@ impl NoiseModel for AnyNoise {
     }
     fn is_white(&self) -> bool {
         self.0.is_white()
+    }
+    fn floor(&self) -> f64 {
+        self.0.floor()
     }
 }
 

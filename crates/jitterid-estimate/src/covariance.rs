@@ -42,6 +42,24 @@ where
     C: Criterion + ?Sized,
     W: Window,
 {
+    let (gram, meat, noise_var) = sandwich_parts(data, model, criterion);
+    sandwich_of(&gram, &meat, held, noise_var)
+}
+
+/// The bread `JᵀJ`, the meat `Jᵀ Σ_r J` and the noise variance of one record's sandwich: the
+/// parts that sum over the records of a joint fit.
+pub(crate) fn sandwich_parts<S, J, N, C, W>(
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+    criterion: &C,
+) -> (Mat<f64>, Mat<f64>, f64)
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion + ?Sized,
+    W: Window,
+{
     let (jitter_var, noise_var) = sample_variances(data, model);
     let white = model.noise.is_white();
     let (gram, meat) = match parseval_weight(criterion, data, model) {
@@ -56,13 +74,24 @@ where
             (crate::solver::gram(&jac), meat)
         }
     };
+    (gram, meat, noise_var)
+}
+
+/// `H⁻¹ M H⁻¹` from the bread `H` and the meat `M`, with the `held` parameters' rows and
+/// columns zero, and `σ_v`.
+pub(crate) fn sandwich_of(
+    gram: &Mat<f64>,
+    meat: &Mat<f64>,
+    held: &[usize],
+    noise_var: f64,
+) -> (Option<Vec<Vec<f64>>>, f64) {
     let p = gram.nrows();
     let free: Vec<usize> = (0..p).filter(|i| !held.contains(i)).collect();
     let block = |m: &Mat<f64>| Mat::from_fn(free.len(), free.len(), |a, b| m[(free[a], free[b])]);
-    let Some(hinv) = inverse_gram(&block(&gram)) else {
+    let Some(hinv) = inverse_gram(&block(gram)) else {
         return (None, noise_var.sqrt());
     };
-    let cov = &hinv * &block(&meat) * &hinv;
+    let cov = &hinv * &block(meat) * &hinv;
     let mut out = vec![vec![0.0; p]; p];
     for (a, &i) in free.iter().enumerate() {
         for (b, &j) in free.iter().enumerate() {
@@ -116,12 +145,18 @@ where
             let mut acc = 0.0;
             for ((y, mu), &f) in data.dtft().iter().zip(&mu).zip(freqs.frequencies()) {
                 let d2 = (y - mu).norm_sqr() / n as f64;
-                acc += (d2 - mean_jitter_var).max(0.0) / model.noise.shape(f, t);
+                acc += (d2 - mean_jitter_var).max(0.0) / measurement_shape(&model.noise, f, t);
             }
             acc / freqs.len() as f64
         }
     };
     (jitter_var, noise_var)
+}
+
+/// The measurement noise's own shape `|H(f)|²`: a jitter floor in the noise model is already in
+/// the samples' jitter variances.
+fn measurement_shape<N: NoiseModel>(noise: &N, f: f64, t: f64) -> f64 {
+    noise.shape(f, t) - noise.floor()
 }
 
 /// `Jᵀ Σ_r J` for white noise in the Parseval case, accumulated sample by sample: the row of
@@ -197,7 +232,7 @@ where
         let nyquist = 0.5 / t;
         let energy: f64 = taper.iter().map(|c| c * c).sum();
         for (fi, &f) in freqs.frequencies().iter().enumerate() {
-            let phi = noise_var * model.noise.shape(f, t) * energy;
+            let phi = noise_var * measurement_shape(&model.noise, f, t) * energy;
             let edge = f == 0.0 || (f - nyquist).abs() < 1e-12 * nyquist;
             let (vre, vim) = if edge {
                 (phi, 0.0)

@@ -77,6 +77,14 @@ pub enum EstimateError {
     /// The noise model is invalid (for example a non-minimum-phase or unstable ARMA filter).
     #[error("noise model: {0}")]
     Noise(String),
+    /// Records given to a joint fit that do not belong to one system.
+    #[error("joint fit: record {record}: {message}")]
+    JointRecords {
+        /// The record's name (empty when the problem is the list itself).
+        record: String,
+        /// What differs.
+        message: String,
+    },
     /// A parameter vector of the wrong length.
     #[error("the model structure takes {expected} free parameter(s), got {got}")]
     WrongParamCount {

@@ -12,6 +12,13 @@
 //! for the heteroscedastic jittered samples, or the inverse Hessian of `−log L`), the cost,
 //! the termination reason. An integer-valued jitter parameter is profiled ([`profile`]).
 //!
+//! Measured data: a [`MeasuredRecord`] holds what a measurement holds (samples, requested
+//! instants, the input, an optional known noise level, a name), read from and written to the
+//! command line's CSV files by [`csv`]; a fitted run-time signal is moved to another record's
+//! input with [`AnySignal::with_input`](jitterid_signal::AnySignal::with_input). Several records
+//! of one system are fitted together by [`estimate_joint`]. Box–Jenkins noise models of jittered
+//! data carry the jitter's white floor ([`ModelStructure::with_jitter_floor`]).
+//!
 //! Run-time choices (a command line, Python) go through [`AnyNoise`] / [`NoiseRegistry`],
 //! [`AnyCriterion`] / [`CriterionRegistry`] and [`solver::AnySolver`] /
 //! [`solver::SolverRegistry`], built from spec tables whose keys are described by
@@ -46,6 +53,7 @@ mod any_noise;
 mod boundary;
 mod covariance;
 mod criterion;
+pub mod csv;
 mod data;
 mod error;
 mod finite_diff;
@@ -53,6 +61,9 @@ mod fit;
 mod flatness;
 mod frequency_data;
 mod init;
+mod jitter_floor;
+mod joint;
+mod measured;
 pub mod ml;
 pub mod montecarlo;
 mod noise;
@@ -77,6 +88,9 @@ pub use frequency_data::FrequencyData;
 pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };
+pub use jitter_floor::{mean_jitter_variance, JITTER_FLOOR_ROUNDS};
+pub use joint::{check_joint, estimate_joint, JointProblem};
+pub use measured::{InputLayout, MeasuredRecord};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
 pub use objective::{ArgminObjective, Objective, WithMetric};
 pub use profile::{profile, Profile};

@@ -20,6 +20,11 @@ pub trait NoiseModel: fmt::Debug + Clone + Send + Sync {
     fn is_white(&self) -> bool {
         false
     }
+    /// The flat floor `ρ` that [`shape`](Self::shape) includes for the jitter's own noise
+    /// (`0` for a model without one): `shape − floor` is the measurement noise's shape alone.
+    fn floor(&self) -> f64 {
+        0.0
+    }
 }
 
 /// White measurement noise: `|H| ≡ 1`, no shape parameter.
@@ -141,6 +146,9 @@ impl NoiseModel for ArmaNoise {
 pub struct WithFloor<N> {
     inner: N,
     floor: f64,
+    /// A known floor: not a parameter (see [`WithFloor::known`]).
+    #[serde(default)]
+    known: bool,
 }
 
 impl<N: NoiseModel> WithFloor<N> {
@@ -151,7 +159,25 @@ impl<N: NoiseModel> WithFloor<N> {
                 "floor must be finite and > 0, got {floor}"
             )));
         }
-        Ok(Self { inner, floor })
+        Ok(Self {
+            inner,
+            floor,
+            known: false,
+        })
+    }
+
+    /// A floor `ρ` set from outside and not estimated with the shape: the parameters are the
+    /// shape's alone. The jitter's floor is known from the jitter model up to the noise level
+    /// (`ρ = λ̄ / σ_e²`), so a fit updates it between rounds instead of searching for it
+    /// ([`ModelStructure::fit_with_jitter_floor`](crate::ModelStructure::fit_with_jitter_floor)).
+    ///
+    /// # Errors
+    ///
+    /// [`EstimateError::Noise`] unless `floor` is finite and `> 0`.
+    pub fn known(inner: N, floor: f64) -> Result<Self, EstimateError> {
+        let mut with = Self::new(inner, floor)?;
+        with.known = true;
+        Ok(with)
     }
 
     /// The floor `ρ`.
@@ -163,15 +189,22 @@ impl<N: NoiseModel> WithFloor<N> {
 impl<N: NoiseModel> NoiseModel for WithFloor<N> {
     fn param_names(&self) -> Vec<String> {
         let mut n = self.inner.param_names();
-        n.push("log_floor".into());
+        if !self.known {
+            n.push("log_floor".into());
+        }
         n
     }
     fn params(&self) -> Vec<f64> {
         let mut p = self.inner.params();
-        p.push(self.floor.ln());
+        if !self.known {
+            p.push(self.floor.ln());
+        }
         p
     }
     fn with_params(&self, params: &[f64]) -> Result<Self, EstimateError> {
+        if self.known {
+            return Self::known(self.inner.with_params(params)?, self.floor);
+        }
         let Some((&log_floor, inner)) = params.split_last() else {
             return Err(EstimateError::WrongParamCount {
                 expected: self.inner.params().len() + 1,
@@ -182,5 +215,8 @@ impl<N: NoiseModel> NoiseModel for WithFloor<N> {
     }
     fn shape(&self, f: f64, interval: f64) -> f64 {
         self.inner.shape(f, interval) + self.floor
+    }
+    fn floor(&self) -> f64 {
+        self.floor
     }
 }

@@ -83,6 +83,20 @@ impl AnySignal {
         spec
     }
 
+    /// The same model (same kind and parameters) driven by `input`, rebuilt through the
+    /// built-in registry: a model fitted on one record, evaluated on another record's input.
+    /// A kind registered elsewhere is rebuilt with
+    /// [`SignalRegistry::build`](crate::registry::SignalRegistry::build) of its own registry and
+    /// this model's [`spec`](Self::spec).
+    ///
+    /// # Errors
+    ///
+    /// Those of [`SignalRegistry::build`](crate::registry::SignalRegistry::build): an unknown
+    /// kind, an input the kind cannot take.
+    pub fn with_input(&self, input: &crate::Input) -> Result<AnySignal, SignalError> {
+        crate::registry::SignalRegistry::builtin().build(&self.spec(), Some(input))
+    }
+
     /// The model inside, as a trait object.
     pub fn model(&self) -> &dyn Signal {
         self.0.model()

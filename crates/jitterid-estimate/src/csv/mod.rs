@@ -1,0 +1,14 @@
+//! The project's CSV files in the library: numeric tables ([`Table`], [`parse`], [`format()`])
+//! and measured records ([`load_record`], [`save_record`]), with errors ([`CsvError`]) that
+//! name the file, the line and the column.
+
+mod error;
+mod record_io;
+mod table;
+
+pub use error::{io_reason, CsvError};
+pub use record_io::{
+    input_from_table, input_side_file, input_to_csv, load_record, piecewise, record_from_table,
+    record_to_csv, save_record,
+};
+pub use table::{check_regular_file, format, parse, read, Column, Table, MAX_FILE_BYTES};

@@ -1,0 +1,411 @@
+//! The plain numeric CSV files of the project: parsing with errors that name the line and the
+//! column, and formatting that reads back to the same values.
+//!
+//! The format: a header line of column names, then one line per row of numbers, all separated by
+//! commas. Blank lines and lines starting with `#` are skipped. Every cell must parse as a
+//! finite number (`1`, `-0.25`, `3e-4`); every row has as many cells as the header. There is no
+//! quoting (names may be wrapped in double quotes, which are removed). Lines end with LF, CR LF
+//! or a lone CR (old Mac files). Problems are named as `file:line:column:` (both 1-based, the
+//! column counted in characters to the start of the cell).
+
+use super::error::{io_reason, CsvError};
+use std::collections::HashSet;
+use std::path::Path;
+
+/// A parsed CSV file: named numeric columns of equal length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// The file's name, for messages.
+    pub name: String,
+    /// Line of the header (1-based).
+    pub header_line: usize,
+    /// Column names, in file order.
+    pub columns: Vec<String>,
+    /// The values, one vector per column.
+    pub values: Vec<Vec<f64>>,
+    /// The line (1-based) of every row.
+    pub lines: Vec<usize>,
+}
+
+impl Table {
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Index of a column.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.columns.iter().position(|c| c == name)
+    }
+
+    /// The values of a column, or an error naming the header and what was expected.
+    ///
+    /// # Errors
+    ///
+    /// [`CsvError::At`] at the header line when there is no such column.
+    pub fn column(&self, name: &str) -> Result<&[f64], CsvError> {
+        match self.index(name) {
+            Some(i) => Ok(&self.values[i]),
+            None => Err(self.error(
+                Some(self.header_line),
+                format!(
+                    "header: expected a column named `{name}`, found {}",
+                    some_names(&self.columns)
+                ),
+            )),
+        }
+    }
+
+    /// The values of a column if it is there.
+    pub fn optional(&self, name: &str) -> Option<&[f64]> {
+        self.index(name).map(|i| self.values[i].as_slice())
+    }
+
+    /// An error at `line` of this file (no column).
+    pub fn error(&self, line: Option<usize>, message: impl Into<String>) -> CsvError {
+        CsvError::at(&self.name, line, None, message)
+    }
+
+    /// An error at row `row` (0-based) of column `column`.
+    pub fn cell_error(&self, row: usize, column: &str, message: impl Into<String>) -> CsvError {
+        let line = self.lines.get(row).copied();
+        CsvError::at(
+            &self.name,
+            line,
+            None,
+            format!("column `{}`: {}", shorten(column), message.into()),
+        )
+    }
+}
+
+fn clean_name(s: &str) -> &str {
+    let s = s.trim();
+    s.strip_prefix('"')
+        .and_then(|s| s.strip_suffix('"'))
+        .unwrap_or(s)
+        .trim()
+}
+
+/// The lines of `text`, ending at LF, CR LF or a lone CR.
+fn lines_of(text: &str) -> impl Iterator<Item = &str> {
+    text.split("\r\n").flat_map(|l| l.split(['\n', '\r']))
+}
+
+/// The cells of a line, each with its 1-based column (in characters) where it starts.
+fn cells_of(line: &str) -> Vec<(usize, &str)> {
+    let mut col = 1;
+    line.split(',')
+        .map(|cell| {
+            let start = col + cell.chars().take_while(|c| c.is_whitespace()).count();
+            col += cell.chars().count() + 1;
+            (start, cell)
+        })
+        .collect()
+}
+
+/// At most a few column names, for a message.
+fn some_names(columns: &[String]) -> String {
+    const SHOWN: usize = 8;
+    let mut s = columns
+        .iter()
+        .take(SHOWN)
+        .map(|c| shorten(c))
+        .collect::<Vec<_>>()
+        .join(",");
+    if columns.len() > SHOWN {
+        s.push_str(&format!(",… ({} more)", columns.len() - SHOWN));
+    }
+    s
+}
+
+fn shorten(s: &str) -> String {
+    let mut out: String = s.chars().take(40).collect();
+    if s.chars().count() > 40 {
+        out.push('…');
+    }
+    out.escape_debug().to_string()
+}
+
+/// The column names of a header line, checked: named, not numbers, each once.
+fn header_names(name: &str, line: usize, header: &str) -> Result<Vec<String>, CsvError> {
+    let err = |col: usize, m: String| CsvError::at(name, Some(line), Some(col), m);
+    let mut columns: Vec<String> = Vec::new();
+    // A set, so that a header of 200 000 names is checked in linear time.
+    let mut seen: HashSet<&str> = HashSet::new();
+    for (i, (col, cell)) in cells_of(header).into_iter().enumerate() {
+        let c = clean_name(cell);
+        if c.is_empty() {
+            return Err(err(col, format!(
+                "header: column {} has no name; expected a comma-separated list of names such as k,t,y",
+                i + 1
+            )));
+        }
+        if c.parse::<f64>().is_ok() {
+            return Err(err(col, format!(
+                "header: expected column names, found the number `{}` (is the header line missing?)",
+                shorten(c)
+            )));
+        }
+        if !seen.insert(c) {
+            return Err(err(
+                col,
+                format!("header: column `{}` appears twice", shorten(c)),
+            ));
+        }
+        columns.push(c.to_string());
+    }
+    Ok(columns)
+}
+
+/// Parses CSV text; `name` is used in messages.
+///
+/// # Errors
+///
+/// [`CsvError::At`] naming the line and column of the first problem.
+pub fn parse(name: &str, text: &str) -> Result<Table, CsvError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = lines_of(text)
+        .enumerate()
+        .map(|(i, l)| (i + 1, l))
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err(CsvError::at(
+            name,
+            None,
+            None,
+            "empty file; expected a header line of column names (for example k,t,y)",
+        ));
+    };
+    let columns = header_names(name, header_line, header)?;
+    let mut values = vec![Vec::new(); columns.len()];
+    let mut rows = Vec::new();
+    for (line, text) in lines {
+        let err = |col: usize, m: String| CsvError::at(name, Some(line), Some(col), m);
+        let cells = cells_of(text);
+        if cells.len() != columns.len() {
+            // The column where the row goes wrong: its first extra cell, or its end.
+            let col = cells
+                .get(columns.len())
+                .map_or(text.chars().count() + 1, |(c, _)| *c);
+            return Err(err(
+                col,
+                format!(
+                    "expected {} cells ({}), found {}",
+                    columns.len(),
+                    some_names(&columns),
+                    cells.len()
+                ),
+            ));
+        }
+        for (j, (col, cell)) in cells.into_iter().enumerate() {
+            let cell = cell.trim();
+            let column = shorten(&columns[j]);
+            if cell.is_empty() {
+                return Err(err(
+                    col,
+                    format!("column `{column}`: expected a number, found an empty cell"),
+                ));
+            }
+            let v: f64 = cell.parse().map_err(|_| {
+                err(
+                    col,
+                    format!(
+                        "column `{column}`: expected a number, found `{}`",
+                        shorten(cell)
+                    ),
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(err(
+                    col,
+                    format!(
+                        "column `{column}`: expected a finite number, found `{}`",
+                        shorten(cell)
+                    ),
+                ));
+            }
+            values[j].push(v);
+        }
+        rows.push(line);
+    }
+    if rows.is_empty() {
+        return Err(CsvError::at(
+            name,
+            Some(header_line),
+            None,
+            "no data rows after the header",
+        ));
+    }
+    Ok(Table {
+        name: name.to_string(),
+        header_line,
+        columns,
+        values,
+        lines: rows,
+    })
+}
+
+/// Largest input file accepted (1 GiB).
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Fails unless `path` is a regular file of at most [`MAX_FILE_BYTES`] (so that a device or a
+/// pipe given by mistake cannot block or exhaust memory).
+///
+/// # Errors
+///
+/// [`CsvError::Io`] naming the file.
+pub fn check_regular_file(path: &Path, name: &str) -> Result<(), CsvError> {
+    let io = |reason: String| CsvError::Io {
+        name: name.to_string(),
+        reason,
+    };
+    let meta =
+        std::fs::metadata(path).map_err(|e| io(format!("cannot read: {}", io_reason(&e))))?;
+    if !meta.is_file() {
+        return Err(io("not a regular file".into()));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(io(format!("larger than {MAX_FILE_BYTES} bytes")));
+    }
+    Ok(())
+}
+
+/// Reads and parses a CSV file.
+///
+/// # Errors
+///
+/// [`CsvError::Io`] if the file cannot be read or is not UTF-8 text; those of [`parse`].
+pub fn read(path: &Path) -> Result<Table, CsvError> {
+    let name = path.display().to_string();
+    check_regular_file(path, &name)?;
+    let bytes = std::fs::read(path).map_err(|e| CsvError::Io {
+        name: name.clone(),
+        reason: format!("cannot read: {}", io_reason(&e)),
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| CsvError::Io {
+        name: name.clone(),
+        reason: format!(
+            "not UTF-8 text (invalid byte at offset {}); expected a CSV file",
+            e.utf8_error().valid_up_to()
+        ),
+    })?;
+    parse(&name, &text)
+}
+
+/// A column to write: a name and its values; integer columns are printed without a fraction.
+#[derive(Debug, Clone, Copy)]
+pub enum Column<'a> {
+    /// Whole numbers.
+    Index(&'a str, &'a [usize]),
+    /// Real numbers, printed with the shortest text that reads back to the same value.
+    Real(&'a str, &'a [f64]),
+}
+
+impl Column<'_> {
+    /// The column's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Column::Index(n, _) | Column::Real(n, _) => n,
+        }
+    }
+    fn len(&self) -> usize {
+        match self {
+            Column::Index(_, v) => v.len(),
+            Column::Real(_, v) => v.len(),
+        }
+    }
+    fn cell(&self, i: usize) -> String {
+        match self {
+            Column::Index(_, v) => v[i].to_string(),
+            Column::Real(_, v) => format!("{:?}", v[i]),
+        }
+    }
+}
+
+/// Formats columns of equal length as CSV text.
+pub fn format(columns: &[Column<'_>]) -> String {
+    let rows = columns.iter().map(Column::len).min().unwrap_or(0);
+    let mut out = columns
+        .iter()
+        .map(Column::name)
+        .collect::<Vec<_>>()
+        .join(",");
+    out.push('\n');
+    for i in 0..rows {
+        let row: Vec<String> = columns.iter().map(|c| c.cell(i)).collect();
+        out.push_str(&row.join(","));
+        out.push('\n');
+    }
+    out
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip() {
+        let y = [0.1, -2.5e-7, 3.0];
+        let text = format(&[Column::Index("k", &[0, 1, 2]), Column::Real("y", &y)]);
+        let t = parse("x.csv", &text).unwrap();
+        assert_eq!(t.column("y").unwrap(), &y);
+        assert_eq!(t.column("k").unwrap(), &[0.0, 1.0, 2.0]);
+        assert_eq!(t.lines, vec![2, 3, 4]);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let e = parse("d.csv", "k,y\n0,1\n1,abc\n").unwrap_err();
+        assert!(e.to_string().starts_with("d.csv:3:3: column `y`"), "{e}");
+        let e = parse("d.csv", "k,  y\n0, 1\n1,  2,3\n").unwrap_err();
+        assert!(
+            e.to_string().starts_with("d.csv:3:7: expected 2 cells"),
+            "{e}"
+        );
+        let e = parse("d.csv", "k,y\n0,NaN\n").unwrap_err();
+        assert!(e.to_string().contains("finite"), "{e}");
+        let e = parse("d.csv", "k,y\n0\n").unwrap_err();
+        assert!(
+            e.to_string().starts_with("d.csv:2:2: expected 2 cells"),
+            "{e}"
+        );
+        let e = parse("d.csv", "").unwrap_err();
+        assert!(e.to_string().contains("empty"), "{e}");
+        let e = parse("d.csv", "k,,y\n").unwrap_err();
+        assert!(e.to_string().starts_with("d.csv:1:3: header"), "{e}");
+        let e = parse("d.csv", "k,y\n0,1\n")
+            .unwrap()
+            .column("t")
+            .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("d.csv:1: header: expected a column named `t`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn every_line_ending_reads_the_same() {
+        let lf = parse("d.csv", "k,y\n0,1\n# note\n1,2\n").unwrap();
+        for text in ["k,y\r\n0,1\r\n# note\r\n1,2\r\n", "k,y\r0,1\r# note\r1,2\r"] {
+            let t = parse("d.csv", text).unwrap();
+            assert_eq!(t.values, lf.values, "{text:?}");
+            assert_eq!(t.lines, lf.lines, "{text:?}");
+        }
+        let e = parse("d.csv", "k,y\r0,1\r1,x\r").unwrap_err();
+        assert!(e.to_string().starts_with("d.csv:3:3: column `y`"), "{e}");
+    }
+
+    #[test]
+    fn a_very_wide_file_gives_a_short_error() {
+        let header: Vec<String> = (0..200_004).map(|i| format!("c{i}")).collect();
+        let text = format!("{}\n1,2\n", header.join(","));
+        let e = parse("d.csv", &text).unwrap_err();
+        assert!(e.to_string().len() < 300, "{} bytes", e.to_string().len());
+        assert!(
+            e.to_string()
+                .starts_with("d.csv:2:4: expected 200004 cells"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("199996 more"), "{e}");
+    }
+}
