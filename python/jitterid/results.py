@@ -17,11 +17,15 @@ class FitResult:
     """One fit, equal to ``jitterid fit --json`` on the same record.
 
     Attributes: ``method``, ``names``, ``params``, ``std_errors`` (NaN where not defined),
-    ``covariance`` (``diag(std_errors²)`` is *not* assumed: ``None`` unless the library
-    computed the full matrix), ``cost``, ``iterations``, ``termination``, ``converged``,
-    ``noise_std``, and the fitted ``model`` (spec tables of the signal and the jitter, the
-    noise parameters and level). ``jitter`` is the fitted jitter model.
+    ``cost``, ``iterations``, ``termination``, ``converged``, ``noise_std``, the fitted
+    ``model`` (spec tables of the signal and the jitter, the noise parameters and level) and
+    ``jitter`` (the fitted jitter model). ``covariance`` is the estimator's asymptotic
+    covariance (``None`` where not defined) of the parameters ``covariance_names``: the
+    estimated ones, in the estimator's order; ``names`` may add derived values (a profiled
+    uniform-sum ``n`` and its ``σ``, a noise level estimated from the residuals).
     """
+
+    _EXTRA = ("model", "estimated", "covariance")
 
     def __init__(self, data: Dict[str, Any]) -> None:
         self._data = data
@@ -38,6 +42,7 @@ class FitResult:
             [np.nan if p["stderr"] is None else p["stderr"] for p in params], dtype=float
         )
         cov = data.get("covariance")
+        self.covariance_names: List[str] = list(data.get("estimated", []))
         self.covariance: Optional[np.ndarray] = None if cov is None else np.array(cov, dtype=float)
         self.model: Dict[str, Any] = data["model"]
 
@@ -57,10 +62,12 @@ class FitResult:
             raise KeyError(f"no parameter {name!r}; parameters: {', '.join(self.names)}") from None
 
     def to_dict(self, model: bool = False) -> Dict[str, Any]:
-        """The command line's ``fit --json`` output (with the fitted model if ``model``)."""
+        """The command line's ``fit --json`` output (with the fitted model and the covariance
+        if ``model``)."""
         d = copy.deepcopy(self._data)
         if not model:
-            d.pop("model", None)
+            for key in self._EXTRA:
+                d.pop(key, None)
         return d
 
     def __reduce__(self) -> Any:

@@ -228,6 +228,8 @@ impl Experiment {
         json_text(&FitOut {
             cli: commands::fit_json(&fit),
             model: Model::of(&fit.fitted),
+            estimated: &fit.estimated,
+            covariance: fit.covariance.as_deref(),
         })
     }
 
@@ -250,6 +252,8 @@ struct FitOut<'a> {
     #[serde(flatten)]
     cli: commands::FitJson<'a>,
     model: Model,
+    estimated: &'a [String],
+    covariance: Option<&'a [Vec<f64>]>,
 }
 
 /// The fitted model's parts as spec tables.

@@ -129,3 +129,11 @@ def test_shards_merge_to_the_single_run(table2):
         jitterid.merge(shards[:2])
     with pytest.raises(ValueError, match="twice"):
         jitterid.merge([shards[0], shards[0], shards[1]])
+
+
+def test_covariance_matches_the_standard_errors(table2):
+    fit = table2.fit(table2.simulate(seed=6))
+    assert fit.covariance_names == fit.names
+    np.testing.assert_allclose(np.sqrt(np.diag(fit.covariance)), fit.std_errors, rtol=1e-12)
+    np.testing.assert_allclose(fit.covariance, fit.covariance.T, rtol=1e-12, atol=0)
+    assert np.all(np.linalg.eigvalsh(fit.covariance) > 0)
