@@ -23,12 +23,18 @@ pub struct Experiment {
     text: String,
     dir: PathBuf,
     pub(crate) exp: experiment::Experiment,
+    /// The experiment read for estimation with its own method, once (re-reading it per fit
+    /// cost about half a Table 2 fit); the message when the file cannot be fitted as it is.
+    for_own_method: Result<experiment::Experiment, String>,
 }
 
 impl Experiment {
     /// The experiment read for estimation with `method` (the file's own if `None`): the
     /// method is checked against what the file marks as estimated.
     pub fn for_method(&self, method: Option<&str>) -> PyResult<experiment::Experiment> {
+        if method.is_none() {
+            return self.for_own_method.clone().map_err(value_error);
+        }
         let chosen = method
             .map(|m| {
                 Method::parse(m).ok_or_else(|| {
@@ -58,7 +64,14 @@ impl Experiment {
     fn new(text: String, file: String, dir: String) -> PyResult<Self> {
         let dir = PathBuf::from(dir);
         let exp = experiment::parse(&file, &text, &dir, Purpose::Simulate).map_err(value_error)?;
-        Ok(Experiment { text, dir, exp })
+        let for_own_method = experiment::parse(&file, &text, &dir, Purpose::Estimate(None))
+            .map_err(|e| e.to_string());
+        Ok(Experiment {
+            text,
+            dir,
+            exp,
+            for_own_method,
+        })
     }
 
     /// The experiment file at `path` (the command line's TOML format).
