@@ -14,6 +14,7 @@ use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 use serde::Serialize;
+use std::borrow::Cow;
 use std::path::PathBuf;
 
 /// An experiment file, read and validated once, with its text kept for pickling.
@@ -31,9 +32,13 @@ pub struct Experiment {
 impl Experiment {
     /// The experiment read for estimation with `method` (the file's own if `None`): the
     /// method is checked against what the file marks as estimated.
-    pub fn for_method(&self, method: Option<&str>) -> PyResult<experiment::Experiment> {
+    pub fn for_method(&self, method: Option<&str>) -> PyResult<Cow<'_, experiment::Experiment>> {
         if method.is_none() {
-            return self.for_own_method.clone().map_err(value_error);
+            return self
+                .for_own_method
+                .as_ref()
+                .map(Cow::Borrowed)
+                .map_err(value_error);
         }
         let chosen = method
             .map(|m| {
@@ -51,6 +56,7 @@ impl Experiment {
             &self.dir,
             Purpose::Estimate(chosen),
         )
+        .map(Cow::Owned)
         .map_err(value_error)
     }
 }
