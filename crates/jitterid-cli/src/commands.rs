@@ -12,7 +12,7 @@ use crate::output::{self, OutputSet};
 use crate::plots;
 use crate::progress::{Progress, Ticker};
 use jitterid::estimate::montecarlo::{realization_rng, realization_seed, run as mc_run, Summary};
-use jitterid::signal::Input;
+use jitterid::signal::{AnySignal, Input};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -48,14 +48,30 @@ pub struct SimulateOptions {
     pub truth: bool,
 }
 
-/// `jitterid simulate`: one record of the experiment's truth. Returns the report line.
-pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
-    let exp = experiment::read(&o.experiment, Purpose::Simulate)?;
-    let mut rng = realization_rng(o.seed, o.run);
-    let input = fitting::realize_input(&exp, &mut rng)?;
+/// One simulated record of an experiment, as values (what `jitterid simulate` writes).
+#[derive(Debug, Clone)]
+pub struct SimulatedData {
+    /// Requested sampling times `t_k = t0 + kT`.
+    pub t: Vec<f64>,
+    /// Samples.
+    pub y: Vec<f64>,
+    /// The input at `t_k`, when the experiment has one.
+    pub u: Option<Vec<f64>>,
+    /// Jitter of each sample.
+    pub tau: Vec<f64>,
+    /// Measurement noise of each sample.
+    pub v: Vec<f64>,
+    /// The input realisation (a random binary input's switch times and levels among others).
+    pub input: Option<Input>,
+}
+
+/// Realisation `run` of the experiment's truth under master seed `seed`: the record of Monte
+/// Carlo run `run`.
+pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> CliResult<SimulatedData> {
+    let mut rng = realization_rng(seed, run);
+    let input = fitting::realize_input(exp, &mut rng)?;
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
-    let sim = fitting::simulate_record(&exp, &signal, &mut rng)?;
-    let n = exp.grid.len();
+    let sim = fitting::simulate_record(exp, &signal, &mut rng)?;
     if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
         return Err(cli_err!(
             "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
@@ -63,22 +79,44 @@ pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
             sim.y[k]
         ));
     }
-    let k: Vec<usize> = (0..n).collect();
     let t: Vec<f64> = exp.grid.times().collect();
-    let u: Option<Vec<f64>> = input
+    let u = input
         .as_ref()
         .map(|i| t.iter().map(|&t| i.value(t)).collect());
+    Ok(SimulatedData {
+        t,
+        y: sim.y,
+        u,
+        tau: sim.tau,
+        v: sim.v,
+        input,
+    })
+}
+
+/// `jitterid simulate`: one record of the experiment's truth. Returns the report line.
+pub fn simulate(o: &SimulateOptions) -> CliResult<String> {
+    let exp = experiment::read(&o.experiment, Purpose::Simulate)?;
+    let SimulatedData {
+        t,
+        y,
+        u,
+        tau,
+        v,
+        input,
+    } = simulate_data(&exp, o.seed, o.run)?;
+    let n = exp.grid.len();
+    let k: Vec<usize> = (0..n).collect();
     let mut cols = vec![
         Column::Index("k", &k),
         Column::Real("t", &t),
-        Column::Real("y", &sim.y),
+        Column::Real("y", &y),
     ];
     if let Some(u) = &u {
         cols.push(Column::Real("u", u));
     }
     if o.truth {
-        cols.push(Column::Real("tau", &sim.tau));
-        cols.push(Column::Real("v", &sim.v));
+        cols.push(Column::Real("tau", &tau));
+        cols.push(Column::Real("v", &v));
     }
     let mut outputs = OutputSet::new();
     outputs.file(&o.out, csvio::format(&cols));
@@ -139,8 +177,9 @@ pub struct FitOptions {
     pub time_limit: Option<f64>,
 }
 
-#[derive(Serialize)]
-struct FitJson<'a> {
+/// The JSON of `jitterid fit --json`, borrowed from a [`Fit`].
+#[derive(Debug, Serialize)]
+pub struct FitJson<'a> {
     method: &'a str,
     converged: bool,
     cost: f64,
@@ -229,6 +268,34 @@ fn read_experiment(
     Ok(exp)
 }
 
+/// Fits the experiment's model with its method to the samples `y` of a record whose input
+/// `signal` holds; `data` names the record in messages.
+pub fn fit_values(exp: &Experiment, signal: AnySignal, y: Vec<f64>, data: &str) -> CliResult<Fit> {
+    let method = exp.estimate.method;
+    let record = fitting::record(&exp.grid, y).map_err(|e| cli_err!("{data}: {e}"))?;
+    let s = fitting::structure(exp, signal, method)?;
+    fitting::fit(exp, &s, &record, method, 0, true).map_err(|e| {
+        cli_err!(
+            "{}: fit with method {} failed: {e}",
+            exp.file,
+            method.as_str()
+        )
+    })
+}
+
+/// The JSON of `jitterid fit --json`.
+pub fn fit_json(f: &Fit) -> FitJson<'_> {
+    FitJson {
+        method: f.method.as_str(),
+        converged: f.converged,
+        cost: f.cost,
+        iterations: f.iterations,
+        termination: &f.termination,
+        noise_std: f.noise_std,
+        parameters: &f.params,
+    }
+}
+
 /// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
 /// not converge (unless `accept_unconverged`).
 pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
@@ -259,24 +326,16 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
         }
     };
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
-    let record =
-        fitting::record(&exp.grid, y.clone()).map_err(|e| cli_err!("{}: {e}", table.name))?;
-    let s = fitting::structure(&exp, signal.clone(), method)?;
-    let fit_err = |e: String| {
-        cli_err!(
-            "{}: fit with method {} failed: {e}",
-            exp.file,
-            method.as_str()
-        )
-    };
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
-    let f: Fit = fitting::fit(&exp, &s, &record, method, 0, true).map_err(fit_err)?;
+    let f = fit_values(&exp, signal.clone(), y.clone(), &table.name)?;
     drop(ticker);
 
     let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
         // The naive LS fit of the system for comparison (when the system is estimated).
         let ls = if exp.system.estimate && method != Method::LS {
+            let record = fitting::record(&exp.grid, y.clone())
+                .map_err(|e| cli_err!("{}: {e}", table.name))?;
             let mut ls_exp = exp.clone();
             ls_exp.jitter.estimate = false;
             ls_exp.noise.estimate = false;
@@ -316,16 +375,7 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
     }
 
     if o.json {
-        let j = FitJson {
-            method: method.as_str(),
-            converged: f.converged,
-            cost: f.cost,
-            iterations: f.iterations,
-            termination: &f.termination,
-            noise_std: f.noise_std,
-            parameters: &f.params,
-        };
-        return serde_json::to_string_pretty(&j)
+        return serde_json::to_string_pretty(&fit_json(&f))
             .map(|text| Outcome {
                 text: text + "\n",
                 status,
@@ -679,35 +729,45 @@ fn mc_table(j: &McJson) -> String {
     out
 }
 
-/// `jitterid montecarlo`: the text to print (empty if the JSON is written to `--out`), and exit
-/// status [`Status::NotConverged`] when no fit converged (unless `accept_unconverged`).
-pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
-    let exp = read_experiment(
-        &o.experiment,
-        Purpose::Estimate(o.method),
-        o.max_iterations,
-        o.time_limit,
-    )?;
+/// A finished study: its JSON and what the figures need.
+struct StudyRun {
+    json: McJson,
+    outs: Vec<RunOut>,
+    names: Vec<String>,
+    truth: Vec<Option<f64>>,
+    signal0: AnySignal,
+}
+
+/// Runs `runs` realisations (or shard `shard` of them) of the experiment with its method on
+/// `threads` worker threads (rayon's default if `None`), keeping the fitted models of the first
+/// runs when `keep_fitted`.
+fn run_study(
+    exp: &Experiment,
+    runs: u64,
+    seed: u64,
+    shard: Option<Shard>,
+    threads: Option<usize>,
+    keep_fitted: bool,
+) -> CliResult<StudyRun> {
     let method = exp.estimate.method;
-    if o.runs == 0 || o.runs > MAX_RUNS {
+    if runs == 0 || runs > MAX_RUNS {
         return Err(cli_err!(
-            "--runs: expected a number of realisations in [1, {MAX_RUNS}], found {}",
-            o.runs
+            "--runs: expected a number of realisations in [1, {MAX_RUNS}], found {runs}"
         ));
     }
     // The names and truths, from realisation 0's setup (they do not depend on the input).
-    let mut rng0 = realization_rng(o.seed, 0);
-    let input0 = fitting::realize_input(&exp, &mut rng0)?;
+    let mut rng0 = realization_rng(seed, 0);
+    let input0 = fitting::realize_input(exp, &mut rng0)?;
     let signal0 = fitting::signal_of(&exp.system.kind, input0.as_ref())?;
-    let names = fitting::param_names(&exp, &signal0, method)?;
-    let truth = fitting::truth_values(&exp, &signal0, method)?;
-    let shard = o.shard.unwrap_or(Shard { index: 0, count: 1 });
-    let first = o.runs * shard.index / shard.count;
-    let end = o.runs * (shard.index + 1) / shard.count;
+    let names = fitting::param_names(exp, &signal0, method)?;
+    let truth = fitting::truth_values(exp, &signal0, method)?;
+    let part = shard.unwrap_or(Shard { index: 0, count: 1 });
+    let first = runs * part.index / part.count;
+    let end = runs * (part.index + 1) / part.count;
     let n = names.len();
     let pool = {
         let mut b = rayon::ThreadPoolBuilder::new();
-        if let Some(k) = o.threads {
+        if let Some(k) = threads {
             if !(1..=1024).contains(&k) {
                 return Err(cli_err!("--threads: expected 1 to 1024 threads, found {k}"));
             }
@@ -719,15 +779,15 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
     let progress = Progress::new(end - first);
     let t0 = Instant::now();
     let outs: Vec<RunOut> = pool.install(|| {
-        mc_run(o.seed, first..end, |r, rng| {
+        mc_run(seed, first..end, |r, rng| {
             let out = one_run(
-                &exp,
+                exp,
                 method,
-                o.seed,
+                seed,
                 n,
                 r,
                 rng,
-                o.plot.is_some() && r < first + KEEP_FITTED,
+                keep_fitted && r < first + KEEP_FITTED,
             );
             progress.tick();
             out
@@ -738,46 +798,81 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
     let realizations: Vec<Realization> = outs.iter().map(|o| o.realization.clone()).collect();
     let parameters = summarize(&names, &truth, &realizations);
     let converged = realizations.iter().filter(|r| r.converged).count() as u64;
-    let sharded = o.shard.is_some_and(|s| s.count > 1);
-    let j = McJson {
+    let sharded = shard.is_some_and(|s| s.count > 1);
+    let json = McJson {
         method: method.as_str().to_string(),
         runs: end - first,
         converged,
         terminations: terminations(&realizations),
         seconds,
-        seed: o.seed,
+        seed,
         experiment: exp.file.clone(),
-        fingerprint: experiment_fingerprint(&exp),
+        fingerprint: experiment_fingerprint(exp),
         program: program(),
         parameters,
         shard: sharded.then_some(ShardInfo {
-            index: shard.index,
-            count: shard.count,
-            runs_total: o.runs,
+            index: part.index,
+            count: part.count,
+            runs_total: runs,
             first,
             end,
         }),
-        realizations: sharded.then_some(realizations.clone()),
+        realizations: sharded.then_some(realizations),
     };
+    Ok(StudyRun {
+        json,
+        outs,
+        names,
+        truth,
+        signal0,
+    })
+}
+
+/// The result of `jitterid montecarlo --json` (with `--shard` when `shard` is given) for an
+/// experiment already read, as values.
+pub fn montecarlo_values(
+    exp: &Experiment,
+    runs: u64,
+    seed: u64,
+    shard: Option<Shard>,
+    threads: Option<usize>,
+) -> CliResult<McJson> {
+    run_study(exp, runs, seed, shard, threads, false).map(|s| s.json)
+}
+
+/// `jitterid montecarlo`: the text to print (empty if the JSON is written to `--out`), and exit
+/// status [`Status::NotConverged`] when no fit converged (unless `accept_unconverged`).
+pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
+    let exp = read_experiment(
+        &o.experiment,
+        Purpose::Estimate(o.method),
+        o.max_iterations,
+        o.time_limit,
+    )?;
+    let study = run_study(&exp, o.runs, o.seed, o.shard, o.threads, o.plot.is_some())?;
+    let j = &study.json;
     let mut outputs = OutputSet::new();
     if let Some(dir) = &o.plot {
-        let conv: Vec<Vec<f64>> = realizations
+        let conv: Vec<Vec<f64>> = study
+            .outs
             .iter()
+            .map(|o| &o.realization)
             .filter(|r| r.converged)
             .map(|r| r.values.iter().map(|v| v.unwrap_or(f64::NAN)).collect())
             .collect();
-        let fitted: Vec<&Structure> = outs
+        let fitted: Vec<&Structure> = study
+            .outs
             .iter()
             .filter(|o| o.realization.converged)
             .filter_map(|o| o.fitted.as_ref())
             .collect();
         let figs = plots::montecarlo_figures(&plots::McPlots {
             exp: &exp,
-            method: method.as_str(),
-            names: &names,
-            truth: &truth,
+            method: &j.method,
+            names: &study.names,
+            truth: &study.truth,
             values: conv.iter().map(Vec::as_slice).collect(),
-            true_signal: &signal0,
+            true_signal: &study.signal0,
             fitted,
         });
         outputs.dir(dir);
@@ -785,10 +880,10 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
             outputs.file(&dir.join(name), svg);
         }
     }
-    let text = emit(&j, o.json, o.out.as_deref(), outputs)?;
+    let text = emit(j, o.json, o.out.as_deref(), outputs)?;
     Ok(Outcome {
         text,
-        status: Status::of_convergence(converged > 0, o.accept_unconverged),
+        status: Status::of_convergence(j.converged > 0, o.accept_unconverged),
     })
 }
 

@@ -245,6 +245,12 @@ pub struct Fit {
     pub params: Vec<Param>,
     /// The fitted structure.
     pub fitted: Structure,
+    /// Names of the estimated parameters, in the estimator's order (which [`params`](Self::params)
+    /// may extend with derived values, such as a profiled `n` or `σ`).
+    pub estimated: Vec<String>,
+    /// Asymptotic covariance of the estimated parameters, in the order of
+    /// [`estimated`](Self::estimated), when computed and defined.
+    pub covariance: Option<Vec<Vec<f64>>>,
 }
 
 /// Names of the reported parameters, in order, for an experiment fitted with `method`.
@@ -381,6 +387,8 @@ struct Raw {
     /// The structure's free parameters, then `σ_v` when a likelihood estimated it.
     params: Vec<f64>,
     std_errors: Option<Vec<f64>>,
+    names: Vec<String>,
+    covariance: Option<Vec<Vec<f64>>>,
     cost: f64,
     iterations: u64,
     termination: String,
@@ -407,6 +415,8 @@ pub fn fit(
             Ok(Raw {
                 params: e.params,
                 std_errors: e.std_errors,
+                names: e.names,
+                covariance: e.covariance,
                 cost: e.cost,
                 iterations: e.iterations,
                 termination: e.termination.to_string(),
@@ -475,6 +485,8 @@ pub fn fit(
         noise_std: e.noise_std,
         params,
         fitted: e.fitted,
+        estimated: e.names,
+        covariance: e.covariance,
     })
 }
 
@@ -541,6 +553,8 @@ fn fit_ml(
     Ok(Raw {
         params: e.params,
         std_errors: e.std_errors,
+        names: e.names,
+        covariance: e.covariance,
         cost: e.cost,
         iterations: e.iterations,
         termination: e.termination.to_string(),

@@ -38,6 +38,11 @@ fn read_part(path: &Path) -> CliResult<Part> {
             e.column()
         )
     })?;
+    part_of(name, json)
+}
+
+/// A shard result called `name` in messages, checked to be a shard.
+fn part_of(name: String, json: McJson) -> CliResult<Part> {
     let (Some(shard), Some(runs)) = (json.shard.clone(), json.realizations.clone()) else {
         return Err(cli_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json"));
     };
@@ -168,6 +173,23 @@ pub fn merge(
         .iter()
         .map(|f| read_part(f))
         .collect::<CliResult<Vec<Part>>>()?;
+    let merged = merge_parts(&parts)?;
+    let status = Status::of_convergence(merged.converged > 0, accept_unconverged);
+    let text = emit(&merged, json, out, OutputSet::new())?;
+    Ok(Outcome { text, status })
+}
+
+/// Combines shard results, each with the name that messages call it by, into the result of
+/// the unsharded study (what `jitterid merge --json` prints).
+pub fn merge_values(shards: Vec<(String, McJson)>) -> CliResult<McJson> {
+    let parts = shards
+        .into_iter()
+        .map(|(name, json)| part_of(name, json))
+        .collect::<CliResult<Vec<Part>>>()?;
+    merge_parts(&parts)
+}
+
+fn merge_parts(parts: &[Part]) -> CliResult<McJson> {
     let Some(first) = parts.first() else {
         return Err(cli_err!("merge: expected at least one shard file"));
     };
@@ -188,7 +210,7 @@ pub fn merge(
         .collect();
     let truth: Vec<Option<f64>> = first.json.parameters.iter().map(|p| p.truth).collect();
     let mut seen = vec![false; s0.count as usize];
-    for p in &parts {
+    for p in parts {
         if let Some((what, this, theirs)) = identity_mismatch(p, first) {
             return Err(cli_err!(
                 "{}: belongs to another study than {}: its {what} is {this:?}, not {theirs:?}",
@@ -252,7 +274,5 @@ pub fn merge(
         shard: None,
         realizations: None,
     };
-    let status = Status::of_convergence(merged.converged > 0, accept_unconverged);
-    let text = emit(&merged, json, out, OutputSet::new())?;
-    Ok(Outcome { text, status })
+    Ok(merged)
 }

@@ -1,0 +1,87 @@
+"""Type stubs of the compiled core (the public API is in ``jitterid`` and ``jitterid.jitter``)."""
+
+from os import PathLike
+from typing import Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class Jitter:
+    """A jitter model: the pdf of the sampling-time error ``τ``."""
+
+    def __new__(cls, spec: str) -> Jitter: ...
+    @staticmethod
+    def from_std_dev(name: str, sigma: float, spec: str) -> Jitter: ...
+    @property
+    def family(self) -> str: ...
+    @property
+    def spec_json(self) -> str: ...
+    @property
+    def param_names(self) -> list[str]: ...
+    @property
+    def param_values(self) -> list[float]: ...
+    @property
+    def std(self) -> float:
+        """Standard deviation of ``τ`` (s)."""
+    @property
+    def mean(self) -> float:
+        """Mean of ``τ`` (s)."""
+    @property
+    def variance(self) -> float:
+        """Variance of ``τ`` (s²)."""
+    def cf(self, f: npt.ArrayLike) -> npt.NDArray[np.complex128]:
+        """Characteristic function ``γ(f) = E[exp(-i2πfτ)]`` at frequencies ``f`` (Hz)."""
+    def mgf(self, z: npt.ArrayLike) -> npt.NDArray[np.complex128]:
+        """Moment generating function ``E[exp(zτ)]``; NaN where it does not exist."""
+    def pdf(self, t: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Density of ``τ`` at ``t`` (1/s)."""
+    def sample(self, size: int, seed: int) -> npt.NDArray[np.float64]:
+        """``size`` independent draws of ``τ`` from a generator seeded with ``seed``."""
+
+class Experiment:
+    """An experiment in the command line's TOML format."""
+
+    def __new__(cls, text: str, file: str = "<string>", dir: str = ".") -> Experiment: ...
+    @classmethod
+    def from_toml(cls, path: Union[str, PathLike[str]]) -> Experiment: ...
+    @property
+    def file(self) -> str: ...
+    @property
+    def title(self) -> Optional[str]: ...
+    @property
+    def text(self) -> str: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def samples(self) -> int: ...
+    @property
+    def interval(self) -> float: ...
+    @property
+    def start(self) -> float: ...
+    @property
+    def fingerprint(self) -> str: ...
+    @property
+    def random_input(self) -> bool: ...
+    def simulate(self, seed: int = ..., run: int = 0, truth: bool = False) -> dict[str, npt.NDArray[np.float64]]:
+        """Record ``run`` under master ``seed``, as ``jitterid simulate`` writes it."""
+    def fit_json(
+        self,
+        y: npt.ArrayLike,
+        input_t: Optional[npt.ArrayLike] = None,
+        input_u: Optional[npt.ArrayLike] = None,
+        method: Optional[str] = None,
+    ) -> str: ...
+
+def jitter_families() -> str: ...
+def montecarlo(
+    experiment: Experiment,
+    runs: int = 128,
+    seed: int = ...,
+    shard: Optional[Tuple[int, int]] = None,
+    method: Optional[str] = None,
+    threads: Optional[int] = None,
+) -> str: ...
+def merge(shards: list[str]) -> str: ...
+def read_record(path: str, input: Optional[str] = None) -> dict[str, npt.NDArray[np.float64]]: ...

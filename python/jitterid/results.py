@@ -1,0 +1,128 @@
+"""Results: a fit (``Experiment.fit``) and a Monte Carlo study (``montecarlo``, ``merge``).
+
+Both keep the command line's JSON (``to_dict()``) and pickle through it, so Dask can ship them.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+
+__all__ = ["FitResult", "MonteCarloResult"]
+
+
+class FitResult:
+    """One fit, equal to ``jitterid fit --json`` on the same record.
+
+    Attributes: ``method``, ``names``, ``params``, ``std_errors`` (NaN where not defined),
+    ``cost``, ``iterations``, ``termination``, ``converged``, ``noise_std``, the fitted
+    ``model`` (spec tables of the signal and the jitter, the noise parameters and level) and
+    ``jitter`` (the fitted jitter model). ``covariance`` is the estimator's asymptotic
+    covariance (``None`` where not defined) of the parameters ``covariance_names``: the
+    estimated ones, in the estimator's order; ``names`` may add derived values (a profiled
+    uniform-sum ``n`` and its ``σ``, a noise level estimated from the residuals).
+    """
+
+    _EXTRA = ("model", "estimated", "covariance")
+
+    def __init__(self, data: Dict[str, Any]) -> None:
+        self._data = data
+        self.method: str = data["method"]
+        self.converged: bool = data["converged"]
+        self.cost: float = data["cost"]
+        self.iterations: int = data["iterations"]
+        self.termination: str = data["termination"]
+        self.noise_std: float = data["noise_std"]
+        params = data["parameters"]
+        self.names: List[str] = [p["name"] for p in params]
+        self.params: np.ndarray = np.array([p["estimate"] for p in params], dtype=float)
+        self.std_errors: np.ndarray = np.array(
+            [np.nan if p["stderr"] is None else p["stderr"] for p in params], dtype=float
+        )
+        cov = data.get("covariance")
+        self.covariance_names: List[str] = list(data.get("estimated", []))
+        self.covariance: Optional[np.ndarray] = None if cov is None else np.array(cov, dtype=float)
+        self.model: Dict[str, Any] = data["model"]
+
+    @property
+    def jitter(self):
+        """The fitted jitter model."""
+        from .jitter import from_name
+
+        spec = dict(self.model["jitter"])
+        return from_name(spec.pop("family"), **spec)
+
+    def __getitem__(self, name: str) -> float:
+        """The estimate of parameter ``name``."""
+        try:
+            return float(self.params[self.names.index(name)])
+        except ValueError:
+            raise KeyError(f"no parameter {name!r}; parameters: {', '.join(self.names)}") from None
+
+    def to_dict(self, model: bool = False) -> Dict[str, Any]:
+        """The command line's ``fit --json`` output (with the fitted model and the covariance
+        if ``model``)."""
+        d = copy.deepcopy(self._data)
+        if not model:
+            for key in self._EXTRA:
+                d.pop(key, None)
+        return d
+
+    def __reduce__(self) -> Any:
+        return (FitResult, (self._data,))
+
+    def __repr__(self) -> str:
+        rows = ", ".join(f"{n}={v:.6g}" for n, v in zip(self.names, self.params))
+        state = "converged" if self.converged else "not converged"
+        return f"FitResult({self.method}, {state}, {rows})"
+
+
+class MonteCarloResult:
+    """A Monte Carlo study (or one shard of it), equal to ``jitterid montecarlo --json``.
+
+    ``names``, ``truth``, ``mean``, ``std``, ``se``, ``rmse`` are per parameter (NaN where
+    undefined); ``runs``, ``converged``, ``terminations``, ``seconds``, ``seed``, ``method``;
+    a shard also holds ``shard`` and the per-run ``estimates`` (runs × parameters).
+    """
+
+    def __init__(self, data: Dict[str, Any]) -> None:
+        self._data = data
+        params = data["parameters"]
+
+        def column(key: str) -> np.ndarray:
+            return np.array([np.nan if p[key] is None else p[key] for p in params], dtype=float)
+
+        self.method: str = data["method"]
+        self.runs: int = data["runs"]
+        self.converged: int = data["converged"]
+        self.terminations: Dict[str, int] = dict(data["terminations"])
+        self.seconds: float = data["seconds"]
+        self.seed: int = data["seed"]
+        self.names: List[str] = [p["name"] for p in params]
+        self.truth = column("true")
+        self.mean = column("mean")
+        self.std = column("std")
+        self.se = column("se")
+        self.rmse = column("rmse")
+        self.shard: Optional[Dict[str, int]] = data.get("shard")
+        runs = data.get("realizations")
+        self.estimates: Optional[np.ndarray] = (
+            None
+            if runs is None
+            else np.array([[np.nan if v is None else v for v in r["values"]] for r in runs], dtype=float).reshape(
+                len(runs), len(self.names)
+            )
+        )
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The command line's ``montecarlo --json`` (or ``merge --json``) output."""
+        return copy.deepcopy(self._data)
+
+    def __reduce__(self) -> Any:
+        return (MonteCarloResult, (self._data,))
+
+    def __repr__(self) -> str:
+        rows = ", ".join(f"{n}={m:.6g}±{s:.2g}" for n, m, s in zip(self.names, self.mean, self.std))
+        return f"MonteCarloResult({self.method}, {self.converged}/{self.runs} converged, {rows})"

@@ -1,0 +1,343 @@
+//! Experiments from the command line's TOML files: one record simulated as `jitterid simulate`
+//! writes it, and a record fitted as `jitterid fit --json` reports it.
+
+use crate::arrays::{finite_samples, SamplesIn};
+use crate::errors::{json_text, value_error};
+use jitterid::signal::Input;
+use jitterid_cli::commands::{self, DEFAULT_SEED};
+use jitterid_cli::csvio;
+use jitterid_cli::experiment::{self, InputSpec, Method, Purpose};
+use jitterid_cli::fingerprint::experiment_fingerprint;
+use jitterid_cli::{fitting, inputs};
+use numpy::IntoPyArray;
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyType};
+use serde::Serialize;
+use std::borrow::Cow;
+use std::path::PathBuf;
+
+/// An experiment file, read and validated once, with its text kept for pickling.
+#[pyclass(module = "jitterid._jitterid", subclass, frozen, skip_from_py_object)]
+#[derive(Debug, Clone)]
+pub struct Experiment {
+    text: String,
+    dir: PathBuf,
+    pub(crate) exp: experiment::Experiment,
+    /// The experiment read for estimation with its own method, once (re-reading it per fit
+    /// cost about half a Table 2 fit); the message when the file cannot be fitted as it is.
+    for_own_method: Result<experiment::Experiment, String>,
+}
+
+impl Experiment {
+    /// The experiment read for estimation with `method` (the file's own if `None`): the
+    /// method is checked against what the file marks as estimated.
+    pub fn for_method(&self, method: Option<&str>) -> PyResult<Cow<'_, experiment::Experiment>> {
+        if method.is_none() {
+            return self
+                .for_own_method
+                .as_ref()
+                .map(Cow::Borrowed)
+                .map_err(value_error);
+        }
+        let chosen = method
+            .map(|m| {
+                Method::parse(m).ok_or_else(|| {
+                    value_error(format!(
+                        "method: expected one of {}, found {m:?}",
+                        Method::names()
+                    ))
+                })
+            })
+            .transpose()?;
+        experiment::parse(
+            &self.exp.file,
+            &self.text,
+            &self.dir,
+            Purpose::Estimate(chosen),
+        )
+        .map(Cow::Owned)
+        .map_err(value_error)
+    }
+}
+
+#[pymethods]
+impl Experiment {
+    /// The experiment in TOML `text`; `file` names it in messages and results, `dir` resolves
+    /// its relative paths.
+    #[new]
+    #[pyo3(signature = (text, file = "<string>".to_string(), dir = ".".to_string()))]
+    fn new(text: String, file: String, dir: String) -> PyResult<Self> {
+        let dir = PathBuf::from(dir);
+        let exp = experiment::parse(&file, &text, &dir, Purpose::Simulate).map_err(value_error)?;
+        let for_own_method = experiment::parse(&file, &text, &dir, Purpose::Estimate(None))
+            .map_err(|e| e.to_string());
+        Ok(Experiment {
+            text,
+            dir,
+            exp,
+            for_own_method,
+        })
+    }
+
+    /// The experiment file at `path` (the command line's TOML format).
+    #[classmethod]
+    fn from_toml<'py>(cls: &Bound<'py, PyType>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            PyOSError::new_err(format!("{file}: cannot read: {}", csvio::io_reason(&e)))
+        })?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.display().to_string(),
+            _ => ".".to_string(),
+        };
+        cls.call1((text, file, dir))
+    }
+
+    /// The file name, as given.
+    #[getter]
+    fn file(&self) -> &str {
+        &self.exp.file
+    }
+
+    /// The title, if the file has one.
+    #[getter]
+    fn title(&self) -> Option<&str> {
+        self.exp.title.as_deref()
+    }
+
+    /// The TOML text.
+    #[getter]
+    fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The file's estimation method.
+    #[getter]
+    fn method(&self) -> &str {
+        self.exp.estimate.method.as_str()
+    }
+
+    /// Number of samples `N`.
+    #[getter]
+    fn samples(&self) -> usize {
+        self.exp.grid.len()
+    }
+
+    /// Sampling interval `T` (s).
+    #[getter]
+    fn interval(&self) -> f64 {
+        self.exp.grid.interval()
+    }
+
+    /// Requested time of the first sample, `t0` (s).
+    #[getter]
+    fn start(&self) -> f64 {
+        self.exp.grid.start()
+    }
+
+    /// The experiment's fingerprint by content (as in Monte Carlo results).
+    #[getter]
+    fn fingerprint(&self) -> String {
+        experiment_fingerprint(&self.exp)
+    }
+
+    /// Whether the input is a random binary signal drawn per record (so fits need the record's
+    /// input realisation).
+    #[getter]
+    fn random_input(&self) -> bool {
+        matches!(self.exp.input, InputSpec::RandomBinary(_))
+    }
+
+    /// Record `run` of the experiment's truth under master `seed`, as `jitterid simulate`
+    /// writes it: a dict of arrays `t`, `y`, `u` (when there is an input), the random input's
+    /// switch times and levels `input_t`, `input_u` (its side file), and with `truth` the drawn
+    /// `tau` and `v`.
+    #[pyo3(signature = (seed = DEFAULT_SEED, run = 0, truth = false))]
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        seed: u64,
+        run: u64,
+        truth: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let data = py
+            .detach(|| commands::simulate_data(&self.exp, seed, run))
+            .map_err(value_error)?;
+        let out = PyDict::new(py);
+        out.set_item("t", data.t.into_pyarray(py))?;
+        out.set_item("y", data.y.into_pyarray(py))?;
+        if let Some(u) = data.u {
+            out.set_item("u", u.into_pyarray(py))?;
+        }
+        if let (InputSpec::RandomBinary(_), Some(Input::Piecewise(p))) =
+            (&self.exp.input, &data.input)
+        {
+            // The side file's columns: the switch times, and the levels with a closing 0.
+            let mut levels = p.levels().to_vec();
+            levels.push(0.0);
+            out.set_item("input_t", p.edges().to_vec().into_pyarray(py))?;
+            out.set_item("input_u", levels.into_pyarray(py))?;
+        }
+        if truth {
+            out.set_item("tau", data.tau.into_pyarray(py))?;
+            out.set_item("v", data.v.into_pyarray(py))?;
+        }
+        Ok(out)
+    }
+
+    /// Fits the samples `y` (with the record's input switch times and levels `input_t`,
+    /// `input_u` for a random-binary experiment) with `method` (the file's if `None`), as
+    /// `jitterid fit --json` does; returns the result as JSON text.
+    #[pyo3(signature = (y, input_t = None, input_u = None, method = None))]
+    fn fit_json(
+        &self,
+        py: Python<'_>,
+        y: SamplesIn<'_>,
+        input_t: Option<SamplesIn<'_>>,
+        input_u: Option<SamplesIn<'_>>,
+        method: Option<&str>,
+    ) -> PyResult<String> {
+        let exp = self.for_method(method)?;
+        let y = finite_samples(&y, "y")?;
+        if y.len() != exp.grid.len() {
+            return Err(value_error(format!(
+                "y: has {} samples, expected {} (the experiment's [sampling] samples)",
+                y.len(),
+                exp.grid.len()
+            )));
+        }
+        let input = match &exp.input {
+            InputSpec::None => None,
+            InputSpec::Known(i) => Some(i.clone()),
+            InputSpec::RandomBinary(_) => {
+                let (Some(t), Some(u)) = (input_t, input_u) else {
+                    return Err(value_error(
+                        "input: the experiment's input is random-binary, so the fit needs the record's input realisation (input_t and input_u, as simulate returns them)",
+                    ));
+                };
+                let values = vec![
+                    finite_samples(&t, "input_t")?,
+                    finite_samples(&u, "input_u")?,
+                ];
+                let table = csvio::Table {
+                    name: "input".into(),
+                    header_line: 1,
+                    columns: vec!["t".into(), "u".into()],
+                    lines: (2..2 + values[0].len()).collect(),
+                    values,
+                };
+                if table.values[0].len() != table.values[1].len() {
+                    return Err(value_error(format!(
+                        "input_t and input_u: expected equal lengths, found {} and {}",
+                        table.values[0].len(),
+                        table.values[1].len()
+                    )));
+                }
+                let p = inputs::piecewise_from_table(&table, "t", "u", &exp.grid)
+                    .map_err(value_error)?;
+                Some(Input::Piecewise(p))
+            }
+        };
+        let fit = py.detach(|| {
+            let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+            commands::fit_values(&exp, signal, y, "y")
+        });
+        let fit = fit.map_err(value_error)?;
+        json_text(&FitOut {
+            cli: commands::fit_json(&fit),
+            model: Model::of(&fit.fitted),
+            estimated: &fit.estimated,
+            covariance: fit.covariance.as_deref(),
+        })
+    }
+
+    fn __getnewargs__(&self) -> (String, String, String) {
+        (
+            self.text.clone(),
+            self.exp.file.clone(),
+            self.dir.display().to_string(),
+        )
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Experiment.from_toml({:?})", self.exp.file)
+    }
+}
+
+/// A fit as the Python side reads it: the command line's JSON and the fitted model.
+#[derive(Serialize)]
+struct FitOut<'a> {
+    #[serde(flatten)]
+    cli: commands::FitJson<'a>,
+    model: Model,
+    estimated: &'a [String],
+    covariance: Option<&'a [Vec<f64>]>,
+}
+
+/// The fitted model's parts as spec tables.
+#[derive(Serialize)]
+struct Model {
+    signal: serde_json::Map<String, serde_json::Value>,
+    jitter: serde_json::Map<String, serde_json::Value>,
+    noise: Vec<(String, f64)>,
+    noise_std: Option<f64>,
+}
+
+impl Model {
+    fn of(s: &fitting::Structure) -> Self {
+        use jitterid::estimate::NoiseModel;
+        Model {
+            signal: s.signal.spec(),
+            jitter: s.jitter.spec(),
+            noise: s
+                .noise
+                .param_names()
+                .into_iter()
+                .zip(s.noise.params())
+                .collect(),
+            noise_std: s.noise_std,
+        }
+    }
+}
+
+/// The columns of a CSV file that `jitterid simulate` wrote, and, when its side file
+/// `<name>.input.csv` is there (or `input` is given), the input's `input_t` and `input_u`.
+#[pyfunction]
+#[pyo3(signature = (path, input = None))]
+pub fn read_record<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    input: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !path.exists() {
+        return Err(PyOSError::new_err(format!(
+            "{}: cannot read: file does not exist",
+            path.display()
+        )));
+    }
+    let table = csvio::read(&path).map_err(value_error)?;
+    let out = PyDict::new(py);
+    for (name, values) in table.columns.iter().zip(table.values) {
+        out.set_item(name, values.into_pyarray(py))?;
+    }
+    let side = input.unwrap_or_else(|| commands::input_side_file(&path));
+    if side.exists() {
+        let t = csvio::read(&side).map_err(value_error)?;
+        out.set_item(
+            "input_t",
+            t.column("t")
+                .map_err(value_error)?
+                .to_vec()
+                .into_pyarray(py),
+        )?;
+        out.set_item(
+            "input_u",
+            t.column("u")
+                .map_err(value_error)?
+                .to_vec()
+                .into_pyarray(py),
+        )?;
+    }
+    Ok(out)
+}

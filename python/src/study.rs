@@ -1,0 +1,60 @@
+//! Monte Carlo studies and the merge of their shards, as `jitterid montecarlo --json` and
+//! `jitterid merge --json` give them.
+
+use crate::errors::{json_text, value_error};
+use crate::experiment::Experiment;
+use jitterid_cli::commands::{self, McJson, Shard, DEFAULT_SEED};
+use jitterid_cli::merge::merge_values;
+use pyo3::prelude::*;
+
+/// Runs `runs` realisations of `experiment` with `method` (the file's if `None`) under master
+/// `seed`, or shard `(index, count)` of them, on `threads` worker threads; returns the result
+/// as JSON text (that of `jitterid montecarlo --json`).
+#[pyfunction]
+#[pyo3(signature = (experiment, runs = 128, seed = DEFAULT_SEED, shard = None, method = None, threads = None))]
+pub fn montecarlo(
+    py: Python<'_>,
+    experiment: &Experiment,
+    runs: u64,
+    seed: u64,
+    shard: Option<(u64, u64)>,
+    method: Option<&str>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let exp = experiment.for_method(method)?;
+    let shard = shard
+        .map(|(index, count)| {
+            if count > 0 && index < count {
+                Ok(Shard { index, count })
+            } else {
+                Err(value_error(format!(
+                    "shard: expected (i, n) with 0 <= i < n, found ({index}, {count})"
+                )))
+            }
+        })
+        .transpose()?;
+    let j = py
+        .detach(|| commands::montecarlo_values(&exp, runs, seed, shard, threads))
+        .map_err(value_error)?;
+    json_text(&j)
+}
+
+/// Merges shard results (JSON texts of sharded `montecarlo` results) into the result of the
+/// unsharded study, checking that they belong together and are whole.
+#[pyfunction]
+pub fn merge(shards: Vec<String>) -> PyResult<String> {
+    let parts = shards
+        .iter()
+        .enumerate()
+        .map(|(i, text)| {
+            serde_json::from_str::<McJson>(text)
+                .map(|j| (format!("shard result {i}"), j))
+                .map_err(|e| {
+                    value_error(format!(
+                        "shard result {i}: not a Monte Carlo shard result: {e}"
+                    ))
+                })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    json_text(&merge_values(parts).map_err(value_error)?)
+}
