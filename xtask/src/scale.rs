@@ -66,11 +66,7 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
             20_001..=1_000_000 => 3,
             _ => 1,
         };
-        let problem = FitProblem {
-            structure: &structure,
-            criterion: &Bcls,
-            data: &data,
-        };
+        let problem = FitProblem::new(&structure, &Bcls, &data);
         let theta = structure.params();
         let eval = median(
             (0..reps)

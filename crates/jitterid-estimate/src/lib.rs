@@ -48,6 +48,7 @@ mod covariance;
 mod criterion;
 mod data;
 mod error;
+mod evaluation_memo;
 mod finite_diff;
 mod fit;
 mod flatness;
