@@ -13,8 +13,10 @@
 //! [`ArgminProblem`] provides both for every [`LeastSquares`] problem.
 //!
 //! The state is argmin's [`IterState`] ([`LmState`]): `param` is the current point, `cost` is
-//! `½ Σ rᵢ²`, and `residuals` and `gradient` (`Jᵀr`) hold the values at `param`; its Jacobian
-//! slot stays empty.
+//! `½ Σ rᵢ²`, and `residuals` and `gradient` (`Jᵀr`) hold the values at `param`, except that
+//! the residuals are released before each iteration's trial evaluations (on a long record they
+//! are as large as the data), so a run that stops inside an iteration without accepting a
+//! step ends with that slot empty; its Jacobian slot stays empty.
 //!
 //! # Algorithm
 //!

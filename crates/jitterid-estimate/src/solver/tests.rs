@@ -135,7 +135,11 @@ fn lm_as_argmin_solver_reports_through_termination_status() {
     assert_eq!(result.solver.termination(), Some(&Termination::SmallStep));
     assert!(result.solver.lambda() > 0.0);
     let state = &result.state;
-    assert_eq!(state.get_residuals().map(Vec::len), Some(2));
+    // The run stopped on a step that shrank to nothing after rejections: the current
+    // residuals were released before the trial evaluations (memory flat in `m`), so the slot
+    // is empty; the cost and gradient at `param` remain.
+    assert_eq!(state.get_residuals(), None);
+    assert!(state.get_cost().is_finite());
     // The state carries the gradient; the Jacobian is never stored (memory flat in `m`).
     assert!(state.get_jacobian().is_none() && state.get_gradient().is_some());
     let evaluations = result.problem.counts.get("normal_equations_count").copied();
