@@ -15,26 +15,33 @@ use std::sync::Mutex;
 /// sensitivities at most).
 pub(crate) const MEMO_MAX_SAMPLES: usize = 1 << 13;
 
-/// One evaluated point.
+/// One evaluated point, with the model built there (`M`).
 #[derive(Debug)]
-struct Entry {
+struct Entry<M> {
     theta: Vec<f64>,
     residuals: Vec<f64>,
     sensitivities: Option<Vec<Vec<f64>>>,
+    model: Option<M>,
 }
 
 /// The last evaluated point of a problem (bitwise-equal parameters hit), shared between
 /// threads behind a lock.
-#[derive(Debug, Default)]
-pub(crate) struct EvaluationMemo(Mutex<Option<Entry>>);
+#[derive(Debug)]
+pub(crate) struct EvaluationMemo<M>(Mutex<Option<Entry<M>>>);
+
+impl<M> Default for EvaluationMemo<M> {
+    fn default() -> Self {
+        EvaluationMemo(Mutex::new(None))
+    }
+}
 
 /// Bitwise equality, so that a hit returns exactly what the evaluation would.
 fn same_point(a: &[f64], b: &[f64]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
-impl EvaluationMemo {
-    fn with<T>(&self, f: impl FnOnce(&mut Option<Entry>) -> T) -> T {
+impl<M> EvaluationMemo<M> {
+    fn with<T>(&self, f: impl FnOnce(&mut Option<Entry<M>>) -> T) -> T {
         let mut guard = match self.0.lock() {
             Ok(g) => g,
             Err(poisoned) => poisoned.into_inner(),
@@ -42,20 +49,33 @@ impl EvaluationMemo {
         f(&mut guard)
     }
 
-    /// Keeps the residuals (and, when computed with them, the sensitivities) at `theta`.
+    /// Keeps the residuals (and, when computed with them, the sensitivities) at `theta`, and
+    /// the model built there.
     pub(crate) fn store(
         &self,
         theta: &[f64],
         residuals: &[f64],
         sensitivities: Option<Vec<Vec<f64>>>,
+        model: M,
     ) {
         self.with(|e| {
             *e = Some(Entry {
                 theta: theta.to_vec(),
                 residuals: residuals.to_vec(),
                 sensitivities,
+                model: Some(model),
             });
         });
+    }
+
+    /// The model built at `theta`, handed over (a second call gets `None`), if that was the
+    /// last point evaluated.
+    pub(crate) fn take_model(&self, theta: &[f64]) -> Option<M> {
+        self.with(|e| {
+            e.as_mut()
+                .filter(|e| same_point(&e.theta, theta))
+                .and_then(|e| e.model.take())
+        })
     }
 
     /// The residuals at `theta`, if that was the last point evaluated.
@@ -85,13 +105,16 @@ mod tests {
     fn hits_only_the_same_point() {
         let memo = EvaluationMemo::default();
         assert_eq!(memo.residuals(&[1.0]), None);
-        memo.store(&[1.0, 2.0], &[3.0], Some(vec![vec![4.0]]));
+        memo.store(&[1.0, 2.0], &[3.0], Some(vec![vec![4.0]]), "model");
         assert_eq!(memo.residuals(&[1.0, 2.0]), Some(vec![3.0]));
         assert_eq!(memo.sensitivities(&[1.0, 2.0]), Some(vec![vec![4.0]]));
+        assert_eq!(memo.take_model(&[1.0]), None);
+        assert_eq!(memo.take_model(&[1.0, 2.0]), Some("model"));
+        assert_eq!(memo.take_model(&[1.0, 2.0]), None);
         assert_eq!(memo.residuals(&[1.0, 2.0 + f64::EPSILON * 2.0]), None);
         assert_eq!(memo.residuals(&[1.0]), None);
         // -0.0 and 0.0 are different points for the memo (bitwise).
-        memo.store(&[0.0], &[5.0], None);
+        memo.store(&[0.0], &[5.0], None, "other");
         assert_eq!(memo.residuals(&[-0.0]), None);
         assert_eq!(memo.sensitivities(&[0.0]), None);
     }

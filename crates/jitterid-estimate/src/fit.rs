@@ -87,7 +87,7 @@ pub struct FitProblem<'a, S, J, N, C: ?Sized, W> {
     pub criterion: &'a C,
     /// The data.
     pub data: &'a FrequencyData<W>,
-    memo: EvaluationMemo,
+    memo: EvaluationMemo<ModelStructure<S, J, N>>,
 }
 
 impl<'a, S, J, N, C: ?Sized, W> FitProblem<'a, S, J, N, C, W> {
@@ -152,7 +152,7 @@ where
             } else {
                 (self.data.residuals(self.criterion, &m), None)
             };
-        self.memo.store(theta, &r, sensitivities);
+        self.memo.store(theta, &r, sensitivities, m);
         Ok(r)
     }
 
@@ -168,7 +168,12 @@ where
         theta: &[f64],
         residuals: &[f64],
     ) -> Result<NormalEquations, SolverError> {
-        Ok(match self.structure.with_params(theta) {
+        // The model the residuals just built at this point, when they did.
+        let model = match self.memo.take_model(theta) {
+            Some(m) => Ok(m),
+            None => self.structure.with_params(theta),
+        };
+        Ok(match model {
             Ok(m) => crate::parseval::criterion_normal_equations(
                 self.criterion,
                 self.data,
