@@ -304,11 +304,7 @@ fn criterion_jacobians_match_finite_differences() {
         data: &FrequencyData<DirichletWindow>,
         s: &ModelStructure<LtiResponse<Zpk>, UniformSum, N>,
     ) {
-        let problem = FitProblem {
-            structure: s,
-            criterion: c,
-            data,
-        };
+        let problem = FitProblem::new(s, c, data);
         let theta = s.params();
         let analytic = problem.jacobian(&theta).unwrap();
         let fd = fd_jacobian(&problem, &theta, 1e-6).unwrap();

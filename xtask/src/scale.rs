@@ -66,15 +66,13 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
             20_001..=1_000_000 => 3,
             _ => 1,
         };
-        let problem = FitProblem {
-            structure: &structure,
-            criterion: &Bcls,
-            data: &data,
-        };
         let theta = structure.params();
         let eval = median(
             (0..reps)
                 .map(|_| {
+                    // A fresh problem each time: a problem memoises its last point, and a
+                    // repeated evaluation there would time a copy.
+                    let problem = FitProblem::new(&structure, &Bcls, &data);
                     let t = Instant::now();
                     let r = problem.residuals(&theta).expect("residuals");
                     let ne = problem

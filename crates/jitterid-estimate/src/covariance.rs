@@ -28,12 +28,14 @@ use std::f64::consts::TAU;
 /// explicit Jacobian is mapped back to time.
 ///
 /// Parameters in `held` (on the boundary of their domain, see [`crate::boundary`]) get zero
-/// rows and columns; the others their covariance conditional on the held ones.
+/// rows and columns; the others their covariance conditional on the held ones. `known` are the
+/// time-domain sensitivities at `model`, when already computed.
 pub(crate) fn sandwich<S, J, N, C, W>(
     data: &FrequencyData<W>,
     model: &ModelStructure<S, J, N>,
     criterion: &C,
     held: &[usize],
+    known: Option<Vec<Vec<f64>>>,
 ) -> (Option<Vec<Vec<f64>>>, f64)
 where
     S: Signal + Clone,
@@ -64,7 +66,7 @@ where
     let white = model.noise.is_white();
     let (gram, meat) = match parseval_weight(criterion, data, model) {
         Some(weight) if white => {
-            let cols = moment_sensitivities(criterion, data, model);
+            let cols = known.unwrap_or_else(|| moment_sensitivities(criterion, data, model));
             let meat = time_domain_meat(&cols, weight, &jitter_var, noise_var);
             (parseval_gram(&cols, weight), meat)
         }

@@ -5,6 +5,7 @@ use crate::boundary::{bound_params, positive_params, settle_at_bounds};
 use crate::covariance::sandwich;
 use crate::criterion::Criterion;
 use crate::data::Record;
+use crate::evaluation_memo::{EvaluationMemo, MEMO_MAX_SAMPLES};
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::result::{CostKind, Fit};
@@ -76,7 +77,8 @@ const EXACT_FIT: f64 = 1e-9;
 /// A criterion and its data as a [`LeastSquares`] problem in the structure's free parameters.
 ///
 /// A parameter vector outside the model's domain (an unstable pole, `a ≤ 0`, …) gives NaN
-/// residuals, which the solvers treat as a rejected trial point.
+/// residuals, which the solvers treat as a rejected trial point. On short records the last
+/// evaluated point is memoised (see [`FitProblem::new`]).
 #[derive(Debug)]
 pub struct FitProblem<'a, S, J, N, C: ?Sized, W> {
     /// The structure at the start (fixed parts and the template for `with_params`).
@@ -85,6 +87,34 @@ pub struct FitProblem<'a, S, J, N, C: ?Sized, W> {
     pub criterion: &'a C,
     /// The data.
     pub data: &'a FrequencyData<W>,
+    memo: EvaluationMemo<ModelStructure<S, J, N>>,
+}
+
+impl<'a, S, J, N, C: ?Sized, W> FitProblem<'a, S, J, N, C, W> {
+    /// The problem of fitting `structure`'s free parameters to `data` by `criterion`.
+    ///
+    /// On records of up to a few thousand samples the residuals of the last point evaluated
+    /// are kept, with the time-domain sensitivities computed in the same pass, so that the
+    /// normal equations that a solver asks for next at that point (and a repeated residual
+    /// evaluation) cost no second pass over the model. The results are the same numbers as
+    /// without it.
+    pub fn new(
+        structure: &'a ModelStructure<S, J, N>,
+        criterion: &'a C,
+        data: &'a FrequencyData<W>,
+    ) -> Self {
+        FitProblem {
+            structure,
+            criterion,
+            data,
+            memo: EvaluationMemo::default(),
+        }
+    }
+
+    /// The time-domain sensitivities at `theta` if the last evaluation was there.
+    pub(crate) fn memoised_sensitivities(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
+        self.memo.sensitivities(theta)
+    }
 }
 
 impl<S, J, N, C, W> LeastSquares for FitProblem<'_, S, J, N, C, W>
@@ -104,10 +134,26 @@ where
     }
 
     fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
-        Ok(match self.structure.with_params(theta) {
-            Ok(m) => self.data.residuals(self.criterion, &m),
-            Err(_) => vec![f64::NAN; self.num_residuals()],
-        })
+        if let Some(r) = self.memo.residuals(theta) {
+            return Ok(r);
+        }
+        let Ok(m) = self.structure.with_params(theta) else {
+            return Ok(vec![f64::NAN; self.num_residuals()]);
+        };
+        if self.data.record().y().len() > MEMO_MAX_SAMPLES {
+            return Ok(self.data.residuals(self.criterion, &m));
+        }
+        let (r, sensitivities) =
+            if crate::parseval::parseval_weight(self.criterion, self.data, &m).is_some() {
+                let (values, cols) =
+                    crate::parseval::moment_and_sensitivities(self.criterion, self.data, &m);
+                let r = self.data.residuals_of_moment(self.criterion, &m, values);
+                (r, Some(cols))
+            } else {
+                (self.data.residuals(self.criterion, &m), None)
+            };
+        self.memo.store(theta, &r, sensitivities, m);
+        Ok(r)
     }
 
     fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
@@ -122,12 +168,18 @@ where
         theta: &[f64],
         residuals: &[f64],
     ) -> Result<NormalEquations, SolverError> {
-        Ok(match self.structure.with_params(theta) {
+        // The model the residuals just built at this point, when they did.
+        let model = match self.memo.take_model(theta) {
+            Some(m) => Ok(m),
+            None => self.structure.with_params(theta),
+        };
+        Ok(match model {
             Ok(m) => crate::parseval::criterion_normal_equations(
                 self.criterion,
                 self.data,
                 &m,
                 residuals,
+                self.memo.sensitivities(theta),
             ),
             Err(_) => NormalEquations::not_finite(self.num_params()),
         })
@@ -186,13 +238,10 @@ where
             params: p,
         });
     }
-    let problem = FitProblem {
-        structure,
-        criterion,
-        data: &data,
-    };
+    let problem = FitProblem::new(structure, criterion, &data);
     let start = structure.params();
-    let r0 = data.residuals(criterion, structure);
+    // Through the problem, so that the solver's first evaluation at the start is memoised.
+    let r0 = problem.residuals(&start)?;
     if let Some((index, &value)) = r0.iter().enumerate().find(|(_, r)| !r.is_finite()) {
         return Err(EstimateError::NonFiniteAtStart { index, value });
     }
@@ -202,9 +251,10 @@ where
     let held = bound_params(&report, &start, &positive_params(structure));
     let report = settle_at_bounds(&problem, report, &held)?;
     let fitted = structure.with_params(&report.params)?;
-    let residuals = data.residuals(criterion, &fitted);
+    let residuals = problem.residuals(&report.params)?;
     let (covariance, noise_std) = if options.covariance {
-        sandwich(&data, &fitted, criterion, &held)
+        let known = problem.memoised_sensitivities(&report.params);
+        sandwich(&data, &fitted, criterion, &held, known)
     } else {
         (None, fitted.noise_std.unwrap_or(f64::NAN))
     };

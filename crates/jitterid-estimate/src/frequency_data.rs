@@ -90,7 +90,22 @@ impl<W: Window> FrequencyData<W> {
         criterion: &C,
         model: &ModelStructure<S, J, N>,
     ) -> Vec<f64> {
-        let mu = self.transform_moment(self.first_moment(criterion, model));
+        self.residuals_of_moment(criterion, model, self.first_moment(criterion, model))
+    }
+
+    /// [`residuals`](Self::residuals) from the model's first moment `m_k`, already computed.
+    pub(crate) fn residuals_of_moment<
+        S: Signal,
+        J: JitterModel,
+        N: NoiseModel,
+        C: Criterion + ?Sized,
+    >(
+        &self,
+        criterion: &C,
+        model: &ModelStructure<S, J, N>,
+        m: Vec<f64>,
+    ) -> Vec<f64> {
+        let mu = self.transform_moment(m);
         let w = self.weights(criterion, model, Some(&mu));
         stack(self.dtft(), &mu, &w)
     }

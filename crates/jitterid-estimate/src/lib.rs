@@ -56,6 +56,7 @@ mod criterion;
 pub mod csv;
 mod data;
 mod error;
+mod evaluation_memo;
 mod finite_diff;
 mod fit;
 mod flatness;

@@ -75,17 +75,69 @@ where
     C: Criterion + ?Sized,
     W: Window,
 {
-    let (ns, nj, nn) = model.blocks();
+    let (ns, _, _) = model.blocks();
+    let grid = data.record().grid();
+    let signal_cols = if ns == 0 {
+        Vec::new()
+    } else if criterion.models_jitter() {
+        model.signal.expected_values_gradient(grid, &model.jitter)
+    } else {
+        model.signal.expected_values_gradient(grid, &NoJitter)
+    };
+    with_other_sensitivities(criterion, data, model, signal_cols)
+}
+
+/// The criterion's first moment `m_k` and its [`moment_sensitivities`], the signal's part
+/// from one pass over the jitter's expectations (the same numbers as the two separately).
+pub(crate) fn moment_and_sensitivities<S, J, N, C, W>(
+    criterion: &C,
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+) -> (Vec<f64>, Vec<Vec<f64>>)
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion + ?Sized,
+    W: Window,
+{
+    let (ns, _, _) = model.blocks();
+    let grid = data.record().grid();
+    let (m, signal_cols) = if ns == 0 {
+        (data.first_moment(criterion, model), Vec::new())
+    } else if criterion.models_jitter() {
+        model
+            .signal
+            .expected_values_and_gradient(grid, &model.jitter)
+    } else {
+        model.signal.expected_values_and_gradient(grid, &NoJitter)
+    };
+    (
+        m,
+        with_other_sensitivities(criterion, data, model, signal_cols),
+    )
+}
+
+/// `signal_cols` followed by the jitter's columns (central differences) and the noise
+/// shape's (zero: the first moment does not depend on it).
+fn with_other_sensitivities<S, J, N, C, W>(
+    criterion: &C,
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+    signal_cols: Vec<Vec<f64>>,
+) -> Vec<Vec<f64>>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion + ?Sized,
+    W: Window,
+{
+    let (_, nj, nn) = model.blocks();
     let grid = data.record().grid();
     let n = grid.len();
-    let mut cols = Vec::with_capacity(ns + nj + nn);
-    if ns > 0 {
-        cols.extend(if criterion.models_jitter() {
-            model.signal.expected_values_gradient(grid, &model.jitter)
-        } else {
-            model.signal.expected_values_gradient(grid, &NoJitter)
-        });
-    }
+    let mut cols = signal_cols;
+    cols.reserve(nj + nn);
     if nj > 0 {
         let theta = model.jitter.params();
         for j in 0..nj {
@@ -159,12 +211,14 @@ fn frequency_gradient<W: Window>(
 }
 
 /// `JᵀJ` and `Jᵀr` of `criterion` at `model`, without the `2F × p` Jacobian when the Parseval
-/// identity applies, from the explicit Jacobian otherwise.
+/// identity applies (from the sensitivities `known` at `model` when given), from the explicit
+/// Jacobian otherwise.
 pub(crate) fn criterion_normal_equations<S, J, N, C, W>(
     criterion: &C,
     data: &FrequencyData<W>,
     model: &ModelStructure<S, J, N>,
     residuals: &[f64],
+    known: Option<Vec<Vec<f64>>>,
 ) -> NormalEquations
 where
     S: Signal + Clone,
@@ -180,7 +234,7 @@ where
     };
     match parseval_weight(criterion, data, model) {
         Some(weight) if residuals.len() == data.num_residuals() => {
-            let cols = moment_sensitivities(criterion, data, model);
+            let cols = known.unwrap_or_else(|| moment_sensitivities(criterion, data, model));
             let gram = parseval_gram(&cols, weight);
             NormalEquations {
                 gram,

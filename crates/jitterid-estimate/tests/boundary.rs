@@ -83,11 +83,7 @@ fn a_width_at_zero_is_converged_at_the_bound() {
             FrequencySet::dft(record.grid()),
         )
         .expect("data");
-        let problem = FitProblem {
-            structure: &structure,
-            criterion: &Bcls,
-            data: &data,
-        };
+        let problem = FitProblem::new(&structure, &Bcls, &data);
         let stalled = LevenbergMarquardt::default()
             .minimize(&problem, &start)
             .expect("runs");

@@ -111,11 +111,7 @@ fn jacobian_of_model_dependent_weights_matches_finite_differences() {
     let structure = structure.with_estimated(true, true, false);
     let freqs = FrequencySet::dft(record.grid());
     let data = FrequencyData::new(record, DirichletWindow, freqs).unwrap();
-    let problem = FitProblem {
-        structure: &structure,
-        criterion: &ModelWeighted,
-        data: &data,
-    };
+    let problem = FitProblem::new(&structure, &ModelWeighted, &data);
     let theta = structure.params();
     let analytic = data.jacobian(&ModelWeighted, &structure);
     // An independent route: central differences of the whole residual vector.

@@ -56,11 +56,7 @@ fn check<C: Criterion, W: Window + Clone>(
     freqs: FrequencySet,
 ) {
     let data = FrequencyData::new(record.clone(), window, freqs).expect("data");
-    let problem = FitProblem {
-        structure,
-        criterion,
-        data: &data,
-    };
+    let problem = FitProblem::new(structure, criterion, &data);
     let theta = structure.params();
     let r = problem.residuals(&theta).expect("residuals");
     let flat = problem
@@ -127,11 +123,7 @@ fn a_point_outside_the_domain_has_non_finite_normal_equations() {
         FrequencySet::dft(record.grid()),
     )
     .expect("data");
-    let problem = FitProblem {
-        structure: &structure,
-        criterion: &Bcls,
-        data: &data,
-    };
+    let problem = FitProblem::new(&structure, &Bcls, &data);
     let mut theta = structure.params();
     let r = problem.residuals(&theta).expect("residuals");
     *theta.last_mut().expect("jitter parameter") = -1.0;
@@ -182,4 +174,48 @@ fn covariance_by_sums_over_samples_matches_the_projected_jacobian() {
             );
         }
     }
+}
+
+/// The residual evaluation keeps the sensitivities of its pass for the normal equations at the
+/// same point: the numbers are those of a problem that evaluates everything afresh, bit for
+/// bit, and a moved point is evaluated anew.
+#[test]
+fn memoised_evaluation_equals_a_fresh_one() {
+    let (record, structure) = setup(200, 11);
+    let data = FrequencyData::new(
+        record.clone(),
+        DirichletWindow,
+        FrequencySet::dft(record.grid()),
+    )
+    .expect("data");
+    let theta = structure.params();
+    let memoised = FitProblem::new(&structure, &Bcls, &data);
+    let r = memoised.residuals(&theta).expect("residuals");
+    let ne = memoised
+        .normal_equations(&theta, &r)
+        .expect("normal equations");
+    // A fresh problem asked for the normal equations first has no memo to use.
+    let fresh = FitProblem::new(&structure, &Bcls, &data);
+    let ne_fresh = fresh
+        .normal_equations(&theta, &r)
+        .expect("normal equations");
+    assert_eq!(ne.gradient, ne_fresh.gradient);
+    assert_eq!(ne.gram, ne_fresh.gram);
+    assert_eq!(r, fresh.residuals(&theta).expect("residuals"));
+    let mut moved = theta.clone();
+    moved[0] *= 1.01;
+    let r_moved = memoised.residuals(&moved).expect("residuals");
+    assert_ne!(r_moved, r);
+    assert_eq!(
+        r_moved,
+        FitProblem::new(&structure, &Bcls, &data)
+            .residuals(&moved)
+            .expect("residuals")
+    );
+    assert_eq!(
+        memoised.normal_equations(&moved, &r_moved).expect("ne"),
+        FitProblem::new(&structure, &Bcls, &data)
+            .normal_equations(&moved, &r_moved)
+            .expect("ne")
+    );
 }

@@ -193,6 +193,13 @@ impl Signal for AnySignal {
     fn expected_values_gradient(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Jacobian {
         self.model().expected_values_gradient(grid, jitter)
     }
+    fn expected_values_and_gradient(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> (Vec<f64>, Jacobian) {
+        self.model().expected_values_and_gradient(grid, jitter)
+    }
     fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
         self.model().expected_squares(grid, jitter)
     }

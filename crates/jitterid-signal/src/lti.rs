@@ -683,20 +683,10 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         }
         let m = self.modal();
         let reps = self.representatives();
-        let coef: Vec<(Complex64, f64)> = reps
-            .iter()
-            .map(|&(i, w)| (m.residues[i] / m.poles[i], w))
-            .collect();
+        let coef = value_terms(m, &reps);
         let mut out = Vec::with_capacity(grid.len());
         self.modal_expectations(grid, jitter, &reps, false, |c, a, _| {
-            out.push(
-                m.dc_gain * c
-                    + coef
-                        .iter()
-                        .zip(a)
-                        .map(|(&(r, w), a)| w * (r * a).re)
-                        .sum::<f64>(),
-            );
+            out.push(expected_value(m, &coef, c, a));
         });
         out
     }
@@ -710,32 +700,95 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         }
         let m = self.modal();
         let reps = self.representatives();
-        // ∂/∂θ_j of G(0)·C + Re Σ (r/p) A, with ∂A/∂p = B.
-        let terms: Vec<Vec<(Complex64, Complex64, f64)>> = (0..np)
-            .map(|j| {
-                reps.iter()
-                    .map(|&(i, w)| {
-                        let (p, r) = (m.poles[i], m.residues[i]);
-                        let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
-                        (dr / p - r * dp / (p * p), r / p * dp, w)
-                    })
-                    .collect()
-            })
-            .collect();
+        let terms = gradient_terms(m, &reps, np);
         let mut cols: Jacobian = (0..np).map(|_| Vec::with_capacity(grid.len())).collect();
         self.modal_expectations(grid, jitter, &reps, true, |c, a, b| {
-            for ((col, terms), d_dc) in cols.iter_mut().zip(&terms).zip(&m.d_dc_gain) {
-                col.push(
-                    d_dc * c
-                        + terms
-                            .iter()
-                            .enumerate()
-                            .map(|(i, &(d_rp, rp_dp, w))| w * (d_rp * a[i] + rp_dp * b[i]).re)
-                            .sum::<f64>(),
-                );
-            }
+            push_gradient(m, &terms, &mut cols, c, a, b);
         });
         cols
+    }
+
+    fn expected_values_and_gradient(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> (Vec<f64>, Jacobian) {
+        if let Input::Tones(_) = self.input {
+            return (
+                self.expected_values(grid, jitter),
+                self.expected_values_gradient(grid, jitter),
+            );
+        }
+        let np = self.model.params().len();
+        let m = self.modal();
+        let reps = self.representatives();
+        let coef = value_terms(m, &reps);
+        let terms = gradient_terms(m, &reps, np);
+        let mut values = Vec::with_capacity(grid.len());
+        let mut cols: Jacobian = (0..np).map(|_| Vec::with_capacity(grid.len())).collect();
+        self.modal_expectations(grid, jitter, &reps, true, |c, a, b| {
+            values.push(expected_value(m, &coef, c, a));
+            push_gradient(m, &terms, &mut cols, c, a, b);
+        });
+        (values, cols)
+    }
+}
+
+/// The coefficients `(r_i/p_i, w_i)` of `m_k = G(0)·C + Re Σ_i w_i (r_i/p_i) A_i`.
+fn value_terms(m: &Modal, reps: &[(usize, f64)]) -> Vec<(Complex64, f64)> {
+    reps.iter()
+        .map(|&(i, w)| (m.residues[i] / m.poles[i], w))
+        .collect()
+}
+
+/// `m_k` from the sample's `C` and `A_i`.
+fn expected_value(m: &Modal, coef: &[(Complex64, f64)], c: f64, a: &[Complex64]) -> f64 {
+    m.dc_gain * c
+        + coef
+            .iter()
+            .zip(a)
+            .map(|(&(r, w), a)| w * (r * a).re)
+            .sum::<f64>()
+}
+
+/// Per parameter `j`, the coefficients of `∂/∂θ_j` of `G(0)·C + Re Σ (r/p) A`, with
+/// `∂A/∂p = B`.
+fn gradient_terms(
+    m: &Modal,
+    reps: &[(usize, f64)],
+    np: usize,
+) -> Vec<Vec<(Complex64, Complex64, f64)>> {
+    (0..np)
+        .map(|j| {
+            reps.iter()
+                .map(|&(i, w)| {
+                    let (p, r) = (m.poles[i], m.residues[i]);
+                    let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
+                    (dr / p - r * dp / (p * p), r / p * dp, w)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Appends one sample's `∂m_k/∂θ_j` to every column.
+fn push_gradient(
+    m: &Modal,
+    terms: &[Vec<(Complex64, Complex64, f64)>],
+    cols: &mut Jacobian,
+    c: f64,
+    a: &[Complex64],
+    b: &[Complex64],
+) {
+    for ((col, terms), d_dc) in cols.iter_mut().zip(terms).zip(&m.d_dc_gain) {
+        col.push(
+            d_dc * c
+                + terms
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &(d_rp, rp_dp, w))| w * (d_rp * a[i] + rp_dp * b[i]).re)
+                    .sum::<f64>(),
+        );
     }
 }
 

@@ -84,6 +84,21 @@ pub trait Signal: fmt::Debug + Send + Sync {
         cols
     }
 
+    /// `m_k` and `∂m_k/∂θ_j` together: one pass over the jitter's expectations where a model
+    /// shares them between the value and its gradient (the values equal
+    /// [`expected_values`](Self::expected_values), the columns
+    /// [`expected_values_gradient`](Self::expected_values_gradient)).
+    fn expected_values_and_gradient(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> (Vec<f64>, Jacobian) {
+        (
+            self.expected_values(grid, jitter),
+            self.expected_values_gradient(grid, jitter),
+        )
+    }
+
     /// `E[s(t_k + τ)²]` for every requested instant (for the second moment
     /// `Var y_k = σ_v² + E[s(t_k+τ)²] − m_k²`).
     fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
