@@ -119,7 +119,7 @@ fn tf() -> SignalKind {
                 "den",
                 "denominator coefficients, highest power first (normalised to monic)",
                 "",
-                "finite, leading ≠ 0, stable distinct poles",
+                "finite, leading ≠ 0, poles stable or marginally stable (repeats allowed)",
             ),
         ],
         true,
