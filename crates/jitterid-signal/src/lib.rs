@@ -29,7 +29,9 @@
 #![warn(missing_docs)]
 
 mod any;
+mod augmented;
 mod error;
+mod expm;
 mod grid;
 mod input;
 mod lti;

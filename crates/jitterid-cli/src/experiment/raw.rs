@@ -66,6 +66,7 @@ section!(RawSystem, "table [system]" {
     frequency: f64,
     phase: f64,
     estimate: bool,
+    allow_unstable: bool,
 });
 
 section!(RawNoise, "table [noise]" {
