@@ -25,11 +25,15 @@
 //! * Inputs: [`PiecewiseConstant`] (and [`RandomBinary`], the paper's input, and zero-order
 //!   hold), [`Multisine`].
 //!
+//! * [`forms`]: plain transfer-function, zero-pole-gain and state-space forms of a model, with
+//!   conversions and readable display, for export.
+//!
 //! The exact jittered simulator [`simulate`] draws `y_k = s(t_k + τ_k) + v_k`.
 #![warn(missing_docs)]
 
 mod any;
 mod error;
+pub mod forms;
 mod grid;
 mod input;
 mod lti;
