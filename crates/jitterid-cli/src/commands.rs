@@ -5,6 +5,7 @@ use crate::csvio::{self, Column};
 use crate::error::{CliError, CliResult};
 use crate::exit::{Outcome, Status};
 use crate::experiment::{self, Experiment, InputSpec, Method, Purpose};
+use crate::export;
 use crate::fingerprint::experiment_fingerprint;
 use crate::fitting::{self, Fit, Structure};
 use crate::inputs;
@@ -157,6 +158,11 @@ struct FitJson<'a> {
     termination: &'a str,
     noise_std: f64,
     parameters: &'a [fitting::Param],
+    /// Covariance of `parameters`, in their order (`null` where undefined).
+    covariance: Option<&'a [Vec<Option<f64>>]>,
+    /// The fitted system in zpk, tf and state-space form (rational systems only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    model: Option<export::ModelForms>,
 }
 
 /// The samples of a data file, checked against the experiment's grid.
@@ -333,6 +339,8 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
             termination: &f.termination,
             noise_std: f.noise_std,
             parameters: &f.params,
+            covariance: f.covariance.as_deref(),
+            model: export::model_forms(&f.fitted.signal),
         };
         return serde_json::to_string_pretty(&j)
             .map(|text| Outcome {

@@ -3,6 +3,7 @@
 use crate::cli_err;
 use crate::error::CliResult;
 use crate::experiment::{name_table, Experiment, InputSpec, Method, SystemKind};
+use crate::export::{reported_covariance, CovarianceSource};
 use crate::inputs::input_span;
 use jitterid::estimate::solver::{
     AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead, SolverRegistry,
@@ -243,6 +244,9 @@ pub struct Fit {
     pub noise_std: f64,
     /// Reported parameters, in the model's order.
     pub params: Vec<Param>,
+    /// Covariance of the reported parameters, in their order, where computed (`None` entries
+    /// for parameters without one, such as a profiled integer).
+    pub covariance: Option<Vec<Vec<Option<f64>>>>,
     /// The fitted structure.
     pub fitted: Structure,
 }
@@ -369,6 +373,7 @@ struct Raw {
     /// The structure's free parameters, then `σ_v` when a likelihood estimated it.
     params: Vec<f64>,
     std_errors: Option<Vec<f64>>,
+    covariance: Option<Vec<Vec<f64>>>,
     cost: f64,
     iterations: u64,
     termination: String,
@@ -395,6 +400,7 @@ pub fn fit(
             Ok(Raw {
                 params: e.params,
                 std_errors: e.std_errors,
+                covariance: e.covariance,
                 cost: e.cost,
                 iterations: e.iterations,
                 termination: e.termination.to_string(),
@@ -419,7 +425,9 @@ pub fn fit(
     };
     let (ns, nj, nn) = s.blocks();
     let mut params = Vec::with_capacity(names.len());
-    let mut push = |estimate: f64, stderr: Option<f64>| {
+    let mut sources: Vec<CovarianceSource> = Vec::with_capacity(names.len());
+    let mut push = |estimate: f64, stderr: Option<f64>, source: CovarianceSource| {
+        sources.push(source);
         let name = names.get(params.len()).cloned().unwrap_or_default();
         params.push(Param {
             name,
@@ -429,7 +437,7 @@ pub fn fit(
     };
     let at = |i: usize| e.params.get(i).copied().unwrap_or(f64::NAN);
     for i in 0..ns {
-        push(at(i), se(i));
+        push(at(i), se(i), Some((i, 1.0)));
     }
     if let Some(n) = e.n {
         let a = at(ns);
@@ -437,22 +445,27 @@ pub fn fit(
         let k = uniform_sum_with_std(1.0)(i64::from(n))
             .map_err(|e| e.to_string())?
             .params()[0];
-        push(f64::from(n), None);
-        push(a, se(ns));
-        push(a / k, se(ns).map(|s| s / k));
+        push(f64::from(n), None, None);
+        push(a, se(ns), Some((ns, 1.0)));
+        push(a / k, se(ns).map(|s| s / k), Some((ns, 1.0 / k)));
     } else {
         for i in ns..ns + nj {
-            push(at(i), se(i));
+            push(at(i), se(i), Some((i, 1.0)));
         }
     }
     for i in ns + nj..ns + nj + nn {
-        push(at(i), se(i));
+        push(at(i), se(i), Some((i, 1.0)));
     }
     if exp.noise.estimate {
         // A likelihood estimates σ_v jointly (the last parameter); the least-squares criteria
         // estimate it from the residuals afterwards (no standard error).
         let joint = e.params.len() > ns + nj + nn;
-        push(e.noise_std, if joint { se(ns + nj + nn) } else { None });
+        let last = ns + nj + nn;
+        push(
+            e.noise_std,
+            if joint { se(last) } else { None },
+            joint.then_some((last, 1.0)),
+        );
     }
     Ok(Fit {
         method,
@@ -461,6 +474,10 @@ pub fn fit(
         iterations: e.iterations,
         termination: e.termination,
         noise_std: e.noise_std,
+        covariance: e
+            .covariance
+            .as_deref()
+            .map(|c| reported_covariance(c, &sources)),
         params,
         fitted: e.fitted,
     })
@@ -529,6 +546,7 @@ fn fit_ml(
     Ok(Raw {
         params: e.params,
         std_errors: e.std_errors,
+        covariance: e.covariance,
         cost: e.cost,
         iterations: e.iterations,
         termination: e.termination.to_string(),
