@@ -4,17 +4,8 @@
 
 mod common;
 
-use common::{run, s, scratch, stderr, stdout};
+use common::{example, run, s, scratch, stderr, stdout};
 use serde_json::Value;
-use std::path::Path;
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/experiments")
-        .join(name)
-        .display()
-        .to_string()
-}
 
 fn numbers(v: &Value) -> Vec<f64> {
     v.as_array()
