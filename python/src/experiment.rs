@@ -248,7 +248,7 @@ impl Experiment {
             cli: commands::fit_json(&fit),
             model: Model::of(&fit.fitted),
             estimated: &fit.estimated,
-            covariance: fit.covariance.as_deref(),
+            covariance: fit.estimator_covariance.as_deref(),
         })
     }
 

@@ -5,6 +5,7 @@ use crate::csvio::{self, Column};
 use crate::error::{CliError, CliResult};
 use crate::exit::{Outcome, Status};
 use crate::experiment::{self, Experiment, InputSpec, Method, Purpose};
+use crate::export;
 use crate::fingerprint::experiment_fingerprint;
 use crate::fitting::{self, Fit, Structure};
 use crate::inputs;
@@ -187,6 +188,11 @@ pub struct FitJson<'a> {
     termination: &'a str,
     noise_std: f64,
     parameters: &'a [fitting::Param],
+    /// Covariance of `parameters`, in their order (`null` where undefined).
+    covariance: Option<&'a [Vec<Option<f64>>]>,
+    /// The fitted system in zpk, tf and state-space form (rational systems only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    model: Option<export::ModelForms>,
 }
 
 /// The samples of a data file, checked against the experiment's grid.
@@ -293,6 +299,8 @@ pub fn fit_json(f: &Fit) -> FitJson<'_> {
         termination: &f.termination,
         noise_std: f.noise_std,
         parameters: &f.params,
+        covariance: f.covariance.as_deref(),
+        model: export::model_forms(&f.fitted.signal),
     }
 }
 

@@ -3,6 +3,7 @@
 use crate::cli_err;
 use crate::error::CliResult;
 use crate::experiment::{name_table, Experiment, InputSpec, Method, SystemKind};
+use crate::export::{reported_covariance, CovarianceSource};
 use crate::inputs::input_span;
 use jitterid::estimate::solver::{
     AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead, SolverRegistry,
@@ -245,6 +246,9 @@ pub struct Fit {
     pub noise_std: f64,
     /// Reported parameters, in the model's order.
     pub params: Vec<Param>,
+    /// Covariance of the reported parameters, in their order, where computed (`None` entries
+    /// for parameters without one, such as a profiled integer).
+    pub covariance: Option<Vec<Vec<Option<f64>>>>,
     /// The fitted structure.
     pub fitted: Structure,
     /// Names of the estimated parameters, in the estimator's order (which [`params`](Self::params)
@@ -252,7 +256,7 @@ pub struct Fit {
     pub estimated: Vec<String>,
     /// Asymptotic covariance of the estimated parameters, in the order of
     /// [`estimated`](Self::estimated), when computed and defined.
-    pub covariance: Option<Vec<Vec<f64>>>,
+    pub estimator_covariance: Option<Vec<Vec<f64>>>,
 }
 
 /// Names of the reported parameters, in order, for an experiment fitted with `method`.
@@ -443,7 +447,9 @@ pub fn fit(
     };
     let (ns, nj, nn) = s.blocks();
     let mut params = Vec::with_capacity(names.len());
-    let mut push = |estimate: f64, stderr: Option<f64>| {
+    let mut sources: Vec<CovarianceSource> = Vec::with_capacity(names.len());
+    let mut push = |estimate: f64, stderr: Option<f64>, source: CovarianceSource| {
+        sources.push(source);
         let name = names.get(params.len()).cloned().unwrap_or_default();
         params.push(Param {
             name,
@@ -453,7 +459,7 @@ pub fn fit(
     };
     let at = |i: usize| e.params.get(i).copied().unwrap_or(f64::NAN);
     for i in 0..ns {
-        push(at(i), se(i));
+        push(at(i), se(i), Some((i, 1.0)));
     }
     if let Some(n) = e.n {
         let a = at(ns);
@@ -461,22 +467,27 @@ pub fn fit(
         let k = uniform_sum_with_std(1.0)(i64::from(n))
             .map_err(|e| e.to_string())?
             .params()[0];
-        push(f64::from(n), None);
-        push(a, se(ns));
-        push(a / k, se(ns).map(|s| s / k));
+        push(f64::from(n), None, None);
+        push(a, se(ns), Some((ns, 1.0)));
+        push(a / k, se(ns).map(|s| s / k), Some((ns, 1.0 / k)));
     } else {
         for i in ns..ns + nj {
-            push(at(i), se(i));
+            push(at(i), se(i), Some((i, 1.0)));
         }
     }
     for i in ns + nj..ns + nj + nn {
-        push(at(i), se(i));
+        push(at(i), se(i), Some((i, 1.0)));
     }
     if exp.noise.estimate {
         // A likelihood estimates σ_v jointly (the last parameter); the least-squares criteria
         // estimate it from the residuals afterwards (no standard error).
         let joint = e.params.len() > ns + nj + nn;
-        push(e.noise_std, if joint { se(ns + nj + nn) } else { None });
+        let last = ns + nj + nn;
+        push(
+            e.noise_std,
+            if joint { se(last) } else { None },
+            joint.then_some((last, 1.0)),
+        );
     }
     Ok(Fit {
         method,
@@ -485,10 +496,14 @@ pub fn fit(
         iterations: e.iterations,
         termination: e.termination,
         noise_std: e.noise_std,
+        covariance: e
+            .covariance
+            .as_deref()
+            .map(|c| reported_covariance(c, &sources)),
         params,
         fitted: e.fitted,
         estimated: e.names,
-        covariance: e.covariance,
+        estimator_covariance: e.covariance,
     })
 }
 

@@ -11,6 +11,7 @@ pub mod csvio;
 pub mod error;
 pub mod exit;
 pub mod experiment;
+pub mod export;
 pub mod fingerprint;
 pub mod fitting;
 pub mod inputs;

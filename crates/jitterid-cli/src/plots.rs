@@ -2,15 +2,13 @@
 
 use crate::error::CliResult;
 use crate::experiment::Experiment;
+use crate::export;
 use crate::fitting::Structure;
 use crate::svg::{self, figure, Panel, Series, Style, BLACK, BLUE, GREEN, GREY, ORANGE, RED};
 use jitterid::jitter::AnyJitter;
 use jitterid::jitter::{JitterModel, NoJitter};
 use jitterid::num_complex::Complex64;
-use jitterid::signal::registry::{SignalRegistry, SpecReader};
-use jitterid::signal::{
-    AnySignal, Input, RationalModel, SampleGrid, Signal, SignalError, TransferFunction, Zpk,
-};
+use jitterid::signal::{AnySignal, Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 
 /// `|X(f)|` of a sequence on the grid at the DFT frequencies (zero excluded).
@@ -54,26 +52,9 @@ fn log_band(grid: &SampleGrid) -> Vec<f64> {
 /// Points of a curve.
 type Curve = Vec<(f64, f64)>;
 
-/// `G(i2πf)` of a rational system (rebuilt from the signal's spec table), `None` for other
-/// signals.
+/// `G(i2πf)` of a rational system, `None` for other signals.
 fn frequency_response(signal: &AnySignal, f: f64) -> Option<Complex64> {
-    let spec = signal.spec();
-    let kind = SignalRegistry::builtin().kind(signal.kind())?;
-    let rebuilt = || -> Result<Option<Complex64>, SignalError> {
-        let r = SpecReader::new(kind, &spec)?;
-        Ok(match signal.kind() {
-            "zpk" => Some(
-                Zpk::new(r.f64("gain")?, r.roots("zeros")?, r.roots("poles")?)?
-                    .frequency_response(f),
-            ),
-            "tf" => Some(
-                TransferFunction::new(&r.f64_list("num")?, &r.f64_list("den")?)?
-                    .frequency_response(f),
-            ),
-            _ => None,
-        })
-    };
-    rebuilt().ok().flatten()
+    export::tf_of(signal).map(|tf| tf.response(Complex64::new(0.0, std::f64::consts::TAU * f)))
 }
 
 /// Magnitude and unwrapped phase (degrees) of `G(i2πf)`.

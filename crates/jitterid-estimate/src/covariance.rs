@@ -44,16 +44,18 @@ where
     C: Criterion + ?Sized,
     W: Window,
 {
-    let (gram, meat, noise_var) = sandwich_parts(data, model, criterion);
+    let (gram, meat, noise_var) = sandwich_parts(data, model, criterion, known);
     sandwich_of(&gram, &meat, held, noise_var)
 }
 
 /// The bread `JᵀJ`, the meat `Jᵀ Σ_r J` and the noise variance of one record's sandwich: the
-/// parts that sum over the records of a joint fit.
+/// parts that sum over the records of a joint fit. `known` are the time-domain sensitivities at
+/// `model`, when already computed.
 pub(crate) fn sandwich_parts<S, J, N, C, W>(
     data: &FrequencyData<W>,
     model: &ModelStructure<S, J, N>,
     criterion: &C,
+    known: Option<Vec<Vec<f64>>>,
 ) -> (Mat<f64>, Mat<f64>, f64)
 where
     S: Signal + Clone,

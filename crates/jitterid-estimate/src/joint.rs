@@ -232,11 +232,7 @@ where
         parts: structures
             .iter()
             .zip(&data)
-            .map(|(structure, data)| FitProblem {
-                structure,
-                criterion,
-                data,
-            })
+            .map(|(structure, data)| FitProblem::new(structure, criterion, data))
             .collect(),
         scales: records.iter().map(|r| 1.0 / r.y().len() as f64).collect(),
     };
@@ -266,7 +262,7 @@ where
         let mut meat = Mat::zeros(p, p);
         let mut noise_var = 0.0;
         for ((d, s), &c) in data.iter().zip(&fitted).zip(&problem.scales) {
-            let (g, m, v) = sandwich_parts(d, s, criterion);
+            let (g, m, v) = sandwich_parts(d, s, criterion, None);
             // r scaled by √c: JᵀJ by c, Jᵀ Σ_r J by c² (J on both sides and Σ_r).
             gram = &gram + &scaled(&g, c);
             meat = &meat + &scaled(&m, c * c);

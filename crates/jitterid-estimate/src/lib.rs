@@ -75,6 +75,7 @@ pub mod registry;
 mod result;
 pub mod solver;
 mod structure;
+pub mod validation;
 
 pub use any_criterion::{AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions};
 pub use any_noise::{AnyNoise, DynNoise, NoiseEntry, NoiseRegistry};

@@ -164,6 +164,16 @@ pub enum SignalError {
         /// The kind.
         kind: String,
     },
+    /// A complex root listed without its conjugate (real coefficients need pairs).
+    #[error("{name} {re}{im:+}i has no complex-conjugate partner in the list")]
+    Unpaired {
+        /// Which list.
+        name: &'static str,
+        /// Real part.
+        re: f64,
+        /// Imaginary part.
+        im: f64,
+    },
     /// The roots of a polynomial could not be found to the required accuracy.
     #[error("could not find the roots of `{name}`")]
     Roots {

@@ -25,6 +25,9 @@
 //! * Inputs: [`PiecewiseConstant`] (and [`RandomBinary`], the paper's input, and zero-order
 //!   hold), [`Multisine`].
 //!
+//! * [`forms`]: plain transfer-function, zero-pole-gain and state-space forms of a model, with
+//!   conversions and readable display, for export.
+//!
 //! The exact jittered simulator [`simulate`] draws `y_k = s(t_k + τ_k) + v_k`.
 #![warn(missing_docs)]
 
@@ -32,6 +35,7 @@ mod any;
 mod augmented;
 mod error;
 mod expm;
+pub mod forms;
 mod grid;
 mod input;
 mod lti;

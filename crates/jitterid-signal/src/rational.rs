@@ -373,37 +373,8 @@ impl TransferFunction {
     }
 
     fn build(num: &[f64], den: &[f64], allow_unstable: bool) -> Result<Self, SignalError> {
-        all_finite("num", num)?;
-        all_finite("den", den)?;
-        if num.is_empty() {
-            return Err(SignalError::TooFew {
-                name: "num",
-                min: 1,
-                value: 0,
-            });
-        }
-        if den.len() < 2 {
-            return Err(SignalError::TooFew {
-                name: "den",
-                min: 2,
-                value: den.len(),
-            });
-        }
-        let lead = den[0];
-        if lead == 0.0 {
-            return Err(SignalError::ZeroLeading { name: "den" });
-        }
-        let first_nonzero = num.iter().position(|&c| c != 0.0).unwrap_or(num.len() - 1);
-        let degree = num.len() - 1 - first_nonzero;
-        if degree > den.len() - 1 {
-            return Err(SignalError::Improper {
-                zeros: degree,
-                poles: den.len() - 1,
-            });
-        }
-        let num: Vec<f64> = num[first_nonzero..].iter().map(|c| c / lead).collect();
-        let den: Vec<f64> = den.iter().map(|c| c / lead).collect();
-        Self::from_monic(num, den, allow_unstable)
+        let form = crate::forms::TfForm::new(num, den)?;
+        Self::from_monic(form.num().to_vec(), form.den().to_vec(), allow_unstable)
     }
 
     /// As [`new`](Self::new), but unstable poles are accepted, here and in
