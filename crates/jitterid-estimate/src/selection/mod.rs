@@ -221,7 +221,7 @@ fn fit_candidate(
             .cloned()
             .zip(fit.params.iter().copied())
             .collect(),
-        failure: (!fit.converged).then(|| format!("{:?}", fit.termination)),
+        failure: (!fit.converged).then(|| fit.termination.to_string()),
     }
 }
 
