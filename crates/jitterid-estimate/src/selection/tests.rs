@@ -86,3 +86,25 @@ fn bad_grids_name_their_key() {
     };
     assert!(message.contains("gaussian"), "{message}");
 }
+
+#[test]
+fn ranking_is_identical_for_any_thread_count() {
+    let (record, input) = record();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            select(
+                &record,
+                &input,
+                &grid(&["none", "gaussian"]),
+                JitterRegistry::builtin(),
+                &SelectionOptions::default(),
+            )
+            .unwrap()
+        })
+    };
+    assert_eq!(run(1), run(3));
+}
