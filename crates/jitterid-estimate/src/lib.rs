@@ -73,6 +73,7 @@ mod parseval;
 mod profile;
 pub mod registry;
 mod result;
+pub mod selection;
 pub mod solver;
 mod structure;
 pub mod validation;

@@ -1,0 +1,263 @@
+//! Model-order and jitter-family selection.
+//!
+//! [`select`] fits every candidate of a [`SelectionGrid`] — a number of zeros and poles (a
+//! transfer function `N(s)/A(s)`, `A` monic) and a jitter family taken from a
+//! [`JitterRegistry`] by name, `"none"` included — with BCLS, each started by the data-driven
+//! initializer ([`crate::initial_model`]) and the jitter at a standard deviation of
+//! [`SelectionOptions::jitter_fraction`] `· T` through [`JitterRegistry::from_std_dev`].
+//!
+//! Candidates are ranked by the BIC of a Gaussian quasi-likelihood of the frequency-domain
+//! residuals: with independent samples the residual `D(f) = Y(f) − μ_Y(f)` has the same
+//! variance `Σ_k λ_k` at every frequency, even though the jittered samples are
+//! heteroscedastic in time, so one common variance is the right nuisance parameter and
+//! `N ln(cost) + k ln N` (with `k` the number of estimated parameters: gain, numerator and
+//! denominator coefficients, the jitter's free parameters) is, up to a constant shared by all
+//! candidates, `−2 log L + k ln N`. Candidates that fail are kept with their reason and ranked
+//! last.
+
+use jitterid_jitter::registry::JitterRegistry;
+use jitterid_signal::{Input, LtiResponse, TransferFunction};
+use rayon::prelude::*;
+
+use crate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
+
+/// A rectangular grid of candidate model orders and jitter families.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionGrid {
+    /// Inclusive range of the number of poles.
+    pub poles: (usize, usize),
+    /// Inclusive range of the number of zeros.
+    pub zeros: (usize, usize),
+    /// Jitter family names, as the registry knows them (`"none"` for no jitter).
+    pub families: Vec<String>,
+}
+
+/// Settings of [`select`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionOptions {
+    /// Starting jitter standard deviation as a fraction of the sampling interval `T`.
+    pub jitter_fraction: f64,
+}
+
+impl Default for SelectionOptions {
+    fn default() -> Self {
+        Self {
+            jitter_fraction: 0.2,
+        }
+    }
+}
+
+/// One fitted (or failed) candidate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// Number of poles.
+    pub poles: usize,
+    /// Number of zeros.
+    pub zeros: usize,
+    /// Jitter family name.
+    pub family: String,
+    /// The information criterion (BIC); `+∞` for a failed candidate.
+    pub criterion: f64,
+    /// Whether the fit converged.
+    pub converged: bool,
+    /// The estimated parameters by name (empty for a failed candidate).
+    pub parameters: Vec<(String, f64)>,
+    /// Why the candidate failed, if it did.
+    pub failure: Option<String>,
+}
+
+/// Why a selection could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SelectionError {
+    /// A key of the grid holds an invalid value.
+    #[error("select.{key}: {message}")]
+    InvalidKey {
+        /// The offending key.
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn invalid(key: &'static str, message: impl Into<String>) -> SelectionError {
+    SelectionError::InvalidKey {
+        key,
+        message: message.into(),
+    }
+}
+
+impl SelectionGrid {
+    /// The (poles, zeros, family) triples of the grid, rejecting bad input by key: an empty
+    /// range, no proper order (zeros > poles everywhere), an unknown family, more parameters
+    /// than the record of `len` samples supports.
+    ///
+    /// # Errors
+    ///
+    /// [`SelectionError::InvalidKey`] naming `poles`, `zeros` or `families`.
+    pub fn candidates(
+        &self,
+        registry: &JitterRegistry,
+        len: usize,
+    ) -> Result<Vec<(usize, usize, String)>, SelectionError> {
+        let (p0, p1) = self.poles;
+        let (z0, z1) = self.zeros;
+        if p0 == 0 || p0 > p1 {
+            return Err(invalid(
+                "poles",
+                format!("[{p0}, {p1}] must be 1 ≤ min ≤ max"),
+            ));
+        }
+        if z0 > z1 {
+            return Err(invalid("zeros", format!("[{z0}, {z1}] must be min ≤ max")));
+        }
+        if z0 > p1 {
+            return Err(invalid(
+                "zeros",
+                format!("at least {z0} zeros but at most {p1} poles: no proper model"),
+            ));
+        }
+        if self.families.is_empty() {
+            return Err(invalid("families", "the list is empty"));
+        }
+        let known: Vec<&str> = registry.families().map(|f| f.name()).collect();
+        for name in &self.families {
+            if !known.contains(&name.as_str()) {
+                return Err(invalid(
+                    "families",
+                    format!("unknown family {name:?}; known: {}", known.join(", ")),
+                ));
+            }
+        }
+        // Levy's linear fit needs 2n + m + 1 real equations from bins below N/2.
+        let needed = 2 * p1 + p1.min(z1) + 2;
+        if needed > len {
+            return Err(invalid(
+                "poles",
+                format!("{p1} poles need at least {needed} samples; the record has {len}"),
+            ));
+        }
+        let mut out = Vec::new();
+        for poles in p0..=p1 {
+            for zeros in z0..=z1.min(poles) {
+                for family in &self.families {
+                    out.push((poles, zeros, family.clone()));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Monic `(s+1)(s+2)…(s+n)`: a stable template of distinct poles (its values are ignored).
+fn template(zeros: usize, poles: usize) -> Result<TransferFunction, String> {
+    let mut den = vec![1.0];
+    for r in 1..=poles {
+        let mut next = vec![0.0; den.len() + 1];
+        for (i, c) in den.iter().enumerate() {
+            next[i] += c;
+            next[i + 1] += c * r as f64;
+        }
+        den = next;
+    }
+    TransferFunction::new(&vec![1.0; zeros + 1], &den).map_err(|e| e.to_string())
+}
+
+fn fit_candidate(
+    record: &Record,
+    input: &Input,
+    registry: &JitterRegistry,
+    options: &SelectionOptions,
+    (poles, zeros, family): (usize, usize, String),
+) -> Candidate {
+    let failed = |reason: String| Candidate {
+        poles,
+        zeros,
+        family: family.clone(),
+        criterion: f64::INFINITY,
+        converged: false,
+        parameters: Vec::new(),
+        failure: Some(reason),
+    };
+    let sigma = options.jitter_fraction * record.grid().interval();
+    let jitter = match registry.from_std_dev(&family, sigma, &serde_json::Map::new()) {
+        Ok(j) => j,
+        Err(e) => return failed(format!("jitter start: {e}")),
+    };
+    let model = match template(zeros, poles) {
+        Ok(m) => m,
+        Err(e) => return failed(format!("template: {e}")),
+    };
+    let signal = LtiResponse::new(model, input.clone());
+    let structure = if family == "none" {
+        ModelStructure::oe(signal, jitter)
+    } else {
+        ModelStructure::joe(signal, jitter)
+    };
+    let structure = match initialize(&structure, record, &InitOptions::default()) {
+        Ok(s) => s,
+        Err(e) => return failed(format!("initializer: {e}")),
+    };
+    let fit = match estimate(&structure, record, &Bcls, &EstimateOptions::default()) {
+        Ok(f) => f,
+        Err(e) => return failed(format!("fit: {e}")),
+    };
+    let n = record.y().len() as f64;
+    let k = fit.params.len() as f64;
+    let criterion = if fit.cost > 0.0 && fit.cost.is_finite() {
+        n * fit.cost.ln() + k * n.ln()
+    } else {
+        return failed(format!("cost {} is not positive and finite", fit.cost));
+    };
+    Candidate {
+        poles,
+        zeros,
+        family,
+        criterion,
+        converged: fit.converged,
+        parameters: fit
+            .names
+            .iter()
+            .cloned()
+            .zip(fit.params.iter().copied())
+            .collect(),
+        failure: (!fit.converged).then(|| fit.termination.to_string()),
+    }
+}
+
+/// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first:
+/// converged candidates by increasing criterion, then the failed ones. Candidates are fitted in
+/// parallel; the order is deterministic (ties broken by grid order).
+///
+/// # Errors
+///
+/// Those of [`SelectionGrid::candidates`].
+pub fn select(
+    record: &Record,
+    input: &Input,
+    grid: &SelectionGrid,
+    registry: &JitterRegistry,
+    options: &SelectionOptions,
+) -> Result<Vec<Candidate>, SelectionError> {
+    if !(options.jitter_fraction.is_finite() && options.jitter_fraction > 0.0) {
+        return Err(invalid(
+            "jitter_fraction",
+            format!("{} must be positive and finite", options.jitter_fraction),
+        ));
+    }
+    let list = grid.candidates(registry, record.y().len())?;
+    let mut out: Vec<Candidate> = list
+        .into_par_iter()
+        .map(|c| fit_candidate(record, input, registry, options, c))
+        .collect();
+    // A stable sort keeps grid order among equal keys: deterministic for any thread count.
+    out.sort_by(|a, b| {
+        (!a.converged)
+            .cmp(&!b.converged)
+            .then(a.criterion.total_cmp(&b.criterion))
+    });
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,110 @@
+use super::*;
+use jitterid_jitter::NoJitter;
+use jitterid_signal::{simulate, RandomBinary, Root, SampleGrid, Zpk};
+use rand::SeedableRng;
+
+/// The paper's Table 2 system (2 poles, 1 zero), no jitter, noise 0.01, N = 200, seed 7.
+fn record() -> (Record, Input) {
+    let truth = Zpk::new(
+        0.2,
+        vec![Root::Real(-0.5)],
+        vec![Root::Pair { re: -0.25, im: 0.3 }],
+    )
+    .unwrap();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let u = RandomBinary::paper()
+        .generate(0.0, 200.0, &mut rng)
+        .unwrap();
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let data = simulate(
+        &LtiResponse::new(truth, u.clone()),
+        &NoJitter,
+        &grid,
+        0.01,
+        &mut rng,
+    )
+    .unwrap();
+    (Record::new(grid, data.y).unwrap(), u.into())
+}
+
+fn grid(families: &[&str]) -> SelectionGrid {
+    SelectionGrid {
+        poles: (1, 2),
+        zeros: (0, 1),
+        families: families.iter().map(|s| s.to_string()).collect(),
+    }
+}
+
+#[test]
+fn picks_the_true_order_on_one_record() {
+    let (record, input) = record();
+    let ranked = select(
+        &record,
+        &input,
+        &grid(&["none", "gaussian"]),
+        JitterRegistry::builtin(),
+        &SelectionOptions::default(),
+    )
+    .unwrap();
+    // (1 or 2 poles) × (0 or 1 zero) × 2 families.
+    assert_eq!(ranked.len(), 8);
+    let best = &ranked[0];
+    assert!(best.converged);
+    assert_eq!(
+        (best.poles, best.zeros, best.family.as_str()),
+        (2, 1, "none")
+    );
+    // Ranked: converged by increasing criterion, failures last.
+    for w in ranked.windows(2) {
+        assert!(!w[0].converged || !w[1].converged || w[0].criterion <= w[1].criterion);
+        assert!(w[0].converged || !w[1].converged);
+    }
+}
+
+#[test]
+fn bad_grids_name_their_key() {
+    let registry = JitterRegistry::builtin();
+    let key = |g: SelectionGrid| match g.candidates(registry, 200) {
+        Err(SelectionError::InvalidKey { key, .. }) => key,
+        Ok(_) => "accepted",
+    };
+    let mut g = grid(&["none"]);
+    g.poles = (3, 2);
+    assert_eq!(key(g), "poles");
+    let mut g = grid(&["none"]);
+    g.zeros = (3, 4);
+    assert_eq!(key(g), "zeros");
+    assert_eq!(key(grid(&[])), "families");
+    assert_eq!(key(grid(&["cauchy-ish"])), "families");
+    let mut g = grid(&["none"]);
+    g.poles = (1, 150);
+    assert_eq!(key(g), "poles");
+    let Err(SelectionError::InvalidKey { message, .. }) =
+        grid(&["bogus"]).candidates(registry, 200)
+    else {
+        panic!("accepted an unknown family")
+    };
+    assert!(message.contains("gaussian"), "{message}");
+}
+
+#[test]
+fn ranking_is_identical_for_any_thread_count() {
+    let (record, input) = record();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            select(
+                &record,
+                &input,
+                &grid(&["none", "gaussian"]),
+                JitterRegistry::builtin(),
+                &SelectionOptions::default(),
+            )
+            .unwrap()
+        })
+    };
+    assert_eq!(run(1), run(3));
+}
