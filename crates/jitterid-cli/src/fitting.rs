@@ -17,7 +17,7 @@ use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
 use jitterid::signal::registry::{roots_json, SignalRegistry};
-use jitterid::signal::{simulate, AnySignal, Input, RationalModel, SampleGrid, Signal};
+use jitterid::signal::{simulate, AnySignal, Input, SampleGrid, Signal};
 use serde_json::{json, Map, Value};
 
 /// The uniform-sum jitter with `n + 1` terms and standard deviation `sigma`, through the
@@ -42,13 +42,11 @@ pub fn signal_of(kind: &SystemKind, input: Option<&Input>) -> CliResult<AnySigna
             ("gain", json!(z.gain())),
             ("zeros", roots_json(z.zeros())),
             ("poles", roots_json(z.poles())),
-            ("allow_unstable", json!(z.rational().allows_unstable())),
         ],
         SystemKind::Tf(t) => vec![
             ("kind", json!("tf")),
             ("num", json!(t.num())),
             ("den", json!(t.den())),
-            ("allow_unstable", json!(t.rational().allows_unstable())),
         ],
         SystemKind::Sinusoid(s) => vec![
             ("kind", json!("sinusoid")),

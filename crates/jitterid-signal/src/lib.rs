@@ -32,9 +32,7 @@
 #![warn(missing_docs)]
 
 mod any;
-mod augmented;
 mod error;
-mod expm;
 pub mod forms;
 mod grid;
 mod input;

@@ -1,10 +1,9 @@
 //! The exact response of a rational model to a known input, and its exact jittered moments.
 
-use crate::augmented::Augmented;
 use crate::input::Input;
 use crate::rational::{Modal, RationalModel};
 use crate::reach::{InReach, Route, SquaresRule};
-use crate::signal::{quadrature, Jacobian, Signal};
+use crate::signal::{Jacobian, Signal};
 use crate::spectrum::{SpectralLine, Spectrum};
 use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
@@ -46,21 +45,7 @@ pub struct LtiResponse<M> {
     /// The modal state right after every step, so that `s(t)` and its gradient cost
     /// `O(log J + poles)`. Built on the first evaluation in time: estimation never needs it.
     prefix: OnceLock<Prefix>,
-    /// The matrix-exponential route, for a model without an accurate modal form.
-    augmented: Option<Augmented>,
 }
-
-/// The modal form of a model that has none, so that the modal route's helpers stay total; the
-/// entry points send such a model to [`Augmented`] before any of them runs.
-static NO_MODES: Modal = Modal {
-    direct: 0.0,
-    poles: Vec::new(),
-    residues: Vec::new(),
-    dc_gain: 0.0,
-    d_poles: Vec::new(),
-    d_residues: Vec::new(),
-    d_dc_gain: Vec::new(),
-};
 
 impl<M: RationalModel> LtiResponse<M> {
     /// The response of `model` to `input`.
@@ -70,16 +55,11 @@ impl<M: RationalModel> LtiResponse<M> {
             Input::Piecewise(p) => p.steps(),
             Input::Tones(_) => Vec::new(),
         };
-        let augmented = match model.modal() {
-            Some(_) => None,
-            None => Some(Augmented::new(model.rational())),
-        };
         Self {
             model,
             input,
             steps,
             prefix: OnceLock::new(),
-            augmented,
         }
     }
 
@@ -125,10 +105,9 @@ impl<M: RationalModel> LtiResponse<M> {
     /// `s(t) = G(0) u(t) + Σ_i w_i Re((r_i/p_i) x_i(t))` (`w_i = 2` for a pair, 1 for a real pole).
     ///
     /// `O(log J + poles)` per instant, from states tabulated once per model at the input's
-    /// steps. `None` for a tone input (whose response is a closed form in `t`) and for a model
-    /// without an accurate modal form ([`RationalModel::modal`] is `None`).
+    /// steps. `None` for a tone input (whose response is a closed form in `t`).
     pub fn state(&self, t: f64) -> Option<ModalState> {
-        let (Input::Piecewise(_), None) = (&self.input, &self.augmented) else {
+        let Input::Piecewise(_) = self.input else {
             return None;
         };
         let reps = self.representatives();
@@ -163,9 +142,6 @@ impl<M: RationalModel> LtiResponse<M> {
     /// piecewise-constant input: what a composite model (a static nonlinearity of this response)
     /// needs at each instant.
     pub fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
-        if let (Input::Piecewise(_), Some(a)) = (&self.input, &self.augmented) {
-            return a.value_and_gradient(&self.steps, t, grad);
-        }
         let Some(state) = self.state(t) else {
             self.value_gradient(t, grad);
             return self.value(t);
@@ -208,7 +184,7 @@ impl<M: RationalModel> LtiResponse<M> {
     }
 
     fn modal(&self) -> &Modal {
-        self.model.modal().unwrap_or(&NO_MODES)
+        self.model.modal()
     }
 
     /// One representative per conjugate pair (upper half plane) and each real pole, with its
@@ -623,17 +599,11 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        let model = self.model.with_params(params)?;
-        let augmented = match model.modal() {
-            Some(_) => None,
-            None => Some(Augmented::new(model.rational())),
-        };
         Ok(Self {
-            model,
+            model: self.model.with_params(params)?,
             input: self.input.clone(),
             steps: self.steps.clone(),
             prefix: OnceLock::new(),
-            augmented,
         })
     }
 
@@ -648,9 +618,6 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                 })
                 .sum(),
             Input::Piecewise(_) => {
-                if let Some(a) = &self.augmented {
-                    return a.value(&self.steps, t);
-                }
                 let j = self.steps.partition_point(|s| s.0 <= t);
                 if j == 0 {
                     return 0.0;
@@ -695,7 +662,7 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     }
 
     fn rate(&self) -> f64 {
-        let poles = self.model.rational().poles().iter().map(|p| p.norm());
+        let poles = self.modal().poles.iter().map(|p| p.norm());
         let tones = match &self.input {
             Input::Tones(m) => m.tones().iter().map(|c| TAU * c.frequency).collect(),
             Input::Piecewise(_) => Vec::new(),
@@ -704,19 +671,15 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     }
 
     fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
-        match (&self.input, &self.augmented) {
-            (Input::Tones(_), _) => self.tones_squares(grid, jitter),
-            (Input::Piecewise(_), Some(_)) => quadrature::expected_squares(self, grid, jitter),
-            (Input::Piecewise(_), None) => self.piecewise_squares(grid, jitter),
+        match self.input {
+            Input::Tones(_) => self.tones_squares(grid, jitter),
+            Input::Piecewise(_) => self.piecewise_squares(grid, jitter),
         }
     }
 
     fn expected_values(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
         if let Input::Tones(_) = self.input {
             return self.tones_expectation(grid, jitter, None);
-        }
-        if self.augmented.is_some() {
-            return quadrature::expected_values(self, grid, jitter);
         }
         let m = self.modal();
         let reps = self.representatives();
@@ -735,9 +698,6 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
             self.tones_expectation(grid, jitter, Some(&mut cols));
             return cols;
         }
-        if self.augmented.is_some() {
-            return quadrature::expected_values_gradient(self, grid, jitter);
-        }
         let m = self.modal();
         let reps = self.representatives();
         let terms = gradient_terms(m, &reps, np);
@@ -753,7 +713,7 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         grid: &SampleGrid,
         jitter: &dyn JitterModel,
     ) -> (Vec<f64>, Jacobian) {
-        if matches!(self.input, Input::Tones(_)) || self.augmented.is_some() {
+        if let Input::Tones(_) = self.input {
             return (
                 self.expected_values(grid, jitter),
                 self.expected_values_gradient(grid, jitter),
@@ -952,7 +912,7 @@ mod tests {
     }
 
     fn parts_of<M: RationalModel>(s: &LtiResponse<M>) -> (Vec<Complex64>, Vec<Complex64>) {
-        let m = s.model().modal().unwrap();
+        let m = s.modal();
         let reps = s.representatives();
         (
             reps.iter().map(|&(i, _)| m.poles[i]).collect(),

@@ -55,12 +55,33 @@ pub trait Signal: fmt::Debug + Send + Sync {
 
     /// `m_k = E[s(t_k + τ)]` for every requested instant.
     fn expected_values(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
-        quadrature::expected_values(self, grid, jitter)
+        let breaks = self.breakpoints();
+        let (lo, hi) = jitter.reach();
+        grid.times()
+            .map(|t| {
+                let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), self.rate());
+                rule.expect(|tau| self.value(t + tau))
+            })
+            .collect()
     }
 
     /// `∂m_k/∂θ_j` as columns, one per parameter.
     fn expected_values_gradient(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Jacobian {
-        quadrature::expected_values_gradient(self, grid, jitter)
+        let p = self.num_params();
+        let mut cols = vec![vec![0.0; grid.len()]; p];
+        let breaks = self.breakpoints();
+        let (lo, hi) = jitter.reach();
+        let mut g = vec![0.0; p];
+        for (k, t) in grid.times().enumerate() {
+            let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), self.rate());
+            for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                self.value_gradient(t + tau, &mut g);
+                for (col, gj) in cols.iter_mut().zip(&g) {
+                    col[k] += w * gj;
+                }
+            }
+        }
+        cols
     }
 
     /// `m_k` and `∂m_k/∂θ_j` together: one pass over the jitter's expectations where a model
@@ -81,67 +102,12 @@ pub trait Signal: fmt::Debug + Send + Sync {
     /// `E[s(t_k + τ)²]` for every requested instant (for the second moment
     /// `Var y_k = σ_v² + E[s(t_k+τ)²] − m_k²`).
     fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
-        quadrature::expected_squares(self, grid, jitter)
-    }
-}
-
-/// The provided expectations of [`Signal`], callable by a model that overrides them for some
-/// of its cases only.
-pub(crate) mod quadrature {
-    use super::{local_breaks, Jacobian, SampleGrid, Signal};
-    use jitterid_jitter::JitterModel;
-
-    /// `m_k` by the jitter's rule cut at the signal's breakpoints.
-    pub(crate) fn expected_values<S: Signal + ?Sized>(
-        signal: &S,
-        grid: &SampleGrid,
-        jitter: &dyn JitterModel,
-    ) -> Vec<f64> {
-        let breaks = signal.breakpoints();
+        let breaks = self.breakpoints();
         let (lo, hi) = jitter.reach();
         grid.times()
             .map(|t| {
-                let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), signal.rate());
-                rule.expect(|tau| signal.value(t + tau))
-            })
-            .collect()
-    }
-
-    /// `∂m_k/∂θ_j` by the same rule.
-    pub(crate) fn expected_values_gradient<S: Signal + ?Sized>(
-        signal: &S,
-        grid: &SampleGrid,
-        jitter: &dyn JitterModel,
-    ) -> Jacobian {
-        let p = signal.num_params();
-        let mut cols = vec![vec![0.0; grid.len()]; p];
-        let breaks = signal.breakpoints();
-        let (lo, hi) = jitter.reach();
-        let mut g = vec![0.0; p];
-        for (k, t) in grid.times().enumerate() {
-            let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), signal.rate());
-            for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
-                signal.value_gradient(t + tau, &mut g);
-                for (col, gj) in cols.iter_mut().zip(&g) {
-                    col[k] += w * gj;
-                }
-            }
-        }
-        cols
-    }
-
-    /// `E[s(t_k + τ)²]` by the rule refined for the square's doubled rate.
-    pub(crate) fn expected_squares<S: Signal + ?Sized>(
-        signal: &S,
-        grid: &SampleGrid,
-        jitter: &dyn JitterModel,
-    ) -> Vec<f64> {
-        let breaks = signal.breakpoints();
-        let (lo, hi) = jitter.reach();
-        grid.times()
-            .map(|t| {
-                let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), 2.0 * signal.rate());
-                rule.expect(|tau| signal.value(t + tau).powi(2))
+                let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), 2.0 * self.rate());
+                rule.expect(|tau| self.value(t + tau).powi(2))
             })
             .collect()
     }

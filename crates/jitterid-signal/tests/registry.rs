@@ -68,7 +68,7 @@ fn bad_tables_name_the_key() {
             "poles",
         ),
         (
-            json!({"kind": "zpk", "gain": 1.0, "poles": [-1.0, 0.5]}),
+            json!({"kind": "zpk", "gain": 1.0, "poles": [-1.0, -1.0]}),
             "poles",
         ),
         (json!({"kind": "zpk", "gain": "x", "poles": [-1.0]}), "gain"),

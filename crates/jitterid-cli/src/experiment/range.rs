@@ -136,31 +136,9 @@ pub(super) fn root_moduli(roots: &[Root]) -> Vec<f64> {
 }
 
 /// A rational system's poles in range and its step response representable: every mode's
-/// contribution `|r_i/p_i|` and the feed-through at most [`MAX_LEVEL`]. A model without a
-/// modal form (repeated poles, integrators: its response goes through the matrix exponential,
-/// with no cancellation) is held to its coefficients instead, and its poles slower than the
-/// record are integrators over it, which that route computes exactly.
+/// contribution `|r_i/p_i|` and the feed-through at most [`MAX_LEVEL`].
 pub(super) fn response<M: RationalModel>(m: &M, grid: &SampleGrid) -> Result<(), String> {
-    let Some(modal) = m.modal() else {
-        let r = m.rational();
-        let slow = MIN_POLE_NT / grid.duration();
-        poles(
-            r.poles().iter().map(|p| p.norm()).filter(|&m| m >= slow),
-            grid,
-        )?;
-        let worst = r
-            .num()
-            .iter()
-            .chain(r.den())
-            .fold(0.0f64, |a, c| a.max(c.abs()));
-        return if worst <= MAX_LEVEL {
-            Ok(())
-        } else {
-            Err(format!(
-                "the system's coefficients reach {worst:e}, beyond the representable {MAX_LEVEL:e}"
-            ))
-        };
-    };
+    let modal = m.modal();
     poles(modal.poles.iter().map(|p| p.norm()), grid)?;
     let worst = modal
         .residues

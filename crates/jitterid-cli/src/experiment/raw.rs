@@ -66,7 +66,6 @@ section!(RawSystem, "table [system]" {
     frequency: f64,
     phase: f64,
     estimate: bool,
-    allow_unstable: bool,
 });
 
 section!(RawNoise, "table [noise]" {

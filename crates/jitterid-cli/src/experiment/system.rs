@@ -16,15 +16,8 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
     let name = kind.get_ref().as_str();
     let allowed: &[&str] = match name {
-        "zpk" => &[
-            "kind",
-            "gain",
-            "zeros",
-            "poles",
-            "estimate",
-            "allow_unstable",
-        ],
-        "tf" => &["kind", "num", "den", "estimate", "allow_unstable"],
+        "zpk" => &["kind", "gain", "zeros", "poles", "estimate"],
+        "tf" => &["kind", "num", "den", "estimate"],
         "sinusoid" => &["kind", "amplitude", "frequency", "phase", "estimate"],
         other => {
             return Err(cx.err(
@@ -45,12 +38,6 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
     Ok(SystemSpec { kind, estimate })
 }
 
-/// `allow_unstable = true`: unstable poles accepted, in the truth and during a search (an
-/// integrator being estimated must be free to cross the imaginary axis).
-fn allows_unstable(r: &RawSystem) -> bool {
-    r.allow_unstable.as_ref().is_some_and(|a| *a.get_ref())
-}
-
 fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
     let why = "kind = \"zpk\" needs gain, poles and optionally zeros";
     let g = cx.required(S, "gain", &r.gain, why)?;
@@ -66,12 +53,7 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
         }
         None => Vec::new(),
     };
-    let zpk = if allows_unstable(r) {
-        Zpk::new_allowing_unstable(gain, zeros, poles)
-    } else {
-        Zpk::new(gain, zeros, poles)
-    }
-    .map_err(|e| cx.err(S, "poles", &p.span(), e))?;
+    let zpk = Zpk::new(gain, zeros, poles).map_err(|e| cx.err(S, "poles", &p.span(), e))?;
     range::response(&zpk, grid).map_err(|m| cx.err(S, "gain", &g.span(), m))?;
     Ok(SystemKind::Zpk(zpk))
 }
@@ -82,12 +64,7 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
     let d = cx.required(S, "den", &r.den, why)?;
     let num = cx.finite_list(S, "num", n)?;
     let den = cx.finite_list(S, "den", d)?;
-    let tf = if allows_unstable(r) {
-        TransferFunction::new_allowing_unstable(&num, &den)
-    } else {
-        TransferFunction::new(&num, &den)
-    }
-    .map_err(|e| cx.err(S, "den", &d.span(), e))?;
+    let tf = TransferFunction::new(&num, &den).map_err(|e| cx.err(S, "den", &d.span(), e))?;
     range::response(&tf, grid).map_err(|m| cx.err(S, "den", &d.span(), m))?;
     if tf.num().iter().all(|b| *b == 0.0) {
         return Err(cx.err(

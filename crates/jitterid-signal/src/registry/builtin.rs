@@ -2,8 +2,8 @@
 
 use super::{ParamSpec, SignalKind, SignalRegistry, Spec, SpecReader};
 use crate::{
-    AnySignal, Input, LtiResponse, PulseResponse, RationalModel, Root, SignalError, Sinusoid,
-    TransferFunction, Zpk,
+    AnySignal, Input, LtiResponse, PulseResponse, Root, SignalError, Sinusoid, TransferFunction,
+    Zpk,
 };
 use serde_json::{json, Value};
 
@@ -68,9 +68,8 @@ fn zpk() -> SignalKind {
                 "poles",
                 "poles: a number (real) or [re, im] (the pair re ± i·im)",
                 "rad/s",
-                "at least one; real part ≤ 0 (repeats allowed), im > 0",
+                "at least one; real part < 0, distinct, im > 0",
             ),
-            allow_unstable_spec(),
         ],
         true,
         |r: &SpecReader<'_>, input| {
@@ -81,12 +80,7 @@ fn zpk() -> SignalKind {
                 ("pole", "poles"),
                 ("poles", "poles"),
             ];
-            let g = if r.flag(ALLOW_UNSTABLE)? {
-                Zpk::new_allowing_unstable(gain, zeros, poles)
-            } else {
-                Zpk::new(gain, zeros, poles)
-            }
-            .map_err(|e| {
+            let g = Zpk::new(gain, zeros, poles).map_err(|e| {
                 let fallback = if matches!(e, SignalError::Improper { .. }) {
                     "zeros"
                 } else {
@@ -99,30 +93,14 @@ fn zpk() -> SignalKind {
                 LtiResponse::new(g, input_of(input)?),
                 |s: &LtiResponse<Zpk>| {
                     let g = s.model();
-                    let mut out = spec([
+                    spec([
                         ("gain", json!(g.gain())),
                         ("zeros", roots_json(g.zeros())),
                         ("poles", roots_json(g.poles())),
-                    ]);
-                    if g.rational().allows_unstable() {
-                        out.insert(ALLOW_UNSTABLE.into(), json!(true));
-                    }
-                    out
+                    ])
                 },
             ))
         },
-    )
-}
-
-/// The key of the opt-in to unstable poles of the rational kinds.
-const ALLOW_UNSTABLE: &str = "allow_unstable";
-
-fn allow_unstable_spec() -> ParamSpec {
-    ParamSpec::new(
-        ALLOW_UNSTABLE,
-        "accept unstable poles, in this model and during a search (an integrator being estimated may cross the imaginary axis)",
-        "",
-        "optional; true or false (default false)",
     )
 }
 
@@ -141,20 +119,14 @@ fn tf() -> SignalKind {
                 "den",
                 "denominator coefficients, highest power first (normalised to monic)",
                 "",
-                "finite, leading ≠ 0, poles stable or marginally stable (repeats allowed)",
+                "finite, leading ≠ 0, stable distinct poles",
             ),
-            allow_unstable_spec(),
         ],
         true,
         |r: &SpecReader<'_>, input| {
             let (num, den) = (r.f64_list("num")?, r.f64_list("den")?);
             let keys = [("num", "num"), ("den", "den")];
-            let g = if r.flag(ALLOW_UNSTABLE)? {
-                TransferFunction::new_allowing_unstable(&num, &den)
-            } else {
-                TransferFunction::new(&num, &den)
-            }
-            .map_err(|e| {
+            let g = TransferFunction::new(&num, &den).map_err(|e| {
                 let fallback = if matches!(e, SignalError::Improper { .. }) {
                     "num"
                 } else {
@@ -166,14 +138,10 @@ fn tf() -> SignalKind {
                 "tf",
                 LtiResponse::new(g, input_of(input)?),
                 |s: &LtiResponse<TransferFunction>| {
-                    let mut out = spec([
+                    spec([
                         ("num", json!(s.model().num())),
                         ("den", json!(s.model().den())),
-                    ]);
-                    if s.model().rational().allows_unstable() {
-                        out.insert(ALLOW_UNSTABLE.into(), json!(true));
-                    }
-                    out
+                    ])
                 },
             ))
         },
