@@ -25,7 +25,7 @@ class FitResult:
     uniform-sum ``n`` and its ``σ``, a noise level estimated from the residuals).
     """
 
-    _EXTRA = ("model", "estimated", "covariance")
+    _EXTRA = ("fitted_model", "estimated", "estimator_covariance")
 
     def __init__(self, data: Dict[str, Any]) -> None:
         self._data = data
@@ -41,10 +41,10 @@ class FitResult:
         self.std_errors: np.ndarray = np.array(
             [np.nan if p["stderr"] is None else p["stderr"] for p in params], dtype=float
         )
-        cov = data.get("covariance")
+        cov = data.get("estimator_covariance")
         self.covariance_names: List[str] = list(data.get("estimated", []))
         self.covariance: Optional[np.ndarray] = None if cov is None else np.array(cov, dtype=float)
-        self.model: Dict[str, Any] = data["model"]
+        self.model: Dict[str, Any] = data["fitted_model"]
 
     @property
     def jitter(self):

@@ -246,9 +246,9 @@ impl Experiment {
         let fit = fit.map_err(value_error)?;
         json_text(&FitOut {
             cli: commands::fit_json(&fit),
-            model: Model::of(&fit.fitted),
+            fitted_model: Model::of(&fit.fitted),
             estimated: &fit.estimated,
-            covariance: fit.estimator_covariance.as_deref(),
+            estimator_covariance: fit.estimator_covariance.as_deref(),
         })
     }
 
@@ -270,9 +270,11 @@ impl Experiment {
 struct FitOut<'a> {
     #[serde(flatten)]
     cli: commands::FitJson<'a>,
-    model: Model,
+    /// The fitted parts as spec tables (the command line's `model` holds its export forms).
+    fitted_model: Model,
     estimated: &'a [String],
-    covariance: Option<&'a [Vec<f64>]>,
+    /// In the estimator's order (the command line's `covariance` is in the reported order).
+    estimator_covariance: Option<&'a [Vec<f64>]>,
 }
 
 /// The fitted model's parts as spec tables.
