@@ -809,7 +809,7 @@ fn estimate_entry_points_never_panic_or_hang() {
 /// the first moment, its gradient and the second moment are finite, and the first moment
 /// equals what each case reduces to in closed form.
 #[test]
-fn wide_jitter_first_moment_cost_is_bounded() {
+fn wide_jitter_moments_are_finite_and_match_closed_forms() {
     let edges = vec![-31.66, -29.66, -29.657, -29.653, -5.58, 19.0, 19.06];
     let levels = vec![1.66, 1.16, -1.46, 0.86, 1.05, 0.5];
     // ∫u dt: the input is zero outside [edges[0], edges[6]).

@@ -215,6 +215,28 @@ pub(crate) fn all_finite(name: &'static str, values: &[f64]) -> Result<(), Signa
     values.iter().try_for_each(|&v| finite(name, v).map(|_| ()))
 }
 
+/// Transfer-function coefficients: finite, a numerator of at least one coefficient and a
+/// denominator of at least two (degree ≥ 1).
+pub(crate) fn tf_coefficients(num: &[f64], den: &[f64]) -> Result<(), SignalError> {
+    all_finite("num", num)?;
+    all_finite("den", den)?;
+    if num.is_empty() {
+        return Err(SignalError::TooFew {
+            name: "num",
+            min: 1,
+            value: 0,
+        });
+    }
+    if den.len() < 2 {
+        return Err(SignalError::TooFew {
+            name: "den",
+            min: 2,
+            value: den.len(),
+        });
+    }
+    Ok(())
+}
+
 pub(crate) fn increasing(name: &'static str, values: &[f64]) -> Result<(), SignalError> {
     all_finite(name, values)?;
     for (i, w) in values.windows(2).enumerate() {

@@ -1,7 +1,7 @@
 //! Proper, stable continuous-time transfer functions `G(s) = N(s)/A(s)` in two
 //! parameterisations, and their modal (partial-fraction) form with parameter derivatives.
 
-use crate::error::{all_finite, finite, SignalError};
+use crate::error::{all_finite, finite, tf_coefficients, SignalError};
 use crate::poly;
 use num_complex::Complex64;
 use std::fmt;
@@ -61,22 +61,7 @@ impl Rational {
         d_num: Vec<Vec<f64>>,
         d_den: Vec<Vec<f64>>,
     ) -> Result<Self, SignalError> {
-        all_finite("num", &num)?;
-        all_finite("den", &den)?;
-        if num.is_empty() {
-            return Err(SignalError::TooFew {
-                name: "num",
-                min: 1,
-                value: 0,
-            });
-        }
-        if den.len() < 2 {
-            return Err(SignalError::TooFew {
-                name: "den",
-                min: 2,
-                value: den.len(),
-            });
-        }
+        tf_coefficients(&num, &den)?;
         if den[0] != 1.0 {
             return Err(SignalError::NotMonic { lead: den[0] });
         }

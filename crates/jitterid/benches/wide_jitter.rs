@@ -1,6 +1,6 @@
 //! The cost of the exact first moment, its gradient and the second moment when the jitter is
 //! far wider than the response, or a pole far faster than the sampling: the cases of the test
-//! `wide_jitter_first_moment_cost_is_bounded` (which checks their values), timed here instead
+//! `wide_jitter_moments_are_finite_and_match_closed_forms` (which checks their values), timed here instead
 //! of in the test. Each should stay within a small multiple of the narrow-jitter case.
 //!
 //! `cargo bench -p jitterid --bench wide_jitter`.

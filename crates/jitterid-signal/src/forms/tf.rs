@@ -1,7 +1,7 @@
 //! Transfer-function coefficients `N(s)/A(s)`.
 
 use super::{StateSpace, ZpkForm};
-use crate::error::{all_finite, SignalError};
+use crate::error::{tf_coefficients, SignalError};
 use crate::poly;
 use crate::RationalModel;
 use num_complex::Complex64;
@@ -22,22 +22,7 @@ impl TfForm {
     /// and the numerator's leading zeros are dropped. Rejects non-finite coefficients, a zero
     /// leading denominator coefficient, a denominator of degree 0 and an improper model.
     pub fn new(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
-        all_finite("num", num)?;
-        all_finite("den", den)?;
-        if num.is_empty() {
-            return Err(SignalError::TooFew {
-                name: "num",
-                min: 1,
-                value: 0,
-            });
-        }
-        if den.len() < 2 {
-            return Err(SignalError::TooFew {
-                name: "den",
-                min: 2,
-                value: den.len(),
-            });
-        }
+        tf_coefficients(num, den)?;
         let lead = den[0];
         if lead == 0.0 {
             return Err(SignalError::ZeroLeading { name: "den" });
