@@ -2,7 +2,7 @@
 
 use crate::cli_err;
 use crate::error::CliResult;
-use crate::experiment::{name_table, Experiment, InputSpec, Method, SystemKind};
+use crate::experiment::{name_table, Experiment, InputSpec, Method};
 use crate::export::{reported_covariance, CovarianceSource};
 use crate::inputs::input_span;
 use jitterid::estimate::solver::{
@@ -16,9 +16,9 @@ use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
-use jitterid::signal::registry::{roots_json, SignalRegistry};
+use jitterid::signal::registry::{SignalRegistry, Spec, KIND_KEY};
 use jitterid::signal::{simulate, AnySignal, Input, SampleGrid, Signal};
-use serde_json::{json, Map, Value};
+use serde_json::Map;
 
 /// The uniform-sum jitter with `n + 1` terms and standard deviation `sigma`, through the
 /// registry: the start of every `n` of a profile.
@@ -33,39 +33,21 @@ fn uniform_sum_with_std(sigma: f64) -> impl Fn(i64) -> Result<AnyJitter, JitterE
 /// The model structure of the command line.
 pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
 
-/// The signal of a system kind driven by `input` (rational systems need one), built through the
-/// signal registry.
-pub fn signal_of(kind: &SystemKind, input: Option<&Input>) -> CliResult<AnySignal> {
-    let pairs = match kind {
-        SystemKind::Zpk(z) => vec![
-            ("kind", json!("zpk")),
-            ("gain", json!(z.gain())),
-            ("zeros", roots_json(z.zeros())),
-            ("poles", roots_json(z.poles())),
-        ],
-        SystemKind::Tf(t) => vec![
-            ("kind", json!("tf")),
-            ("num", json!(t.num())),
-            ("den", json!(t.den())),
-        ],
-        SystemKind::Sinusoid(s) => vec![
-            ("kind", json!("sinusoid")),
-            ("amplitude", json!(s.amplitude())),
-            ("frequency", json!(s.frequency())),
-            ("phase", json!(s.phase())),
-        ],
-    };
-    let spec: Map<String, Value> = pairs.into_iter().map(|(k, v)| (k.into(), v)).collect();
-    if kind_needs_input(kind) && input.is_none() {
+/// The signal of a system's spec table driven by `input` (a kind that needs one, such as a
+/// rational system, fails without it), built through the signal registry.
+pub fn signal_of(spec: &Spec, input: Option<&Input>) -> CliResult<AnySignal> {
+    let registry = SignalRegistry::builtin();
+    let needs_input = spec
+        .get(KIND_KEY)
+        .and_then(|k| k.as_str())
+        .and_then(|name| registry.kind(name))
+        .is_some_and(|k| k.needs_input());
+    if needs_input && input.is_none() {
         return Err(cli_err!("a rational system needs an input"));
     }
-    SignalRegistry::builtin()
-        .build(&spec, input)
+    registry
+        .build(spec, input)
         .map_err(|e| cli_err!("[system]: {e}"))
-}
-
-fn kind_needs_input(kind: &SystemKind) -> bool {
-    !matches!(kind, SystemKind::Sinusoid(_))
 }
 
 /// The input of one realisation: a random binary input is drawn from `rng`, others are fixed.

@@ -4,11 +4,12 @@ use super::checks::finite_value;
 use super::diagnostics::Source;
 use super::range;
 use super::raw::RawInput;
-use super::spec::{InputSpec, SystemKind};
+use super::spec::{InputSpec, SystemSpec};
 use crate::cli_err;
 use crate::csvio;
 use crate::error::CliResult;
 use crate::inputs::{input_span, piecewise, piecewise_from_table};
+use jitterid::signal::registry::{SignalRegistry, KIND_KEY};
 use jitterid::signal::{Input, Multisine, RandomBinary, SampleGrid, Tone};
 use toml::Spanned;
 
@@ -18,26 +19,31 @@ pub const MAX_SWITCHES: f64 = 1e6;
 const S: &str = "input";
 const KINDS: &str = "\"random-binary\", \"sine\", \"multisine\", \"piecewise\" or \"csv\"";
 
-/// The input of `system`: none for a sinusoid, required for a rational system.
+/// The input of `system`: none for a kind without one (a sinusoid), required for a kind the
+/// signal registry drives by an input (a rational system).
 pub(super) fn parse_input_section(
     cx: &Source,
     r: Option<&RawInput>,
-    system: &SystemKind,
+    system: &SystemSpec,
     grid: &SampleGrid,
 ) -> CliResult<InputSpec> {
-    let why = "a sinusoid system has no input; remove the [input] section";
-    match (system, r) {
-        (SystemKind::Sinusoid(_), None) => Ok(InputSpec::None),
-        (SystemKind::Sinusoid(_), Some(r)) => Err(cx.err_at(S, "kind", r.kind.as_ref(), why)),
-        (_, None) => Err(cli_err!(
-            "{}: missing section [input]; a {} system needs an input (kind = {KINDS})",
+    let name = system
+        .kind
+        .get(KIND_KEY)
+        .and_then(|k| k.as_str())
+        .unwrap_or("");
+    let needs_input = SignalRegistry::builtin()
+        .kind(name)
+        .is_some_and(|k| k.needs_input());
+    let why = format!("a {name} system has no input; remove the [input] section");
+    match (needs_input, r) {
+        (false, None) => Ok(InputSpec::None),
+        (false, Some(r)) => Err(cx.err_at(S, "kind", r.kind.as_ref(), why)),
+        (true, None) => Err(cli_err!(
+            "{}: missing section [input]; a {name} system needs an input (kind = {KINDS})",
             cx.file,
-            match system {
-                SystemKind::Zpk(_) => "zpk",
-                _ => "tf",
-            }
         )),
-        (_, Some(r)) => parse_input(cx, r, grid),
+        (true, Some(r)) => parse_input(cx, r, grid),
     }
 }
 

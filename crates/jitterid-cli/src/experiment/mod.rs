@@ -24,7 +24,7 @@ pub use input::MAX_SWITCHES;
 pub use sampling::MAX_SAMPLES;
 pub use spec::{
     name_table, EstimateSpec, Experiment, InputSpec, JitterSpec, Method, NoiseSpec, SolverName,
-    SystemKind, SystemSpec,
+    SystemSpec,
 };
 
 use crate::cli_err;
@@ -86,7 +86,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
     })?;
     let grid = sampling::parse_sampling(&cx, r_sampling)?;
     let system = system::parse_system(&cx, r_system, &grid)?;
-    let input = input::parse_input_section(&cx, raw.input.as_ref(), &system.kind, &grid)?;
+    let input = input::parse_input_section(&cx, raw.input.as_ref(), &system, &grid)?;
     let jitter = match &raw.jitter {
         Some(r) => jitter::parse_jitter(&cx, r, &grid)?,
         None => jitter::no_jitter(),

@@ -5,7 +5,8 @@ use jitterid::estimate::{
     AnyCriterion, AnyNoise, CriterionRegistry, Frequencies, NoiseModel, SpecTable,
 };
 use jitterid::jitter::AnyJitter;
-use jitterid::signal::{Input, RandomBinary, SampleGrid, Sinusoid, TransferFunction, Zpk};
+use jitterid::signal::registry::Spec;
+use jitterid::signal::{Input, RandomBinary, SampleGrid};
 use std::fmt;
 use std::path::PathBuf;
 
@@ -20,23 +21,13 @@ pub enum InputSpec {
     Known(Input),
 }
 
-/// The system kind with its parameters (the truth in `simulate`/`montecarlo`, the start in
-/// `fit`).
-#[derive(Debug, Clone, PartialEq)]
-pub enum SystemKind {
-    /// Zeros, poles, gain.
-    Zpk(Zpk),
-    /// Polynomial transfer function.
-    Tf(TransferFunction),
-    /// A sinusoid `A sin(2πft + φ)` (no input).
-    Sinusoid(Sinusoid),
-}
-
 /// The `[system]` section.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemSpec {
-    /// The model.
-    pub kind: SystemKind,
+    /// The signal registry's spec table (`kind` and that kind's keys, checked at the door): the
+    /// truth in `simulate`/`montecarlo`, the start in `fit`. Built with
+    /// [`crate::fitting::signal_of`].
+    pub kind: Spec,
     /// Whether its parameters are estimated.
     pub estimate: bool,
 }

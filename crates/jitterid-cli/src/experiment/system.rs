@@ -4,9 +4,11 @@ use super::checks::{describe, number};
 use super::diagnostics::Source;
 use super::range;
 use super::raw::RawSystem;
-use super::spec::{SystemKind, SystemSpec};
+use super::spec::SystemSpec;
 use crate::error::CliResult;
+use jitterid::signal::registry::{roots_json, Spec, KIND_KEY};
 use jitterid::signal::{Root, SampleGrid, Sinusoid, TransferFunction, Zpk};
+use serde_json::{json, Value};
 use toml::Spanned;
 
 const S: &str = "system";
@@ -38,7 +40,7 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
     Ok(SystemSpec { kind, estimate })
 }
 
-fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
+fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
     let why = "kind = \"zpk\" needs gain, poles and optionally zeros";
     let g = cx.required(S, "gain", &r.gain, why)?;
     let gain = cx.checked(S, "gain", g, range::gain)?;
@@ -55,10 +57,17 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
     };
     let zpk = Zpk::new(gain, zeros, poles).map_err(|e| cx.err(S, "poles", &p.span(), e))?;
     range::response(&zpk, grid).map_err(|m| cx.err(S, "gain", &g.span(), m))?;
-    Ok(SystemKind::Zpk(zpk))
+    Ok(spec(
+        "zpk",
+        [
+            ("gain", json!(zpk.gain())),
+            ("zeros", roots_json(zpk.zeros())),
+            ("poles", roots_json(zpk.poles())),
+        ],
+    ))
 }
 
-fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
+fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
     let why = "kind = \"tf\" needs num and den (highest power first)";
     let n = cx.required(S, "num", &r.num, why)?;
     let d = cx.required(S, "den", &r.den, why)?;
@@ -74,10 +83,13 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
             "expected a nonzero numerator (a zero gain gives no signal to identify)",
         ));
     }
-    Ok(SystemKind::Tf(tf))
+    Ok(spec(
+        "tf",
+        [("num", json!(tf.num())), ("den", json!(tf.den()))],
+    ))
 }
 
-fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKind> {
+fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
     let why = "kind = \"sinusoid\" needs amplitude, frequency and optionally phase";
     let a = cx.required(S, "amplitude", &r.amplitude, why)?;
     let f = cx.required(S, "frequency", &r.frequency, why)?;
@@ -86,7 +98,22 @@ fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemKi
     let phase = cx.opt_finite(S, "phase", &r.phase, 0.0)?;
     let s = Sinusoid::new(amplitude, frequency, phase)
         .map_err(|e| cx.err(S, "frequency", &f.span(), e))?;
-    Ok(SystemKind::Sinusoid(s))
+    Ok(spec(
+        "sinusoid",
+        [
+            ("amplitude", json!(s.amplitude())),
+            ("frequency", json!(s.frequency())),
+            ("phase", json!(s.phase())),
+        ],
+    ))
+}
+
+/// The signal registry's spec table of `kind` with `keys`, as the door checks built them.
+fn spec<const N: usize>(kind: &str, keys: [(&str, Value); N]) -> Spec {
+    let mut spec = Spec::new();
+    spec.insert(KIND_KEY.into(), kind.into());
+    spec.extend(keys.into_iter().map(|(k, v)| (k.to_string(), v)));
+    spec
 }
 
 fn parse_roots(cx: &Source, key: &str, v: &Spanned<Vec<toml::Value>>) -> CliResult<Vec<Root>> {
