@@ -40,6 +40,7 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
     println!("|---|---|---|---|---|---|---|");
     let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).map_err(|e| e.to_string())?;
     let mut base = None;
+    let mut estimates = Vec::new();
     for &n in sizes {
         reset_peak_rss();
         let mut rng = realization_rng(7, n as u64);
@@ -113,6 +114,9 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
             "| {n} | {steps} | {eval:.2} | {fit:.2} | {full:.2} | {iters} | {:.0} |",
             peak_rss_mib()
         );
+        // Shortest round-trip form of every estimate, so that two runs can be compared for
+        // bit-identical results.
+        estimates.push(format!("N = {n}: {:?}", e.params));
         if let Some(b) = base {
             if n == 20_000 {
                 println!("\nfit time ratio N = 20 000 / N = 200: {:.1}\n", fit / b);
@@ -120,6 +124,10 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
         } else {
             base = Some(fit);
         }
+    }
+    println!("\nBCLS estimates (with covariance):");
+    for line in estimates {
+        println!("{line}");
     }
     Ok(())
 }

@@ -7,17 +7,24 @@
 //!   (target: at most 20 ms);
 //! * the LS-bias record (N = 1 000, `G(s) = 2(s+1)/((s+1)² + 4)` estimated, about 500 input
 //!   switches, uniform jitter `a = 0.35` known), from a start 10 % off (target: at most 1 s),
-//!   and one cost-and-gradient evaluation of it.
+//!   and one cost-and-gradient evaluation of it;
+//! * one likelihood evaluation of the Table 1 record for each `n = 0..=9`, and the profile on
+//!   one thread's worth of samples (`parallel: false`);
+//! * the sine case (N = 200, Gaussian jitter σ = 0.05): cost, cost and gradient, and the fit,
+//!   with the samples in parallel and serially.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use jitterid_estimate::ml::{
-    ml_estimate, ml_profile, ExactMl, LikelihoodObjective, MlOptions, QuasiMl,
+    fit_sine, ml_estimate, ml_profile, sine_least_squares, ExactMl, LikelihoodObjective, MlOptions,
+    QuasiMl,
 };
 use jitterid_estimate::{ModelStructure, Objective, Record};
 use jitterid_jitter::registry::JitterRegistry;
-use jitterid_jitter::UniformSum;
+use jitterid_jitter::{Gaussian, UniformSum};
 use jitterid_jitter::{JitterError, JitterModel};
-use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Zpk};
+use jitterid_signal::{
+    simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Sinusoid, Zpk,
+};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::hint::black_box;
@@ -169,5 +176,92 @@ fn system(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, table1, system);
+/// The exact likelihood on one thread's worth of samples (`parallel: false`), as the Monte Carlo
+/// workers run it.
+fn serial() -> ExactMl {
+    ExactMl {
+        parallel: false,
+        ..ExactMl::default()
+    }
+}
+
+/// One evaluation of the Table 1 record's likelihood for each `n`, and the serial profile.
+fn table1_per_n(c: &mut Criterion) {
+    let (structure, record) = table1_setup(11);
+    let mut group = c.benchmark_group("table1-per-n");
+    group.sample_size(20);
+    for n in 0u32..=9 {
+        let a = 0.5 / 3f64.sqrt() * (3.0 * (n as f64 + 1.0)).sqrt();
+        let s = ModelStructure::oe(structure.signal.clone(), UniformSum::new(n, a).unwrap())
+            .with_estimated(false, true, false)
+            .with_noise_std(0.01)
+            .unwrap();
+        let e = serial();
+        let o = LikelihoodObjective::new(&s, &e, &record);
+        group.bench_function(format!("exact-ml cost n={n}"), |b| {
+            b.iter(|| black_box(o.cost(&[a])))
+        });
+    }
+    let opts = MlOptions::default();
+    group.bench_function("exact-ml profile n=0..=9, serial samples", |b| {
+        b.iter(|| {
+            black_box(
+                ml_profile(
+                    &structure,
+                    &record,
+                    &serial(),
+                    &opts,
+                    0..=9,
+                    keep_std_dev(&structure.jitter),
+                )
+                .unwrap(),
+            )
+        })
+    });
+    group.finish();
+}
+
+/// The sine case: cost, cost and gradient, and the fit, parallel and serial samples.
+fn sine(c: &mut Criterion) {
+    let sine = Sinusoid::new(1.0, 1.78, 0.3).unwrap();
+    let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+    let jitter = Gaussian::new(0.05).unwrap();
+    let mut rng = StdRng::seed_from_u64(40);
+    let data = simulate(&sine, &jitter, &grid, 0.01, &mut rng).unwrap();
+    let record = Record::new(grid, data.y).unwrap();
+    let ls = sine_least_squares(&record).unwrap();
+    let structure = ModelStructure::oe(sine, jitter).with_estimated(true, false, false);
+    let theta = [1.0, 1.78, 0.3, 0.01];
+    let mut group = c.benchmark_group("sine");
+    group.sample_size(10);
+    for (name, e) in [("parallel", ExactMl::default()), ("serial", serial())] {
+        let o = LikelihoodObjective::new(&structure, &e, &record);
+        group.bench_function(format!("{name}: cost"), |b| {
+            b.iter(|| black_box(o.cost(&theta)))
+        });
+        group.bench_function(format!("{name}: cost and gradient"), |b| {
+            b.iter(|| black_box(o.cost_gradient(&theta)))
+        });
+        group.bench_function(format!("{name}: fit"), |b| {
+            b.iter(|| {
+                black_box(
+                    fit_sine(
+                        &record,
+                        &ls,
+                        1.78,
+                        jitter,
+                        false,
+                        None,
+                        &e,
+                        &MlOptions::default(),
+                    )
+                    .unwrap(),
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, table1, system, table1_per_n, sine);
 criterion_main!(benches);
