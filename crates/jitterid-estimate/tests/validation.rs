@@ -145,7 +145,7 @@ fn verdicts<M: RationalModel + 'static>(
     u: &jitterid_signal::PiecewiseConstant,
     y: &[f64],
 ) -> (bool, bool) {
-    let structure = ModelStructure::oe(LtiResponse::new(model, u.clone()), s.jitter.clone());
+    let structure = ModelStructure::oe(LtiResponse::new(model, u.clone()), s.jitter);
     let e = standardized_residuals(&structure, &s.grid, y, s.noise)
         .unwrap()
         .standardized;
@@ -176,9 +176,8 @@ fn whiteness_passes_at_the_truth_and_fails_for_a_wrong_order() {
     // residuals.
     let (u, y) = record(&s, &truth, 77);
     let start = Zpk::new(0.3, vec![], vec![Root::Real(-0.4)]).unwrap();
-    let structure =
-        ModelStructure::oe(LtiResponse::new(start.clone(), u.clone()), s.jitter.clone());
-    let data = Record::new(s.grid.clone(), y.clone()).unwrap();
+    let structure = ModelStructure::oe(LtiResponse::new(start.clone(), u.clone()), s.jitter);
+    let data = Record::new(s.grid, y.clone()).unwrap();
     let fit = estimate(&structure, &data, &Bcls, &EstimateOptions::default()).unwrap();
     let fitted = start.with_params(&fit.params).unwrap();
     let (white, cross) = verdicts(&s, fitted, &u, &y);
@@ -206,10 +205,10 @@ fn delta_method_band_matches_the_monte_carlo_spread() {
     let mut sigmas = Vec::new();
     for seed in 0..runs {
         let (u, y) = record(&s, &truth, 5000 + seed);
-        let structure = ModelStructure::oe(LtiResponse::new(truth.clone(), u), s.jitter.clone())
+        let structure = ModelStructure::oe(LtiResponse::new(truth.clone(), u), s.jitter)
             .with_noise_std(s.noise)
             .unwrap();
-        let data = Record::new(s.grid.clone(), y).unwrap();
+        let data = Record::new(s.grid, y).unwrap();
         let fit = estimate(&structure, &data, &Bcls, &EstimateOptions::default()).unwrap();
         assert!(fit.converged, "seed {seed}: {}", fit.termination);
         let fitted = truth.with_params(&fit.params).unwrap();
