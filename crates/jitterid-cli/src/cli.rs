@@ -35,6 +35,34 @@ pub enum Command {
     Montecarlo(MonteCarloArgs),
     /// Merge the shard files of `montecarlo --shard i/n --json` into the unsharded result.
     Merge(MergeArgs),
+    /// Validate a fitted model on its record (and a validation record): fit percent, residual
+    /// whiteness and input cross-correlation, flatness, frequency response with bands.
+    Validate(ValidateArgs),
+}
+
+/// Arguments of `validate`.
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    /// The experiment file (TOML).
+    pub experiment: PathBuf,
+    /// The estimation record (CSV as for `fit`; a random-binary input from <stem>.input.csv).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// A validation record of the same system (same T, its own length and input side file).
+    #[arg(long, value_name = "FILE")]
+    pub validation: Option<PathBuf>,
+    /// The model to validate, as written by `jitterid fit --json` [default: fit it here].
+    #[arg(long, value_name = "FIT.json")]
+    pub model: Option<PathBuf>,
+    /// Print JSON (the only output format of validate; accepted for symmetry with fit).
+    #[arg(long)]
+    pub json: bool,
+    /// Write the frequency response with ±2σ bands as CSV to this file.
+    #[arg(long, value_name = "FILE.csv")]
+    pub bode: Option<PathBuf>,
+    /// Write the JSON to this file (atomically, with --bode) instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -190,6 +218,14 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             accept_unconverged: a.budget.accept_unconverged,
             max_iterations: a.budget.max_iterations,
             time_limit: a.budget.time_limit,
+        }),
+        Command::Validate(a) => crate::validate::validate(&crate::validate::ValidateOptions {
+            experiment: a.experiment,
+            data: a.data,
+            validation: a.validation,
+            model: a.model,
+            bode: a.bode,
+            out: a.out,
         }),
         Command::Merge(a) => {
             crate::merge::merge(&a.shards, a.json, a.out.as_deref(), a.accept_unconverged)

@@ -196,7 +196,7 @@ pub struct FitJson<'a> {
 }
 
 /// The samples of a data file, checked against the experiment's grid.
-fn read_data(exp: &Experiment, path: &Path) -> CliResult<csvio::Table> {
+pub fn read_data(exp: &Experiment, path: &Path) -> CliResult<csvio::Table> {
     let table = csvio::read(path)?;
     let y = table.column("y")?;
     let n = exp.grid.len();

@@ -2,6 +2,7 @@
 //! poles and gain, and a state-space realisation (`fit --json`'s `model`), and the covariance
 //! of the reported parameters.
 
+use jitterid::estimate::{validation, EstimateError};
 use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
 use jitterid::signal::registry::{SignalRegistry, SpecReader};
 use jitterid::signal::{AnySignal, SignalError, TransferFunction, Zpk};
@@ -71,4 +72,58 @@ pub fn reported_covariance(
         .iter()
         .map(|&a| sources.iter().map(|&b| entry(a, b)).collect())
         .collect()
+}
+
+/// The signal's system as a [`Zpk`] in the signal's own parameterisation (so that the rows of
+/// its covariance match), `None` for other kinds.
+fn zpk_of(signal: &AnySignal) -> Option<Zpk> {
+    let kind = SignalRegistry::builtin().kind("zpk")?;
+    let spec = signal.spec();
+    let r = SpecReader::new(kind, &spec).ok()?;
+    (signal.kind() == "zpk")
+        .then(|| {
+            Zpk::new(
+                r.f64("gain").ok()?,
+                r.roots("zeros").ok()?,
+                r.roots("poles").ok()?,
+            )
+            .ok()
+        })
+        .flatten()
+}
+
+/// The signal's system as a [`TransferFunction`], `None` for other kinds.
+fn transfer_function_of(signal: &AnySignal) -> Option<TransferFunction> {
+    let kind = SignalRegistry::builtin().kind("tf")?;
+    let spec = signal.spec();
+    let r = SpecReader::new(kind, &spec).ok()?;
+    (signal.kind() == "tf")
+        .then(|| TransferFunction::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok())
+        .flatten()
+}
+
+/// The Bode diagram of a rational signal's system at `freqs` with delta-method bands from the
+/// covariance of its parameters; `None` for other signal kinds.
+pub fn bode_of(
+    signal: &AnySignal,
+    freqs: &[f64],
+    covariance: Option<&[Vec<f64>]>,
+) -> Option<Result<Vec<validation::BodePoint>, EstimateError>> {
+    if let Some(z) = zpk_of(signal) {
+        return Some(validation::bode(&z, freqs, covariance));
+    }
+    transfer_function_of(signal).map(|t| validation::bode(&t, freqs, covariance))
+}
+
+/// The unit-step response of a rational signal's system with delta-method bands; `None` for
+/// other signal kinds.
+pub fn step_of(
+    signal: &AnySignal,
+    times: &[f64],
+    covariance: Option<&[Vec<f64>]>,
+) -> Option<Result<Vec<validation::StepPoint>, EstimateError>> {
+    if let Some(z) = zpk_of(signal) {
+        return Some(validation::step_response(&z, times, covariance));
+    }
+    transfer_function_of(signal).map(|t| validation::step_response(&t, times, covariance))
 }

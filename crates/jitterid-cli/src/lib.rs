@@ -20,5 +20,6 @@ pub mod output;
 pub mod plots;
 pub mod progress;
 pub mod svg;
+pub mod validate;
 
 pub use cli::run;

@@ -93,6 +93,16 @@ pub enum EstimateError {
         /// Length given.
         got: usize,
     },
+    /// An argument of a validation or export helper is out of its range.
+    #[error("{name} = {value}: {reason}")]
+    BadArgument {
+        /// The argument.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        reason: &'static str,
+    },
     /// From the signal model.
     #[error(transparent)]
     Signal(#[from] SignalError),

@@ -1,6 +1,26 @@
 //! Validation of a fitted model on a record: how much of the data's variation the model's
-//! expected samples explain ([`fit_percent`]).
+//! expected samples explain ([`fit_percent`], [`compare`]), whether its standardised residuals
+//! are white and unrelated to the input ([`standardized_residuals`], [`whiteness`],
+//! [`cross_correlation`]), and its frequency and step responses with delta-method confidence
+//! bands ([`bode`], [`step_response`]) on log-spaced grids ([`log_spaced`]).
+//! `docs/method.md` ("Validation") states the definitions.
 
+mod compare;
+mod correlation;
 mod fit_percent;
+mod log_grid;
+mod residuals;
+mod response;
 
+pub use compare::{compare, Comparison};
+pub use correlation::{
+    allowed_outside, cross_correlation, default_max_lag, whiteness, CorrelationTest,
+    DEFAULT_MAX_LAG, LAG_ALPHA, TEST_ALPHA, Z_99,
+};
 pub use fit_percent::fit_percent;
+pub use log_grid::log_spaced;
+pub use residuals::{standardized_residuals, Residuals};
+pub use response::{
+    bode, log_response_gradient, step_response, step_value_and_gradient, BodePoint, StepPoint,
+    BAND_SIGMAS,
+};
