@@ -33,6 +33,8 @@ pub enum Command {
     Fit(FitArgs),
     /// Run a Monte Carlo study: simulate and fit many seeded realisations.
     Montecarlo(MonteCarloArgs),
+    /// Fit the [select] grid of model orders × jitter families and rank them (BIC).
+    Select(SelectArgs),
     /// Merge the shard files of `montecarlo --shard i/n --json` into the unsharded result.
     Merge(MergeArgs),
     /// Validate a fitted model on its record (and a validation record): fit percent, residual
@@ -167,6 +169,25 @@ pub struct MonteCarloArgs {
     pub budget: BudgetArgs,
 }
 
+/// Arguments of `select`.
+#[derive(Debug, Args)]
+pub struct SelectArgs {
+    /// The experiment file (TOML) with a [select] section.
+    pub experiment: PathBuf,
+    /// The data file (CSV with a column `y`); a random-binary input is read from its side file.
+    #[arg(long)]
+    pub data: PathBuf,
+    /// A validation record: each candidate's fit percent on it is reported beside the BIC.
+    #[arg(long, value_name = "FILE")]
+    pub validation: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the JSON to this file instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
 /// Arguments of `merge`.
 #[derive(Debug, Args)]
 pub struct MergeArgs {
@@ -225,6 +246,13 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             validation: a.validation,
             model: a.model,
             bode: a.bode,
+            out: a.out,
+        }),
+        Command::Select(a) => crate::select::select(&crate::select::SelectOptions {
+            experiment: a.experiment,
+            data: a.data,
+            validation: a.validation,
+            json: a.json,
             out: a.out,
         }),
         Command::Merge(a) => {

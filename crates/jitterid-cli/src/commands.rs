@@ -248,7 +248,7 @@ fn fmt_num(x: f64) -> String {
 
 /// The experiment of `path` with the command line's iteration and wall-clock budgets, where
 /// given.
-fn read_experiment(
+pub fn read_experiment(
     path: &Path,
     purpose: Purpose,
     max_iterations: Option<u64>,
@@ -304,6 +304,28 @@ pub fn fit_json(f: &Fit) -> FitJson<'_> {
     }
 }
 
+/// The input of the record in `data`: the experiment's known input, or for a random-binary
+/// experiment the realisation in `input` (default: the side file of `data`).
+pub fn read_input(exp: &Experiment, data: &Path, input: Option<&Path>) -> CliResult<Option<Input>> {
+    Ok(match &exp.input {
+        InputSpec::None => None,
+        InputSpec::Known(i) => Some(i.clone()),
+        InputSpec::RandomBinary(_) => {
+            let side = input.map_or_else(|| input_side_file(data), Path::to_path_buf);
+            if !side.exists() {
+                return Err(cli_err!(
+                    "{}: cannot read: file does not exist; the experiment's input is random-binary, so fit reads the input realisation written by `jitterid simulate` (or give --input FILE with columns t,u)",
+                    side.display()
+                ));
+            }
+            let t = csvio::read(&side)?;
+            Some(Input::Piecewise(inputs::piecewise_from_table(
+                &t, "t", "u", &exp.grid,
+            )?))
+        }
+    })
+}
+
 /// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
 /// not converge (unless `accept_unconverged`).
 pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
@@ -316,23 +338,7 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
     let method = exp.estimate.method;
     let table = read_data(&exp, &o.data)?;
     let y = table.column("y")?.to_vec();
-    let input: Option<Input> = match &exp.input {
-        InputSpec::None => None,
-        InputSpec::Known(i) => Some(i.clone()),
-        InputSpec::RandomBinary(_) => {
-            let side = o.input.clone().unwrap_or_else(|| input_side_file(&o.data));
-            if !side.exists() {
-                return Err(cli_err!(
-                    "{}: cannot read: file does not exist; the experiment's input is random-binary, so fit reads the input realisation written by `jitterid simulate` (or give --input FILE with columns t,u)",
-                    side.display()
-                ));
-            }
-            let t = csvio::read(&side)?;
-            Some(Input::Piecewise(inputs::piecewise_from_table(
-                &t, "t", "u", &exp.grid,
-            )?))
-        }
-    };
+    let input = read_input(&exp, &o.data, o.input.as_deref())?;
     let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let f = fit_values(&exp, signal.clone(), y.clone(), &table.name)?;

@@ -19,6 +19,7 @@ pub mod merge;
 pub mod output;
 pub mod plots;
 pub mod progress;
+pub mod select;
 pub mod svg;
 pub mod validate;
 

@@ -17,6 +17,7 @@ mod noise;
 pub mod range;
 mod raw;
 mod sampling;
+mod select;
 mod spec;
 mod system;
 
@@ -122,6 +123,10 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
         };
         method::check_method(&cx, &raw, &parts, estimate.method, chosen.is_some())?;
     }
+    let select = match &raw.select {
+        Some(r) => Some(select::parse_select(&cx, r, grid.len())?),
+        None => None,
+    };
     Ok(Experiment {
         file: file.to_string(),
         dir: cx.dir.clone(),
@@ -132,5 +137,6 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
         jitter,
         noise,
         estimate,
+        select,
     })
 }

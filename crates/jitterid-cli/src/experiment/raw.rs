@@ -86,6 +86,12 @@ section!(RawEstimate, "table [estimate]" {
     max_iterations: i64,
 });
 
+section!(RawSelect, "table [select]" {
+    poles: Vec<i64>,
+    zeros: Vec<i64>,
+    families: Vec<String>,
+});
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename = "experiment file")]
 pub(super) struct RawExperiment {
@@ -103,10 +109,12 @@ pub(super) struct RawExperiment {
     pub(super) noise: Option<RawNoise>,
     #[serde(default)]
     pub(super) estimate: Option<RawEstimate>,
+    #[serde(default)]
+    pub(super) select: Option<RawSelect>,
 }
 
 pub(super) const SECTIONS: &[&str] = &[
-    "title", "sampling", "input", "system", "jitter", "noise", "estimate",
+    "title", "sampling", "input", "system", "jitter", "noise", "estimate", "select",
 ];
 
 pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
@@ -116,6 +124,7 @@ pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
         "system" => RawSystem::KEYS,
         "noise" => RawNoise::KEYS,
         "estimate" => RawEstimate::KEYS,
+        "select" => RawSelect::KEYS,
         _ => SECTIONS,
     }
 }

@@ -272,4 +272,6 @@ pub struct Experiment {
     pub noise: NoiseSpec,
     /// How to estimate.
     pub estimate: EstimateSpec,
+    /// The `[select]` grid of model orders and jitter families, when the file has one.
+    pub select: Option<jitterid::estimate::selection::SelectionGrid>,
 }

@@ -15,10 +15,11 @@
 //! candidates, `−2 log L + k ln N`. Candidates that fail are kept with their reason and ranked
 //! last.
 
-use jitterid_jitter::registry::JitterRegistry;
-use jitterid_signal::{Input, LtiResponse, TransferFunction};
+use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
+use jitterid_signal::{Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 
+use crate::validation::fit_percent;
 use crate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
 
 /// A rectangular grid of candidate model orders and jitter families.
@@ -64,6 +65,20 @@ pub struct Candidate {
     pub parameters: Vec<(String, f64)>,
     /// Why the candidate failed, if it did.
     pub failure: Option<String>,
+    /// The fitted transfer function and jitter (absent for a failed candidate).
+    pub fitted: Option<(TransferFunction, AnyJitter)>,
+}
+
+impl Candidate {
+    /// The normalised fit percent ([`fit_percent`]) of the candidate's expected samples
+    /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`; `None` for a
+    /// failed candidate or where the fit percent is undefined (constant data).
+    pub fn validation_fit(&self, record: &Record, input: &Input) -> Option<f64> {
+        let (model, jitter) = self.fitted.as_ref()?;
+        let signal = LtiResponse::new(model.clone(), input.clone());
+        let m = signal.expected_values(record.grid(), jitter);
+        fit_percent(record.y(), &m).ok()
+    }
 }
 
 /// Why a selection could not run.
@@ -178,6 +193,7 @@ fn fit_candidate(
         converged: false,
         parameters: Vec::new(),
         failure: Some(reason),
+        fitted: None,
     };
     let sigma = options.jitter_fraction * record.grid().interval();
     let jitter = match registry.from_std_dev(&family, sigma, &serde_json::Map::new()) {
@@ -222,6 +238,10 @@ fn fit_candidate(
             .zip(fit.params.iter().copied())
             .collect(),
         failure: (!fit.converged).then(|| fit.termination.to_string()),
+        fitted: structure
+            .with_params(&fit.params)
+            .ok()
+            .map(|s| (s.signal.model().clone(), s.jitter)),
     }
 }
 
