@@ -155,7 +155,6 @@ impl<M: RationalModel> Spectrum for Delayed<M> {
         grad[..n].iter_mut().for_each(|g| *g *= e);
         grad[n] = Complex64::new(0.0, -TAU * f) * self.density(f);
     }
-
 }
 
 /// `e^{−i2πfD}`, the transform of a delay by `D`.

@@ -54,9 +54,9 @@ mod spectrum;
 pub mod testing;
 
 pub use any::AnySignal;
+pub use delay::Delayed;
 pub use error::SignalError;
 pub use grid::SampleGrid;
-pub use delay::Delayed;
 pub use initial::{ModalSignal, WithInitialState};
 pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone, MAX_SWITCHES};
 pub use lti::{LtiResponse, ModalState};

@@ -206,7 +206,10 @@ impl<M: RationalModel> LtiResponse<M> {
         if m.direct != 0.0 {
             let (lo, hi) = jitter.reach();
             self.walk(grid, lo, hi, &[], false, |k, t, _, _, _, in_reach| {
-                let jumps: f64 = in_reach.iter().map(|&(tj, du)| du * jitter.pdf(tj - t)).sum();
+                let jumps: f64 = in_reach
+                    .iter()
+                    .map(|&(tj, du)| du * jitter.pdf(tj - t))
+                    .sum();
                 out[k] += m.direct * jumps;
             });
         }
