@@ -199,11 +199,12 @@ impl<S: ModalSignal> WithInitialState<S> {
                 if let Some(cols) = cols.as_deref_mut() {
                     // ∂/∂θ of c e^{pΔ} M(p): ∂c e^{pΔ}M + c e^{pΔ}(Δ M + M') ∂p.
                     let slope = m.c * e * (delta * m0 + m1);
-                    for j in 0..ni {
-                        cols[j][k] += m.w * (m.dc[j] * em + slope * m.dp[j]).re;
+                    let (inner, free) = cols.split_at_mut(ni);
+                    for ((col, dc), dp) in inner.iter_mut().zip(&m.dc).zip(&m.dp) {
+                        col[k] += m.w * (dc * em + slope * dp).re;
                     }
-                    for (j, b) in m.basis.iter().enumerate() {
-                        cols[ni + j][k] += m.w * (b * em).re;
+                    for (col, b) in free.iter_mut().zip(&m.basis) {
+                        col[k] += m.w * (b * em).re;
                     }
                 }
             }
@@ -272,11 +273,12 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
         let delta = t - self.origin;
         for m in self.modes() {
             let e = (m.p * delta).exp();
-            for j in 0..ni {
-                grad[j] += m.w * ((m.dc[j] + m.c * delta * m.dp[j]) * e).re;
+            let (inner, free) = grad.split_at_mut(ni);
+            for ((g, dc), dp) in inner.iter_mut().zip(&m.dc).zip(&m.dp) {
+                *g += m.w * ((dc + m.c * delta * dp) * e).re;
             }
-            for (j, b) in m.basis.iter().enumerate() {
-                grad[ni + j] += m.w * (b * e).re;
+            for (g, b) in free.iter_mut().zip(&m.basis) {
+                *g += m.w * (b * e).re;
             }
         }
     }

@@ -217,3 +217,50 @@ fn bad_input_is_named() {
         Err(SignalError::NeedsSteps { .. })
     ));
 }
+
+/// The registry's `delay`, `initial` and `origin` keys: parameters named and ordered, the
+/// spec rebuilt, and bad values named by key.
+#[test]
+fn registry_builds_delay_and_initial_state() {
+    use jitterid_signal::registry::SignalRegistry;
+    let input = binary(1, 8.0, 0.0, 200.0).unwrap().into();
+    let registry = SignalRegistry::builtin();
+    let spec = serde_json::json!({
+        "kind": "tf", "num": [0.5], "den": [1.0, 0.8, 0.6],
+        "delay": 1.5, "initial": [0.1, -0.2], "origin": 3.0,
+    });
+    let s = registry
+        .build(spec.as_object().unwrap(), Some(&input))
+        .unwrap();
+    assert_eq!(
+        s.param_names(),
+        ["b0", "a1", "a0", "delay", "initial.0", "initial.1"]
+    );
+    assert_eq!(s.params(), [0.5, 0.8, 0.6, 1.5, 0.1, -0.2]);
+    let t = s.with_params(&[0.5, 0.8, 0.6, 2.0, 0.3, 0.0]).unwrap();
+    assert_eq!(t.spec()["delay"], serde_json::json!(2.0));
+    assert_eq!(t.spec()["origin"], serde_json::json!(3.0));
+    let again = registry.build(&t.spec(), Some(&input)).unwrap();
+    assert_eq!(again.params(), t.params());
+    let plain = serde_json::json!({"kind": "zpk", "gain": 1.0, "poles": [-1.0]});
+    let p = registry
+        .build(plain.as_object().unwrap(), Some(&input))
+        .unwrap();
+    assert_eq!(p.param_names(), ["gain", "pole0"]);
+    for (key, bad) in [
+        ("delay", serde_json::json!(-1.0)),
+        ("initial", serde_json::json!([1.0])),
+        ("origin", serde_json::json!(f64::NAN)),
+    ] {
+        let mut spec = serde_json::json!({"kind": "zpk", "gain": 1.0, "poles": [-1.0, -2.0]});
+        spec[key] = bad;
+        if key == "origin" {
+            spec["initial"] = serde_json::json!([0.0, 0.0]);
+            spec["origin"] = serde_json::json!("later");
+        }
+        let e = registry
+            .build(spec.as_object().unwrap(), Some(&input))
+            .unwrap_err();
+        assert_eq!(e.key(), Some(key), "{e}");
+    }
+}
