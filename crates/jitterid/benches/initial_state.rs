@@ -41,7 +41,7 @@ fn benches(c: &mut Criterion) {
         covariance: false,
         ..EstimateOptions::default()
     };
-    let at_rest = ModelStructure::oe(start.clone(), jitter.clone());
+    let at_rest = ModelStructure::oe(start.clone(), jitter);
     let free = ModelStructure::oe(WithInitialState::at_rest(start, 0.0).unwrap(), jitter);
     let mut g = c.benchmark_group("initial-state");
     g.bench_function("BCLS fit, model from rest", |b| {
