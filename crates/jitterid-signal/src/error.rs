@@ -174,6 +174,12 @@ pub enum SignalError {
         /// Imaginary part.
         im: f64,
     },
+    /// A feature that needs an input made of steps was given a tone input.
+    #[error("{what} needs a piecewise-constant input (steps), not tones")]
+    NeedsSteps {
+        /// The feature.
+        what: &'static str,
+    },
     /// The roots of a polynomial could not be found to the required accuracy.
     #[error("could not find the roots of `{name}`")]
     Roots {

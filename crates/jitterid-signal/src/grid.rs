@@ -31,6 +31,15 @@ impl SampleGrid {
         })
     }
 
+    /// The same instants moved earlier by `by` seconds (`t_k − by`): where a response delayed
+    /// by `by` is sampled in its own time. `by` is finite (checked by the caller).
+    pub(crate) fn earlier(&self, by: f64) -> Self {
+        Self {
+            start: self.start - by,
+            ..*self
+        }
+    }
+
     /// `t0`, the first requested instant (s).
     pub fn start(&self) -> f64 {
         self.start

@@ -19,6 +19,9 @@
 //!
 //! * [`TransferFunction`] (polynomial coefficients) and [`Zpk`] (zeros, poles, gain; real roots
 //!   and complex pairs), both [`RationalModel`]s, driven by an [`Input`] in [`LtiResponse`].
+//! * [`Delayed`]: an LTI response to its input delayed by a dead time `D` (a parameter).
+//! * [`WithInitialState`]: a response plus the free response from an unknown state at the
+//!   record's start.
 //! * [`Sinusoid`]: `A sin(2πf0 t + φ)` with parameters `(A, f0, φ)`, spectral lines only.
 //! * [`PulseResponse`]: a discrete-time pulse response `g(t) = Σ h_l δ(t − lT_s)` driven by a
 //!   piecewise-constant input.
@@ -32,9 +35,11 @@
 #![warn(missing_docs)]
 
 mod any;
+mod delay;
 mod error;
 pub mod forms;
 mod grid;
+mod initial;
 mod input;
 mod lti;
 pub mod poly;
@@ -49,8 +54,10 @@ mod spectrum;
 pub mod testing;
 
 pub use any::AnySignal;
+pub use delay::Delayed;
 pub use error::SignalError;
 pub use grid::SampleGrid;
+pub use initial::{ModalSignal, WithInitialState};
 pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone, MAX_SWITCHES};
 pub use lti::{LtiResponse, ModalState};
 pub use pulse::PulseResponse;

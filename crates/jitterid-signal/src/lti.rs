@@ -168,6 +168,54 @@ impl<M: RationalModel> LtiResponse<M> {
         s
     }
 
+    /// `ṡ(t)` for a piecewise-constant input, away from the input's steps: `Σ_i r_i x_i(t)`
+    /// (the feed-through's jumps at the steps are left out). `None` for a tone input.
+    pub fn rate_at(&self, t: f64) -> Option<f64> {
+        let state = self.state(t)?;
+        let m = self.modal();
+        Some(
+            self.representatives()
+                .iter()
+                .zip(&state.x)
+                .map(|(&(i, w), x)| w * (m.residues[i] * x).re)
+                .sum(),
+        )
+    }
+
+    /// `E[ṡ(t_k + τ)]` for a piecewise-constant input, exactly: `Re Σ_i w_i r_i A_ik` plus,
+    /// with a direct feed-through `D`, its jumps `D Σ_j Δu_j f_τ(t_j − t_k)` through the
+    /// jitter's density `f_τ` (an atom of the jitter that meets a step makes `m_k` jump, where
+    /// it has no derivative; that part is left out). `None` for a tone input.
+    ///
+    /// This is `∂m_k/∂t0`, what the gradient of a delayed response needs.
+    pub fn expected_rates(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Option<Vec<f64>> {
+        let Input::Piecewise(_) = self.input else {
+            return None;
+        };
+        let m = self.modal();
+        let reps = self.representatives();
+        let mut out = Vec::with_capacity(grid.len());
+        self.modal_expectations(grid, jitter, &reps, false, |_, a, _| {
+            out.push(
+                reps.iter()
+                    .zip(a)
+                    .map(|(&(i, w), a)| w * (m.residues[i] * a).re)
+                    .sum(),
+            );
+        });
+        if m.direct != 0.0 {
+            let (lo, hi) = jitter.reach();
+            self.walk(grid, lo, hi, &[], false, |k, t, _, _, _, in_reach| {
+                let jumps: f64 = in_reach
+                    .iter()
+                    .map(|&(tj, du)| du * jitter.pdf(tj - t))
+                    .sum();
+                out[k] += m.direct * jumps;
+            });
+        }
+        Some(out)
+    }
+
     /// The model `G`.
     pub fn model(&self) -> &M {
         &self.model

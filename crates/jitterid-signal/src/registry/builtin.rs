@@ -2,8 +2,8 @@
 
 use super::{ParamSpec, SignalKind, SignalRegistry, Spec, SpecReader};
 use crate::{
-    AnySignal, Input, LtiResponse, PulseResponse, Root, SignalError, Sinusoid, TransferFunction,
-    Zpk,
+    AnySignal, Delayed, Input, LtiResponse, PulseResponse, RationalModel, Root, SignalError,
+    Sinusoid, TransferFunction, WithInitialState, Zpk,
 };
 use serde_json::{json, Value};
 
@@ -70,7 +70,10 @@ fn zpk() -> SignalKind {
                 "rad/s",
                 "at least one; real part < 0, distinct, im > 0",
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(response_keys())
+        .collect(),
         true,
         |r: &SpecReader<'_>, input| {
             let (gain, zeros, poles) = (r.f64("gain")?, r.roots("zeros")?, r.roots("poles")?);
@@ -88,18 +91,18 @@ fn zpk() -> SignalKind {
                 };
                 r.invalid(&key_of(&e, &keys, fallback), e)
             })?;
-            Ok(AnySignal::with_spectrum(
+            lti_signal(
                 "zpk",
+                r,
                 LtiResponse::new(g, input_of(input)?),
-                |s: &LtiResponse<Zpk>| {
-                    let g = s.model();
+                |g: &Zpk| {
                     spec([
                         ("gain", json!(g.gain())),
                         ("zeros", roots_json(g.zeros())),
                         ("poles", roots_json(g.poles())),
                     ])
                 },
-            ))
+            )
         },
     )
 }
@@ -121,7 +124,10 @@ fn tf() -> SignalKind {
                 "",
                 "finite, leading ≠ 0, stable distinct poles",
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(response_keys())
+        .collect(),
         true,
         |r: &SpecReader<'_>, input| {
             let (num, den) = (r.f64_list("num")?, r.f64_list("den")?);
@@ -134,18 +140,108 @@ fn tf() -> SignalKind {
                 };
                 r.invalid(&key_of(&e, &keys, fallback), e)
             })?;
-            Ok(AnySignal::with_spectrum(
+            lti_signal(
                 "tf",
+                r,
                 LtiResponse::new(g, input_of(input)?),
-                |s: &LtiResponse<TransferFunction>| {
-                    spec([
-                        ("num", json!(s.model().num())),
-                        ("den", json!(s.model().den())),
-                    ])
-                },
-            ))
+                |g: &TransferFunction| spec([("num", json!(g.num())), ("den", json!(g.den()))]),
+            )
         },
     )
+}
+
+/// The keys every LTI kind adds to its model's: an input delay and the free response from an
+/// initial state (each a parameter only when given).
+fn response_keys() -> Vec<ParamSpec> {
+    vec![
+        ParamSpec::new(
+            "delay",
+            "input delay (dead time) D, a parameter `delay` when given",
+            "s",
+            "optional; finite, ≥ 0, piecewise-constant input",
+        ),
+        ParamSpec::new(
+            "initial",
+            "free response q_0 … q_{n−1} (Laplace transform q(s)/A(s) from `origin`), \
+             parameters `initial.j` when given",
+            "",
+            "optional; one finite value per pole",
+        ),
+        ParamSpec::new(
+            "origin",
+            "time t0 of the initial state (the record's first instant)",
+            "s",
+            "finite",
+        )
+        .with_default(0.0),
+    ]
+}
+
+/// `response`, delayed and given a free response as the spec table asks, with `keys` writing
+/// the model's keys back.
+fn lti_signal<M: RationalModel + Clone + 'static>(
+    kind: &'static str,
+    r: &SpecReader<'_>,
+    response: LtiResponse<M>,
+    keys: fn(&M) -> Spec,
+) -> Result<AnySignal, SignalError> {
+    let delay = if r.has("delay") {
+        let d = r.f64("delay")?;
+        if !(d >= 0.0) {
+            return Err(r.invalid("delay", format!("must be ≥ 0, got {d}")));
+        }
+        Some(d)
+    } else {
+        None
+    };
+    let initial = r
+        .has("initial")
+        .then(|| r.f64_list("initial"))
+        .transpose()?;
+    let origin = r.f64("origin")?;
+    let with_origin = move |mut s: Spec, initial: &[f64], origin: f64| {
+        s.insert("initial".into(), json!(initial));
+        s.insert("origin".into(), json!(origin));
+        s
+    };
+    let delayed =
+        |resp| Delayed::new(resp, delay.unwrap_or(0.0)).map_err(|e| r.invalid("delay", e));
+    let free_error = |e: SignalError| {
+        let key = if matches!(e, SignalError::NotFinite { name: "origin", .. }) {
+            "origin"
+        } else {
+            "initial"
+        };
+        r.invalid(key, e)
+    };
+    Ok(match (delay, initial) {
+        (None, None) => {
+            AnySignal::with_spectrum(kind, response, move |s: &LtiResponse<M>| keys(s.model()))
+        }
+        (Some(_), None) => {
+            AnySignal::with_spectrum(kind, delayed(response)?, move |s: &Delayed<M>| {
+                let mut out = keys(s.response().model());
+                out.insert("delay".into(), json!(s.delay()));
+                out
+            })
+        }
+        (None, Some(q)) => AnySignal::new(
+            kind,
+            WithInitialState::new(response, origin, q).map_err(free_error)?,
+            move |s: &WithInitialState<LtiResponse<M>>| {
+                with_origin(keys(s.response().model()), s.initial(), s.origin())
+            },
+        ),
+        (Some(_), Some(q)) => AnySignal::new(
+            kind,
+            WithInitialState::new(delayed(response)?, origin, q).map_err(free_error)?,
+            move |s: &WithInitialState<Delayed<M>>| {
+                let mut out = keys(s.response().response().model());
+                out.insert("delay".into(), json!(s.response().delay()));
+                with_origin(out, s.initial(), s.origin())
+            },
+        ),
+    })
 }
 
 fn sinusoid() -> SignalKind {

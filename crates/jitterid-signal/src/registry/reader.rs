@@ -56,6 +56,11 @@ impl<'a> SpecReader<'a> {
             .ok_or_else(|| self.invalid(key, format!("expected a number, found {v}")))
     }
 
+    /// Whether the table has `key`.
+    pub fn has(&self, key: &str) -> bool {
+        self.spec.contains_key(key)
+    }
+
     /// A number; its default when absent.
     pub fn f64(&self, key: &str) -> Result<f64, SignalError> {
         match self.spec.get(key) {

@@ -1,0 +1,342 @@
+//! The free response from an unknown state at the record's start, added to an LTI response.
+
+use crate::delay::Delayed;
+use crate::lti::LtiResponse;
+use crate::rational::{Modal, RationalModel};
+use crate::signal::{local_breaks, Jacobian, Signal};
+use crate::{SampleGrid, SignalError};
+use jitterid_jitter::JitterModel;
+use num_complex::Complex64;
+
+/// A signal whose output is a rational model's response: its modal form gives the modes a
+/// free response is made of.
+pub trait ModalSignal: Signal {
+    /// The modal form of the model (poles and their derivatives with respect to this
+    /// signal's leading parameters).
+    fn modal(&self) -> &Modal;
+}
+
+impl<M: RationalModel> ModalSignal for LtiResponse<M> {
+    fn modal(&self) -> &Modal {
+        self.model().modal()
+    }
+}
+
+impl<M: RationalModel> ModalSignal for Delayed<M> {
+    fn modal(&self) -> &Modal {
+        Delayed::modal(self)
+    }
+}
+
+/// `s(t) + f(t)`: a response `s` plus the free response `f` of its system from an unknown
+/// state at the origin `t0` (the record's first requested instant).
+///
+/// For a model with denominator `A(s)` of degree `n`, every free response from a state at
+/// `t0` has the Laplace transform `q(s)/A(s)` (time origin `t0`) with `q` a real polynomial of
+/// degree `< n`; its coefficients `q_0 … q_{n−1}` are the parameters `initial.0 …
+/// initial.{n−1}`, after the response's own. In modal form
+/// `f(t) = Σ_i c_i e^{p_i (t − t0)}` with `c_i = q(p_i)/A'(p_i)`, which stays continuous
+/// when a complex pair of a search becomes two real poles (the number of parameters does not
+/// change). An input that ran before `t0` leaves exactly such a free response after `t0`.
+///
+/// The free response is taken as the analytic `Σ c_i e^{p_i(t − t0)}` at every `t`, also a
+/// little before `t0`, where jitter may move the first samples. Its jittered mean is then
+/// exact: `E[e^{p(t_k + τ − t0)}] = e^{p(t_k − t0)} M_τ(p)` with the jitter's moment-generating
+/// function `M_τ` (the jitter's quadrature rule where `M_τ(p)` diverges), and its gradient
+/// uses `E[τ e^{pτ}]`. The second moment adds `E[2 s f + f²]` by the jitter's rule cut at the
+/// response's breakpoints, for the samples where `f` is not negligible against `E[s²]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WithInitialState<S> {
+    inner: S,
+    origin: f64,
+    initial: Vec<f64>,
+}
+
+/// One representative mode (a real pole or the upper member of a pair) and what its
+/// coefficient `c = q(p)/A'(p)` depends on.
+struct Mode {
+    p: Complex64,
+    /// 2 for a pair (the conjugate adds the conjugate term), 1 for a real pole.
+    w: f64,
+    c: Complex64,
+    /// `∂p/∂θ_j` for the response's parameters.
+    dp: Vec<Complex64>,
+    /// `∂c/∂θ_j` for the response's parameters.
+    dc: Vec<Complex64>,
+    /// `∂c/∂q_j = p^j / A'(p)`.
+    basis: Vec<Complex64>,
+}
+
+impl<S: ModalSignal> WithInitialState<S> {
+    /// `response` plus the free response with coefficients `initial` (`q_0 … q_{n−1}`, `n`
+    /// the number of poles) from the origin `origin`.
+    ///
+    /// # Errors
+    ///
+    /// [`SignalError::NotFinite`] for a NaN or infinite origin or coefficient,
+    /// [`SignalError::WrongLength`] when `initial` does not have one value per pole.
+    pub fn new(response: S, origin: f64, initial: Vec<f64>) -> Result<Self, SignalError> {
+        crate::error::finite("origin", origin)?;
+        crate::error::all_finite("initial", &initial)?;
+        let n = response.modal().poles.len();
+        if initial.len() != n {
+            return Err(SignalError::WrongLength {
+                name: "initial",
+                expected: n,
+                got: initial.len(),
+            });
+        }
+        Ok(Self {
+            inner: response,
+            origin,
+            initial,
+        })
+    }
+
+    /// `response` from rest at `origin` (every `q_j = 0`), as a start for estimation.
+    pub fn at_rest(response: S, origin: f64) -> Result<Self, SignalError> {
+        let n = response.modal().poles.len();
+        Self::new(response, origin, vec![0.0; n])
+    }
+
+    /// The response without the free part.
+    pub fn response(&self) -> &S {
+        &self.inner
+    }
+
+    /// The origin `t0` of the free response (s).
+    pub fn origin(&self) -> f64 {
+        self.origin
+    }
+
+    /// The coefficients `q_0 … q_{n−1}`.
+    pub fn initial(&self) -> &[f64] {
+        &self.initial
+    }
+
+    /// The free response alone, `f(t)`.
+    pub fn free_value(&self, t: f64) -> f64 {
+        free_of(&self.modes(), t - self.origin)
+    }
+
+    fn modes(&self) -> Vec<Mode> {
+        let m = self.inner.modal();
+        let ni = self.inner.num_params();
+        let poles = &m.poles;
+        let mut out = Vec::new();
+        for (i, &p) in poles.iter().enumerate() {
+            let w = match p.im.partial_cmp(&0.0) {
+                Some(std::cmp::Ordering::Greater) => 2.0,
+                Some(std::cmp::Ordering::Equal) => 1.0,
+                _ => continue,
+            };
+            let mut a_prime = Complex64::new(1.0, 0.0);
+            for (l, &pl) in poles.iter().enumerate() {
+                if l != i {
+                    a_prime *= p - pl;
+                }
+            }
+            let r = a_prime.inv();
+            // q(p) and q'(p) by Horner, highest power first.
+            let (mut q, mut dq) = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+            for &qj in self.initial.iter().rev() {
+                dq = dq * p + q;
+                q = q * p + qj;
+            }
+            let c = q * r;
+            let d_pole = |l: usize, j: usize| m.d_poles[l].get(j).copied().unwrap_or_default();
+            let dp: Vec<Complex64> = (0..ni).map(|j| d_pole(i, j)).collect();
+            let dc = (0..ni)
+                .map(|j| {
+                    // ∂(1/A'(p_i)) = −(1/A'(p_i)) Σ_{l≠i} (∂p_i − ∂p_l)/(p_i − p_l).
+                    let spread: Complex64 = (0..poles.len())
+                        .filter(|&l| l != i)
+                        .map(|l| (dp[j] - d_pole(l, j)) / (p - poles[l]))
+                        .sum();
+                    dq * dp[j] * r - c * spread
+                })
+                .collect();
+            let mut basis = Vec::with_capacity(self.initial.len());
+            let mut pj = r;
+            for _ in 0..self.initial.len() {
+                basis.push(pj);
+                pj *= p;
+            }
+            out.push(Mode {
+                p,
+                w,
+                c,
+                dp,
+                dc,
+                basis,
+            });
+        }
+        out
+    }
+
+    /// Adds the free response's jittered mean to `values` and its gradient to `cols`.
+    fn add_free(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+        values: Option<&mut [f64]>,
+        cols: Option<&mut Jacobian>,
+    ) {
+        let modes = self.modes();
+        let factors: Vec<(Complex64, Complex64)> =
+            modes.iter().map(|m| jitter_factors(jitter, m.p)).collect();
+        let ni = self.inner.num_params();
+        let mut values = values;
+        let mut cols = cols;
+        for (k, t) in grid.times().enumerate() {
+            let delta = t - self.origin;
+            for (m, &(m0, m1)) in modes.iter().zip(&factors) {
+                let e = (m.p * delta).exp();
+                let em = e * m0;
+                if let Some(v) = values.as_deref_mut() {
+                    v[k] += m.w * (m.c * em).re;
+                }
+                if let Some(cols) = cols.as_deref_mut() {
+                    // ∂/∂θ of c e^{pΔ} M(p): ∂c e^{pΔ}M + c e^{pΔ}(Δ M + M') ∂p.
+                    let slope = m.c * e * (delta * m0 + m1);
+                    let (inner, free) = cols.split_at_mut(ni);
+                    for ((col, dc), dp) in inner.iter_mut().zip(&m.dc).zip(&m.dp) {
+                        col[k] += m.w * (dc * em + slope * dp).re;
+                    }
+                    for (col, b) in free.iter_mut().zip(&m.basis) {
+                        col[k] += m.w * (b * em).re;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `Σ_i c_i e^{p_i Δ}` over all modes.
+fn free_of(modes: &[Mode], delta: f64) -> f64 {
+    modes
+        .iter()
+        .map(|m| m.w * (m.c * (m.p * delta).exp()).re)
+        .sum()
+}
+
+/// `M_τ(p) = E[e^{pτ}]` (the moment-generating function, or the jitter's rule where it
+/// diverges) and `E[τ e^{pτ}]` (the rule).
+fn jitter_factors(jitter: &dyn JitterModel, p: Complex64) -> (Complex64, Complex64) {
+    let rule = jitter.rule(&[], p.norm());
+    let expect = |h: &dyn Fn(f64) -> Complex64| {
+        Complex64::new(rule.expect(|tau| h(tau).re), rule.expect(|tau| h(tau).im))
+    };
+    let m0 = jitter
+        .mgf(p)
+        .unwrap_or_else(|| expect(&|tau| (p * tau).exp()));
+    (m0, expect(&|tau| tau * (p * tau).exp()))
+}
+
+impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
+    fn param_names(&self) -> Vec<String> {
+        let mut names = self.inner.param_names();
+        names.extend((0..self.initial.len()).map(|j| format!("initial.{j}")));
+        names
+    }
+
+    fn params(&self) -> Vec<f64> {
+        let mut p = self.inner.params();
+        p.extend_from_slice(&self.initial);
+        p
+    }
+
+    fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
+        let ni = self.inner.num_params();
+        let n = ni + self.initial.len();
+        if params.len() != n {
+            return Err(SignalError::WrongParamCount {
+                expected: n,
+                got: params.len(),
+            });
+        }
+        Self::new(
+            self.inner.with_params(&params[..ni])?,
+            self.origin,
+            params[ni..].to_vec(),
+        )
+    }
+
+    fn value(&self, t: f64) -> f64 {
+        self.inner.value(t) + self.free_value(t)
+    }
+
+    fn value_gradient(&self, t: f64, grad: &mut [f64]) {
+        let ni = self.inner.num_params();
+        self.inner.value_gradient(t, &mut grad[..ni]);
+        grad[ni..].iter_mut().for_each(|g| *g = 0.0);
+        let delta = t - self.origin;
+        for m in self.modes() {
+            let e = (m.p * delta).exp();
+            let (inner, free) = grad.split_at_mut(ni);
+            for ((g, dc), dp) in inner.iter_mut().zip(&m.dc).zip(&m.dp) {
+                *g += m.w * ((dc + m.c * delta * dp) * e).re;
+            }
+            for (g, b) in free.iter_mut().zip(&m.basis) {
+                *g += m.w * (b * e).re;
+            }
+        }
+    }
+
+    fn breakpoints(&self) -> Vec<f64> {
+        self.inner.breakpoints()
+    }
+
+    fn rate(&self) -> f64 {
+        self.inner.rate()
+    }
+
+    fn expected_values(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        let mut v = self.inner.expected_values(grid, jitter);
+        self.add_free(grid, jitter, Some(&mut v), None);
+        v
+    }
+
+    fn expected_values_gradient(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Jacobian {
+        let mut cols = self.inner.expected_values_gradient(grid, jitter);
+        cols.extend((0..self.initial.len()).map(|_| vec![0.0; grid.len()]));
+        self.add_free(grid, jitter, None, Some(&mut cols));
+        cols
+    }
+
+    fn expected_values_and_gradient(
+        &self,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> (Vec<f64>, Jacobian) {
+        let (mut v, mut cols) = self.inner.expected_values_and_gradient(grid, jitter);
+        cols.extend((0..self.initial.len()).map(|_| vec![0.0; grid.len()]));
+        self.add_free(grid, jitter, Some(&mut v), Some(&mut cols));
+        (v, cols)
+    }
+
+    fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
+        let mut sq = self.inner.expected_squares(grid, jitter);
+        let modes = self.modes();
+        let breaks = self.inner.breakpoints();
+        let (lo, hi) = jitter.reach();
+        for (k, t) in grid.times().enumerate() {
+            // |f| ≤ bound on the sample's reach (every mode decays), so by Cauchy–Schwarz
+            // |E[2sf + f²]| ≤ 2·bound·√E[s²] + bound²: below rounding of E[s²], skip it.
+            let bound: f64 = modes
+                .iter()
+                .map(|m| m.w * m.c.norm() * (m.p.re * (t + lo - self.origin)).exp())
+                .sum();
+            let extra_bound = 2.0 * bound * sq[k].max(0.0).sqrt() + bound * bound;
+            if extra_bound <= 1e-17 * sq[k] || bound == 0.0 {
+                continue;
+            }
+            let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), 2.0 * self.rate());
+            sq[k] += rule.expect(|tau| {
+                let f = free_of(&modes, t + tau - self.origin);
+                f * (2.0 * self.inner.value(t + tau) + f)
+            });
+        }
+        sq
+    }
+}
