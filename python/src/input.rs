@@ -11,7 +11,13 @@ use pyo3::prelude::*;
 use serde_json::{json, Value};
 
 /// A known input `u(t)` that drives a system.
-#[pyclass(module = "jitterid._jitterid", subclass, frozen, eq, skip_from_py_object)]
+#[pyclass(
+    module = "jitterid._jitterid",
+    subclass,
+    frozen,
+    eq,
+    skip_from_py_object
+)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Input {
     pub(crate) input: LibInput,

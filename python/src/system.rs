@@ -67,7 +67,13 @@ fn roots_spec(roots: &[Complex64]) -> Value {
     roots
         .iter()
         .filter(|r| r.im >= 0.0)
-        .map(|r| if r.im == 0.0 { json!(r.re) } else { json!([r.re, r.im]) })
+        .map(|r| {
+            if r.im == 0.0 {
+                json!(r.re)
+            } else {
+                json!([r.re, r.im])
+            }
+        })
         .collect()
 }
 
