@@ -20,6 +20,8 @@ import json
 import os
 from typing import Any, Iterable, Mapping, Optional, Tuple, Union
 
+import numpy as np
+
 from . import _jitterid, inputs, jitter, system
 from .inputs import Input
 from .system import System
