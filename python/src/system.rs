@@ -14,6 +14,13 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use serde_json::{json, Value};
 
+/// A float64 vector out.
+type Reals<'py> = Bound<'py, PyArray1<f64>>;
+/// A complex128 vector out.
+type Complexes<'py> = Bound<'py, PyArray1<Complex64>>;
+/// A float64 matrix out.
+type Matrix<'py> = Bound<'py, PyArray2<f64>>;
+
 /// A system (or signal) kind of the registry with its keys; rational kinds also hold their
 /// transfer-function coefficients.
 #[pyclass(module = "jitterid._jitterid", subclass, frozen, skip_from_py_object)]
@@ -137,10 +144,7 @@ impl System {
     }
 
     /// The transfer-function coefficients `(num, den)`, highest power first, `den` monic.
-    fn tf_coefficients<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn tf_coefficients<'py>(&self, py: Python<'py>) -> PyResult<(Reals<'py>, Reals<'py>)> {
         let tf = self.rational()?;
         Ok((
             tf.num().to_vec().into_pyarray(py),
@@ -149,15 +153,7 @@ impl System {
     }
 
     /// Zeros, poles (complex, conjugate pairs in full) and gain.
-    #[allow(clippy::type_complexity)]
-    fn zpk_form<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<Complex64>>,
-        Bound<'py, PyArray1<Complex64>>,
-        f64,
-    )> {
+    fn zpk_form<'py>(&self, py: Python<'py>) -> PyResult<(Complexes<'py>, Complexes<'py>, f64)> {
         let zpk = self.rational()?.to_zpk().map_err(value_error)?;
         Ok((
             zpk.zeros().to_vec().into_pyarray(py),
@@ -168,16 +164,10 @@ impl System {
 
     /// The controllable canonical realisation `(A, B, C, D)`: `A` n×n, `B` n×1, `C` 1×n, `D`
     /// 1×1.
-    #[allow(clippy::type_complexity)]
     fn state_space<'py>(
         &self,
         py: Python<'py>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray2<f64>>,
-    )> {
+    ) -> PyResult<(Matrix<'py>, Matrix<'py>, Matrix<'py>, Matrix<'py>)> {
         let ss = self.rational()?.to_state_space();
         let n = ss.order();
         let a = Array2::from_shape_fn((n, n), |(i, j)| ss.a()[i][j]);
