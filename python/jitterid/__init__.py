@@ -20,7 +20,11 @@ import json
 import os
 from typing import Any, Iterable, Mapping, Optional, Tuple, Union
 
-from . import _jitterid, jitter
+import numpy as np
+
+from . import _jitterid, inputs, jitter, system
+from .inputs import Input
+from .system import System
 from .results import FitResult, MonteCarloResult
 
 __version__: str = _jitterid.__version__
@@ -31,6 +35,14 @@ __all__ = [
     "FitResult",
     "MonteCarloResult",
     "DEFAULT_SEED",
+    "Input",
+    "System",
+    "first_moment",
+    "fit",
+    "inputs",
+    "second_moment",
+    "simulate",
+    "system",
     "jitter",
     "merge",
     "montecarlo",
@@ -87,3 +99,77 @@ def read_record(path: Union[str, os.PathLike], input: Optional[Union[str, os.Pat
     arrays, with the input realisation ``input_t``, ``input_u`` from its side file
     ``<name>.input.csv`` (or ``input``) when there is one."""
     return _jitterid.read_record(os.fspath(path), None if input is None else os.fspath(input))
+
+
+def _grid(samples: int, interval: float, start: float) -> tuple:
+    return int(samples), float(interval), float(start)
+
+
+def simulate(system: System, jitter: "jitter.Jitter", input: Optional[Input] = None, *, samples: int,
+             interval: float, start: float = 0.0, noise_std: float = 0.0, seed: int = DEFAULT_SEED,
+             truth: bool = False) -> dict:
+    """``samples`` jittered samples ``y_k = s(t_k + τ_k) + v_k`` of ``system`` driven by
+    ``input`` at ``t_k = start + k·interval``, white noise of std ``noise_std``, seeded by
+    ``seed``: a dict of arrays ``t``, ``y``, ``u`` (with an input), and with ``truth`` the drawn
+    ``tau`` and ``v``. The GIL is released while it runs."""
+    return _jitterid.simulate(system, jitter, input, *_grid(samples, interval, start), float(noise_std),
+                              int(seed), bool(truth))
+
+
+def first_moment(system: System, jitter: "jitter.Jitter", input: Optional[Input] = None, *, samples: int,
+                 interval: float, start: float = 0.0) -> "np.ndarray":
+    """``m_k = E[s(t_k + τ)]`` at ``t_k = start + k·interval``, exact."""
+    return _jitterid.first_moment(system, jitter, input, *_grid(samples, interval, start))
+
+
+def second_moment(system: System, jitter: "jitter.Jitter", input: Optional[Input] = None, *, samples: int,
+                  interval: float, start: float = 0.0, noise_std: float = 0.0) -> "np.ndarray":
+    """``λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²`` at ``t_k = start + k·interval``, exact."""
+    return _jitterid.second_moment(system, jitter, input, *_grid(samples, interval, start), float(noise_std))
+
+
+def fit(record: Mapping[str, Any], system: System, jitter: "jitter.Jitter", method: str = "bcls", *,
+        estimate: Iterable[str] = ("system",), interval: Optional[float] = None,
+        start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
+        options: Optional[Mapping[str, Any]] = None) -> FitResult:
+    """Fits the samples ``record["y"]`` with ``method`` (``"ls"``, ``"bcls"``, ``"bj"``,
+    ``"ml"``, …), starting from ``system`` and ``jitter``; ``estimate`` names the estimated
+    parts (``"system"``, ``"jitter"``, ``"noise"``). The grid is ``interval`` and ``start``
+    (else the record's ``T``/``t0``, else its ``t`` column); the input is ``input`` (else the
+    record's ``input``, or its ``input_t``/``input_u``). ``options`` holds further keys of the
+    experiment file's ``[estimate]`` section (``solver``, ``frequencies``, ``max_iterations``…).
+    The result equals ``Experiment.fit`` on an experiment with the same sections."""
+    if not isinstance(record, Mapping) or "y" not in record:
+        raise TypeError("record: expected a mapping with at least `y`")
+    parts = set(estimate)
+    unknown = parts - {"system", "jitter", "noise"}
+    if unknown:
+        raise ValueError(f"estimate: unknown part(s) {sorted(unknown)}; expected 'system', 'jitter' or 'noise'")
+    y = np.asarray(record["y"], dtype=float)
+    t = record.get("t")
+    if interval is None:
+        interval = record.get("T")
+        if interval is None and t is not None and len(t) > 1:
+            interval = (float(t[-1]) - float(t[0])) / (len(t) - 1)
+        if interval is None:
+            raise ValueError("interval: not given and the record has no `T` or `t` to take it from")
+    if start is None:
+        start = record.get("t0", float(t[0]) if t is not None and len(t) else 0.0)
+    sections: dict = {"sampling": {"interval": float(interval), "samples": int(y.size), "start": float(start)}}
+    if input is None:
+        input = record.get("input")
+    if input is None and record.get("input_t") is not None:
+        u = np.asarray(record["input_u"], dtype=float)
+        t_in = np.asarray(record["input_t"], dtype=float)
+        sections["input"] = {"kind": "piecewise", "times": t_in.tolist(),
+                             "values": (u[:-1] if len(u) >= 2 and u[-1] == 0.0 else u).tolist()}
+    elif input is not None:
+        sections["input"] = json.loads(input.section_json())
+    sections["system"] = dict(system.spec, estimate="system" in parts)
+    sections["jitter"] = dict(jitter.spec, estimate="jitter" in parts)
+    sections["noise"] = {"std": float(noise_std), "estimate": "noise" in parts}
+    sections["estimate"] = {"method": method, **dict(options or {})}
+    from ._spec import spec_json
+
+    exp = Experiment.from_sections(spec_json(sections), "fit arguments")
+    return exp.fit({"y": y})

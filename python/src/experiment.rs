@@ -2,7 +2,8 @@
 //! writes it, and a record fitted as `jitterid fit --json` reports it.
 
 use crate::arrays::{finite_samples, SamplesIn};
-use crate::errors::{json_text, value_error};
+use crate::errors::{json_text, spec_table, value_error};
+use crate::toml_text;
 use jitterid::signal::Input;
 use jitterid_cli::commands::{self, DEFAULT_SEED};
 use jitterid_cli::csvio;
@@ -92,6 +93,19 @@ impl Experiment {
             _ => ".".to_string(),
         };
         cls.call1((text, file, dir))
+    }
+
+    /// The experiment whose sections are the tables of `sections` (JSON text: `{"sampling":
+    /// {...}, "system": {...}, ...}`), read as the experiment file it spells; `file` names it in
+    /// messages.
+    #[classmethod]
+    fn from_sections<'py>(
+        cls: &Bound<'py, PyType>,
+        sections: &str,
+        file: String,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let text = toml_text::experiment_text(&spec_table(sections)?)?;
+        cls.call1((text, file, ".".to_string()))
     }
 
     /// The file name, as given.

@@ -10,8 +10,12 @@
 mod arrays;
 mod errors;
 mod experiment;
+mod input;
 mod jitter;
+mod sampling;
 mod study;
+mod system;
+mod toml_text;
 
 use pyo3::prelude::*;
 
@@ -20,6 +24,12 @@ use pyo3::prelude::*;
 fn _jitterid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<jitter::Jitter>()?;
     m.add_class::<experiment::Experiment>()?;
+    m.add_class::<system::System>()?;
+    m.add_class::<input::Input>()?;
+    m.add_function(wrap_pyfunction!(system::system_kinds, m)?)?;
+    m.add_function(wrap_pyfunction!(sampling::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(sampling::first_moment, m)?)?;
+    m.add_function(wrap_pyfunction!(sampling::second_moment, m)?)?;
     m.add_function(wrap_pyfunction!(jitter::jitter_families, m)?)?;
     m.add_function(wrap_pyfunction!(study::montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(study::merge, m)?)?;

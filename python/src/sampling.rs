@@ -1,0 +1,121 @@
+//! Jittered records of a system and the exact moments of their samples: the library's
+//! simulator (`y_k = s(t_k + τ_k) + v_k`), `m_k = E[s(t_k + τ)]` and
+//! `λ_k = σ_v² + E[s(t_k + τ)²] − m_k²`.
+
+use crate::errors::value_error;
+use crate::input::Input;
+use crate::jitter::Jitter;
+use crate::system::System;
+use jitterid::rand::rngs::StdRng;
+use jitterid::rand::SeedableRng;
+use jitterid::signal::{AnySignal, SampleGrid, Signal};
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The grid `t_k = start + k·interval`, `k < samples`, and the system driven by `input`.
+fn setup(
+    system: &System,
+    input: Option<&Input>,
+    samples: usize,
+    interval: f64,
+    start: f64,
+) -> PyResult<(SampleGrid, AnySignal)> {
+    let grid = SampleGrid::new(start, interval, samples).map_err(value_error)?;
+    let signal = system.driven_by(input.map(|i| &i.input))?;
+    Ok((grid, signal))
+}
+
+/// `samples` jittered samples of `system` driven by `input` at `start + k·interval`, with
+/// white noise of standard deviation `noise_std`, from a generator seeded with `seed`: a dict
+/// of arrays `t`, `y`, `u` (with an input) and with `truth` the drawn `tau` and `v`.
+#[pyfunction]
+#[pyo3(signature = (system, jitter, input, samples, interval, start, noise_std, seed, truth))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    system: &System,
+    jitter: &Jitter,
+    input: Option<&Input>,
+    samples: usize,
+    interval: f64,
+    start: f64,
+    noise_std: f64,
+    seed: u64,
+    truth: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (grid, signal) = setup(system, input, samples, interval, start)?;
+    let sim = py
+        .detach(|| {
+            let mut rng = StdRng::seed_from_u64(seed);
+            jitterid::signal::simulate(
+                signal.model(),
+                jitter.model.model(),
+                &grid,
+                noise_std,
+                &mut rng,
+            )
+        })
+        .map_err(value_error)?;
+    let t: Vec<f64> = grid.times().collect();
+    let out = PyDict::new(py);
+    if let Some(i) = input {
+        let u: Vec<f64> = t.iter().map(|&t| i.input.value(t)).collect();
+        out.set_item("u", u.into_pyarray(py))?;
+    }
+    out.set_item("t", t.into_pyarray(py))?;
+    out.set_item("y", sim.y.into_pyarray(py))?;
+    if truth {
+        out.set_item("tau", sim.tau.into_pyarray(py))?;
+        out.set_item("v", sim.noise.into_pyarray(py))?;
+    }
+    Ok(out)
+}
+
+/// `m_k = E[s(t_k + τ)]` at `t_k = start + k·interval`, exact.
+#[pyfunction]
+pub fn first_moment<'py>(
+    py: Python<'py>,
+    system: &System,
+    jitter: &Jitter,
+    input: Option<&Input>,
+    samples: usize,
+    interval: f64,
+    start: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (grid, signal) = setup(system, input, samples, interval, start)?;
+    let m = py.detach(|| signal.expected_values(&grid, jitter.model.model()));
+    Ok(m.into_pyarray(py))
+}
+
+/// `λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²` at `t_k = start + k·interval`, exact
+/// (the jitter's part clamped at 0 against rounding).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn second_moment<'py>(
+    py: Python<'py>,
+    system: &System,
+    jitter: &Jitter,
+    input: Option<&Input>,
+    samples: usize,
+    interval: f64,
+    start: f64,
+    noise_std: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if !noise_std.is_finite() || noise_std < 0.0 {
+        return Err(value_error(format!(
+            "noise_std: expected a finite number >= 0, found {noise_std}"
+        )));
+    }
+    let (grid, signal) = setup(system, input, samples, interval, start)?;
+    let j = jitter.model.model();
+    let lambda: Vec<f64> = py.detach(|| {
+        let m = signal.expected_values(&grid, j);
+        let s2 = signal.expected_squares(&grid, j);
+        m.iter()
+            .zip(&s2)
+            .map(|(m, s2)| noise_std * noise_std + (s2 - m * m).max(0.0))
+            .collect()
+    });
+    Ok(lambda.into_pyarray(py))
+}

@@ -1,0 +1,243 @@
+//! Systems by kind through the library's `SignalRegistry`, with the export forms of
+//! `jitterid_signal::forms` (transfer function, zeros/poles/gain, state space), the frequency
+//! response and the step response on NumPy arrays.
+
+use crate::arrays::{map_reals, RealsIn};
+use crate::errors::{json_text, spec_table, value_error};
+use jitterid::num_complex::Complex64;
+use jitterid::signal::forms::{TfForm, ZpkForm};
+use jitterid::signal::registry::{SignalRegistry, Spec};
+use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
+use jitterid_cli::export::tf_of;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
+use pyo3::prelude::*;
+use serde_json::{json, Value};
+
+/// A float64 vector out.
+type Reals<'py> = Bound<'py, PyArray1<f64>>;
+/// A complex128 vector out.
+type Complexes<'py> = Bound<'py, PyArray1<Complex64>>;
+/// A float64 matrix out.
+type Matrix<'py> = Bound<'py, PyArray2<f64>>;
+
+/// A system (or signal) kind of the registry with its keys; rational kinds also hold their
+/// transfer-function coefficients.
+#[pyclass(module = "jitterid._jitterid", subclass, frozen, skip_from_py_object)]
+#[derive(Debug, Clone)]
+pub struct System {
+    pub(crate) spec: Spec,
+    /// The model built on a unit step at 0 (kinds that take no input ignore it).
+    model: AnySignal,
+    tf: Option<TfForm>,
+}
+
+impl System {
+    /// The model of `spec`, checked by building it through the registry.
+    pub fn of(spec: Spec) -> PyResult<Self> {
+        let model = build(&spec, Some(&unit_step(1.0)?))?;
+        let tf = tf_of(&model);
+        Ok(System { spec, model, tf })
+    }
+
+    /// The model driven by `input` (`None` for kinds that take none).
+    pub fn driven_by(&self, input: Option<&Input>) -> PyResult<AnySignal> {
+        build(&self.spec, input)
+    }
+
+    fn rational(&self) -> PyResult<&TfForm> {
+        self.tf.as_ref().ok_or_else(|| {
+            value_error(format!(
+                "a {} system is not rational: it has no transfer function",
+                self.model.kind()
+            ))
+        })
+    }
+}
+
+fn build(spec: &Spec, input: Option<&Input>) -> PyResult<AnySignal> {
+    SignalRegistry::builtin()
+        .build(spec, input)
+        .map_err(value_error)
+}
+
+/// `u = 1` from 0 to `end`.
+fn unit_step(end: f64) -> PyResult<Input> {
+    PiecewiseConstant::new(vec![0.0, end], vec![1.0])
+        .map(Input::from)
+        .map_err(value_error)
+}
+
+/// Complex roots as a spec table writes them: a number for a real root, `[re, im]` once per
+/// conjugate pair (the member with `im > 0`; ZpkForm has checked that every pair is whole).
+fn roots_spec(roots: &[Complex64]) -> Value {
+    roots
+        .iter()
+        .filter(|r| r.im >= 0.0)
+        .map(|r| {
+            if r.im == 0.0 {
+                json!(r.re)
+            } else {
+                json!([r.re, r.im])
+            }
+        })
+        .collect()
+}
+
+fn complex_in(py: Python<'_>, x: &Bound<'_, PyAny>) -> PyResult<Vec<Complex64>> {
+    let z = py
+        .import("numpy")?
+        .call_method1("asarray", (x, "complex128"))?;
+    let z: PyReadonlyArrayDyn<'_, Complex64> = z.extract()?;
+    Ok(z.as_array().iter().copied().collect())
+}
+
+#[pymethods]
+impl System {
+    /// The model a spec table describes (JSON text with `"kind"` and the kind's keys).
+    #[new]
+    fn new(spec: &str) -> PyResult<Self> {
+        System::of(spec_table(spec)?)
+    }
+
+    /// `k Π(s − z_i) / Π(s − p_i)` from complex (or real) zeros and poles, conjugate pairs
+    /// listed in full.
+    #[staticmethod]
+    fn from_zpk(
+        py: Python<'_>,
+        zeros: &Bound<'_, PyAny>,
+        poles: &Bound<'_, PyAny>,
+        gain: f64,
+    ) -> PyResult<Self> {
+        let form = ZpkForm::new(gain, complex_in(py, zeros)?, complex_in(py, poles)?)
+            .map_err(value_error)?;
+        let mut spec = Spec::new();
+        spec.insert("kind".into(), "zpk".into());
+        spec.insert("gain".into(), json!(form.gain()));
+        spec.insert("zeros".into(), roots_spec(form.zeros()));
+        spec.insert("poles".into(), roots_spec(form.poles()));
+        System::of(spec)
+    }
+
+    /// The registry name of the kind.
+    #[getter]
+    fn kind(&self) -> String {
+        self.model.kind().to_string()
+    }
+
+    /// The spec table that rebuilds this system, as JSON text.
+    #[getter]
+    fn spec_json(&self) -> PyResult<String> {
+        json_text(&self.model.spec())
+    }
+
+    /// Names of the parameters, in the estimator's order.
+    #[getter]
+    fn param_names(&self) -> Vec<String> {
+        self.model.param_names()
+    }
+
+    /// Values of the parameters, in the order of `param_names`.
+    #[getter]
+    fn param_values(&self) -> Vec<f64> {
+        self.model.params()
+    }
+
+    /// The transfer-function coefficients `(num, den)`, highest power first, `den` monic.
+    fn tf_coefficients<'py>(&self, py: Python<'py>) -> PyResult<(Reals<'py>, Reals<'py>)> {
+        let tf = self.rational()?;
+        Ok((
+            tf.num().to_vec().into_pyarray(py),
+            tf.den().to_vec().into_pyarray(py),
+        ))
+    }
+
+    /// Zeros, poles (complex, conjugate pairs in full) and gain.
+    fn zpk_form<'py>(&self, py: Python<'py>) -> PyResult<(Complexes<'py>, Complexes<'py>, f64)> {
+        let zpk = self.rational()?.to_zpk().map_err(value_error)?;
+        Ok((
+            zpk.zeros().to_vec().into_pyarray(py),
+            zpk.poles().to_vec().into_pyarray(py),
+            zpk.gain(),
+        ))
+    }
+
+    /// The controllable canonical realisation `(A, B, C, D)`: `A` n×n, `B` n×1, `C` 1×n, `D`
+    /// 1×1.
+    fn state_space<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Matrix<'py>, Matrix<'py>, Matrix<'py>, Matrix<'py>)> {
+        let ss = self.rational()?.to_state_space();
+        let n = ss.order();
+        let a = Array2::from_shape_fn((n, n), |(i, j)| ss.a()[i][j]);
+        let b = Array2::from_shape_fn((n, 1), |(i, _)| ss.b()[i]);
+        let c = Array2::from_shape_fn((1, n), |(_, j)| ss.c()[j]);
+        let d = Array2::from_elem((1, 1), ss.d());
+        Ok((
+            a.into_pyarray(py),
+            b.into_pyarray(py),
+            c.into_pyarray(py),
+            d.into_pyarray(py),
+        ))
+    }
+
+    /// `G(i2πf)` at frequencies `f` (Hz).
+    fn frequency_response<'py>(
+        &self,
+        py: Python<'py>,
+        f: RealsIn<'py>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<Complex64>>> {
+        let tf = self.rational()?;
+        Ok(map_reals(py, &f, |f| {
+            tf.response(Complex64::new(0.0, std::f64::consts::TAU * f))
+        }))
+    }
+
+    /// The response to a unit step at `t = 0` at times `t` (s), exact; 0 before the step.
+    fn step<'py>(&self, py: Python<'py>, t: RealsIn<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        self.rational()?;
+        let last = t
+            .as_array()
+            .iter()
+            .copied()
+            .filter(|x| x.is_finite())
+            .fold(0.0_f64, f64::max);
+        let signal = build(&self.spec, Some(&unit_step(last + 1.0)?))?;
+        Ok(map_reals(py, &t, |t| signal.value(t)))
+    }
+
+    fn __repr__(&self) -> String {
+        let keys: Vec<String> = self
+            .model
+            .spec()
+            .iter()
+            .filter(|(k, _)| k.as_str() != "kind")
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        format!("System({:?}, {})", self.model.kind(), keys.join(", "))
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<System>()
+            .is_ok_and(|o| o.get().model.spec() == self.model.spec())
+    }
+}
+
+/// The registry's system kinds with their keys, as JSON text.
+#[pyfunction]
+pub fn system_kinds() -> PyResult<String> {
+    let entries: Vec<Value> = SignalRegistry::builtin()
+        .kinds()
+        .map(|k| {
+            json!({
+                "name": k.name(),
+                "summary": k.summary(),
+                "params": k.params(),
+                "needs_input": k.needs_input(),
+            })
+        })
+        .collect();
+    json_text(&entries)
+}
