@@ -537,6 +537,10 @@ fn fit_ml(
     if let Some(max_seconds) = exp.estimate.max_seconds {
         opts.solver.bfgs.max_seconds = max_seconds;
     }
+    if let Some(hook) = crate::progress::active_fit_hook() {
+        opts.solver.bfgs.progress = Some(hook.clone());
+        opts.solver.brent.progress = Some(hook);
+    }
     let (e, n, base) = if s.noise.is_white() && method.as_str() == "ml" {
         go(exp, s, record, &ExactMl::default(), &opts)?
     } else {

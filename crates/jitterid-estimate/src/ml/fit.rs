@@ -15,7 +15,7 @@ use crate::noise::NoiseModel;
 use crate::objective::{Objective, WithMetric};
 use crate::profile::{best_of, fitted_jitter, Profile};
 use crate::result::{CostKind, Fit};
-use crate::solver::{Brent, BrentOrBfgs, ObjectiveSolver, Transform};
+use crate::solver::{Brent, BrentOrBfgs, ObjectiveSolver, ProgressHook, Transform};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
@@ -253,7 +253,21 @@ pub const PROFILE_MARGIN: f64 = 0.25;
 fn is_default_solver<V: Any>(solver: &V) -> bool {
     (solver as &dyn Any)
         .downcast_ref::<BrentOrBfgs>()
-        .is_some_and(|s| *s == BrentOrBfgs::default())
+        .is_some_and(|s| {
+            // A progress hook only observes: it does not make the solver another one.
+            let mut plain = s.clone();
+            plain.brent.progress = None;
+            plain.bfgs.progress = None;
+            plain == BrentOrBfgs::default()
+        })
+}
+
+/// The progress hook of the default solver's Brent stage, handed on to the staged profile's
+/// own Brent solvers.
+fn brent_hook<V: Any>(solver: &V) -> Option<ProgressHook> {
+    (solver as &dyn Any)
+        .downcast_ref::<BrentOrBfgs>()
+        .and_then(|s| s.brent.progress.clone())
 }
 
 /// Fits `structure` with its jitter replaced by `build(v)` for every `v` in `values`, in
@@ -310,6 +324,7 @@ where
         covariance: false,
         ..options.with_solver(Brent {
             tolerance: 3e-3,
+            progress: brent_hook(&options.solver),
             ..Brent::default()
         })
     };
@@ -340,6 +355,7 @@ where
             .fold(f64::INFINITY, f64::min);
         let fine = options.with_solver(Brent {
             bracket_step: 0.01,
+            progress: brent_hook(&options.solver),
             ..Brent::default()
         });
         let fine = MlOptions {

@@ -197,6 +197,7 @@ pub fn sine_least_squares(record: &Record) -> Result<SineLs, MlError> {
         bracket_step: 0.25 * df,
         tolerance: 1e-9 * df,
         max_iters: 200,
+        ..Brent::default()
     };
     let report = brent
         .minimize(&Rss(record), &[f_peak])

@@ -7,6 +7,7 @@
 //! Hessian stays positive definite. The objective may offer an initial inverse Hessian
 //! ([`Objective::initial_metric`]), for example the inverse of the expected information.
 
+use super::progress::{Progress, ProgressHook};
 use super::{Solver, SolverError, SolverReport, Termination};
 use crate::objective::{check_objective_start, Objective};
 use serde::{Deserialize, Serialize};
@@ -31,6 +32,10 @@ pub struct Bfgs {
     /// [`Termination::TimeLimit`] once it is spent. Default 600; `f64::INFINITY` for none.
     #[serde(default = "default_max_seconds")]
     pub max_seconds: f64,
+    /// Receives the iteration and cost after the start's evaluation and after every
+    /// iteration, when set (a front end's progress line; not serialised).
+    #[serde(skip)]
+    pub progress: Option<ProgressHook>,
 }
 
 fn default_max_seconds() -> f64 {
@@ -46,6 +51,7 @@ impl Default for Bfgs {
             cost_tol: 1e-14,
             initial_step: 0.2,
             max_seconds: default_max_seconds(),
+            progress: None,
         }
     }
 }
@@ -133,6 +139,16 @@ impl Bfgs {
         let mut small_changes = 0;
         let mut iterations = 0;
         let started = std::time::Instant::now();
+        let report = |iteration: u64, cost: f64| {
+            if let Some(hook) = &self.progress {
+                hook.report(&Progress {
+                    iteration,
+                    cost,
+                    elapsed_seconds: started.elapsed().as_secs_f64(),
+                });
+            }
+        };
+        report(0, f);
         let termination = loop {
             if iterations >= self.max_iters {
                 break Termination::MaxIterations;
@@ -207,6 +223,7 @@ impl Bfgs {
             x = xt;
             f = ft;
             g = gt;
+            report(iterations, f);
             if sy > 1e-12 * dot(&s, &s).sqrt() * dot(&yv, &yv).sqrt() {
                 if !updated {
                     let yy = dot(&yv, &yv);

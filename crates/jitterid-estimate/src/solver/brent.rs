@@ -5,6 +5,7 @@
 //! integer profile of a Table 1 record costs about 20 likelihood evaluations per value.
 
 use super::bfgs::Bfgs;
+use super::progress::{ProgressHook, ProgressObserver};
 use super::{Solver, SolverError, SolverReport, Termination};
 use crate::objective::{check_objective_start, Objective};
 use argmin::core::{CostFunction, Error, Executor, IterState};
@@ -20,6 +21,10 @@ pub struct Brent {
     pub tolerance: f64,
     /// Iteration limit of Brent's method (and of the bracket's growth). Default 100.
     pub max_iters: u64,
+    /// Receives the iteration and cost of Brent's method (after the bracket is found), when
+    /// set (a front end's progress line; not serialised).
+    #[serde(skip)]
+    pub progress: Option<ProgressHook>,
 }
 
 impl Default for Brent {
@@ -28,6 +33,7 @@ impl Default for Brent {
             bracket_step: 0.1,
             tolerance: 1e-8,
             max_iters: 100,
+            progress: None,
         }
     }
 }
@@ -115,9 +121,19 @@ impl Brent {
         }
         let (lo, hi) = if a < c { (a, c) } else { (c, a) };
         let solver = BrentOpt::new(lo, hi).set_tolerance(f64::EPSILON.sqrt(), self.tolerance);
-        let result = Executor::new(Scalar(objective), solver)
+        let mut executor = Executor::new(Scalar(objective), solver)
             .configure(|s: IterState<f64, (), (), (), (), f64>| s.max_iters(self.max_iters))
-            .ctrlc(false)
+            .ctrlc(false);
+        if let Some(hook) = &self.progress {
+            executor = executor.add_observer(
+                ProgressObserver {
+                    hook: hook.clone(),
+                    started: std::time::Instant::now(),
+                },
+                argmin::core::observers::ObserverMode::Always,
+            );
+        }
+        let result = executor
             .run()
             .map_err(|e| SolverError::Argmin(e.to_string()))?;
         let state = result.state;

@@ -10,7 +10,8 @@ use std::sync::Arc;
 pub struct Progress {
     /// Iterations done (accepted steps; 0 after the start's evaluation).
     pub iteration: u64,
-    /// Cost `½ Σ rᵢ²` at the current point.
+    /// The solver's cost at the current point: `½ Σ rᵢ²` for least squares, the criterion's
+    /// value (a negative log-likelihood) for the likelihood solvers.
     pub cost: f64,
     /// Seconds since the run started.
     pub elapsed_seconds: f64,
@@ -37,6 +38,13 @@ impl ProgressHook {
     /// Calls the hook.
     pub fn report(&self, progress: &Progress) {
         (self.0)(progress);
+    }
+}
+
+/// Two hooks are equal when they share the same callback (so options holding a hook compare).
+impl PartialEq for ProgressHook {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
     }
 }
 
