@@ -346,46 +346,7 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
 
     let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
-        // The naive LS fit of the system for comparison (when the system is estimated).
-        let ls = if exp.system.estimate && method != Method::LS {
-            let record = fitting::record(&exp.grid, y.clone())
-                .map_err(|e| cli_err!("{}: {e}", table.name))?;
-            let mut ls_exp = exp.clone();
-            ls_exp.jitter.estimate = false;
-            ls_exp.noise.estimate = false;
-            fitting::structure(&ls_exp, signal.clone(), Method::LS)
-                .ok()
-                .and_then(|ls_s| fitting::fit(&ls_exp, &ls_s, &record, Method::LS, 0, false).ok())
-                .map(|f| f.fitted)
-        } else if method == Method::LS {
-            Some(f.fitted.clone())
-        } else {
-            None
-        };
-        let main_label = if method == Method::LS {
-            "naive LS"
-        } else {
-            method.as_str()
-        };
-        let figs = plots::fit_figures(&plots::FitPlots {
-            exp: &exp,
-            y: &y,
-            input: input.as_ref(),
-            file_model: &signal,
-            ls: if method == Method::LS {
-                None
-            } else {
-                ls.as_ref()
-            },
-            main: (main_label, &f.fitted),
-            tau: table.optional("tau"),
-        })?;
-        let mut outputs = OutputSet::new();
-        outputs.dir(dir);
-        for (name, svg) in figs {
-            outputs.file(&dir.join(name), svg);
-        }
-        outputs.commit()?;
+        write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &y, &table)?;
     }
 
     if o.json {
@@ -396,11 +357,72 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
             })
             .map_err(|e| cli_err!("JSON: {e}"));
     }
+    let out = fit_text(&exp, &f, &table.name, o.plot.as_deref());
+    Ok(Outcome { text: out, status })
+}
+
+/// The figures of `fit --plot DIR`, written as one set (the naive LS fit beside the method's).
+fn write_fit_figures(
+    dir: &Path,
+    exp: &Experiment,
+    f: &Fit,
+    signal: &AnySignal,
+    input: Option<&Input>,
+    y: &[f64],
+    table: &csvio::Table,
+) -> CliResult<()> {
+    let method = exp.estimate.method;
+    // The naive LS fit of the system for comparison (when the system is estimated).
+    let ls = if exp.system.estimate && method != Method::LS {
+        let record =
+            fitting::record(&exp.grid, y.to_vec()).map_err(|e| cli_err!("{}: {e}", table.name))?;
+        let mut ls_exp = exp.clone();
+        ls_exp.jitter.estimate = false;
+        ls_exp.noise.estimate = false;
+        fitting::structure(&ls_exp, signal.clone(), Method::LS)
+            .ok()
+            .and_then(|ls_s| fitting::fit(&ls_exp, &ls_s, &record, Method::LS, 0, false).ok())
+            .map(|f| f.fitted)
+    } else if method == Method::LS {
+        Some(f.fitted.clone())
+    } else {
+        None
+    };
+    let main_label = if method == Method::LS {
+        "naive LS"
+    } else {
+        method.as_str()
+    };
+    let figs = plots::fit_figures(&plots::FitPlots {
+        exp,
+        y,
+        input,
+        file_model: signal,
+        ls: if method == Method::LS {
+            None
+        } else {
+            ls.as_ref()
+        },
+        main: (main_label, &f.fitted),
+        tau: table.optional("tau"),
+    })?;
+    let mut outputs = OutputSet::new();
+    outputs.dir(dir);
+    for (name, svg) in figs {
+        outputs.file(&dir.join(name), svg);
+    }
+    outputs.commit()?;
+    Ok(())
+}
+
+/// The human-readable report of `fit`.
+fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> String {
+    let method = exp.estimate.method;
     let mut out = String::new();
     let _ = writeln!(
         out,
         "fit of {} with {} ({})",
-        table.name,
+        name,
         method.as_str(),
         exp.file
     );
@@ -443,14 +465,14 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
             p.stderr.map_or("–".into(), fmt_num)
         );
     }
-    if let Some(dir) = &o.plot {
+    if let Some(dir) = plot {
         let _ = writeln!(
             out,
             "figures in {}: bode.svg (rational systems), spectrum.svg, moment.svg, jitter-pdf.svg",
             dir.display()
         );
     }
-    Ok(Outcome { text: out, status })
+    out
 }
 
 // ---------------------------------------------------------------------------------------------
