@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from typing import Any, Mapping
+from typing import Any, Dict, Mapping
 
 import numpy as np
 
@@ -35,3 +35,23 @@ def spec_json(table: Mapping[str, Any]) -> str:
         return json.dumps(plain, allow_nan=False)
     except (TypeError, ValueError) as e:
         raise TypeError(f"spec table: {e}") from None
+
+
+class SpecTable:
+    """What a registry object (a jitter model, a system) shows of its spec table: mixed into
+    the Python classes over the extension's, which provide ``param_names``, ``param_values``
+    and ``spec_json``."""
+
+    param_names: Any
+    param_values: Any
+    spec_json: str
+
+    @property
+    def params(self) -> Dict[str, float]:
+        """The (continuous) parameters by name, in the estimator's order."""
+        return dict(zip(self.param_names, self.param_values))
+
+    @property
+    def spec(self) -> Dict[str, Any]:
+        """The spec table that rebuilds this object (``from_name(**spec)``)."""
+        return json.loads(self.spec_json)

@@ -18,23 +18,13 @@ import json
 from typing import Any, Dict, List
 
 from . import _jitterid
-from ._spec import spec_json
+from ._spec import SpecTable, spec_json
 
 __all__ = ["Jitter", "from_name", "from_std", "families"]
 
 
-class Jitter(_jitterid.Jitter):
+class Jitter(SpecTable, _jitterid.Jitter):
     """A jitter model built from the registry (see ``from_name``)."""
-
-    @property
-    def params(self) -> Dict[str, float]:
-        """The continuous parameters by name."""
-        return dict(zip(self.param_names, self.param_values))
-
-    @property
-    def spec(self) -> Dict[str, Any]:
-        """The spec table that rebuilds this model (``from_name(**spec)``)."""
-        return json.loads(self.spec_json)
 
     def __reduce__(self) -> Any:
         # By spec table, so that Dask and multiprocessing can ship models.

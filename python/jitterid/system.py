@@ -15,12 +15,12 @@ from typing import Any, Dict, List, Tuple
 import numpy as np
 
 from . import _jitterid
-from ._spec import spec_json
+from ._spec import SpecTable, spec_json
 
 __all__ = ["System", "from_name", "kinds"]
 
 
-class System(_jitterid.System):
+class System(SpecTable, _jitterid.System):
     """A system of the library's registry (``from_name``), driven by a known input."""
 
     @staticmethod
@@ -37,16 +37,6 @@ class System(_jitterid.System):
     def names(self) -> List[str]:
         """Names of the parameters, in the estimator's order."""
         return list(self.param_names)
-
-    @property
-    def params(self) -> Dict[str, float]:
-        """The parameters by name."""
-        return dict(zip(self.param_names, self.param_values))
-
-    @property
-    def spec(self) -> Dict[str, Any]:
-        """The spec table that rebuilds this system (``from_name(**spec)``)."""
-        return json.loads(self.spec_json)
 
     def to_tf(self) -> "System":
         """The same system in coefficient form."""

@@ -56,43 +56,35 @@ fn validate_reports_verdicts_and_refuses_bad_input() {
         stdout(&run(&["fit", &exp, "--data", s(&data), "--json"])).replace("\"gain\"", "\"k\""),
     )
     .unwrap();
-    let o = run(&["validate", &exp, "--data", s(&data), "--model", s(&wrong)]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("do not match"), "{}", stderr(&o));
+    let validate = |model: &std::path::Path, validation: Option<&std::path::Path>| {
+        let mut args = vec![
+            "validate",
+            exp.as_str(),
+            "--data",
+            s(&data),
+            "--model",
+            s(model),
+        ];
+        if let Some(v) = validation {
+            args.extend(["--validation", s(v)]);
+        }
+        run(&args)
+    };
+    let refused = |o: std::process::Output, needle: &str| {
+        assert_eq!(o.status.code(), Some(2));
+        assert!(stderr(&o).contains(needle), "{}", stderr(&o));
+    };
+    refused(validate(&wrong, None), "do not match");
     // Malformed JSON.
     std::fs::write(&wrong, "{").unwrap();
-    let o = run(&["validate", &exp, "--data", s(&data), "--model", s(&wrong)]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("fit --json"), "{}", stderr(&o));
+    refused(validate(&wrong, None), "fit --json");
     // A validation record with another T, and one too short.
     let short = dir.join("short.csv");
     std::fs::write(&short, "t,y\n0,1\n2,2\n4,3\n").unwrap();
-    let o = run(&[
-        "validate",
-        &exp,
-        "--data",
-        s(&data),
-        "--model",
-        s(&fit),
-        "--validation",
-        s(&short),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("too short"), "{}", stderr(&o));
+    refused(validate(&fit, Some(&short)), "too short");
     let rows: String = (0..40)
         .map(|k| format!("{},{}\n", 2.0 * k as f64, k))
         .collect();
     std::fs::write(&short, format!("t,y\n{rows}")).unwrap();
-    let o = run(&[
-        "validate",
-        &exp,
-        "--data",
-        s(&data),
-        "--model",
-        s(&fit),
-        "--validation",
-        s(&short),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("interval"), "{}", stderr(&o));
+    refused(validate(&fit, Some(&short)), "interval");
 }

@@ -41,15 +41,7 @@ impl TryFrom<RawRecord> for Record {
 impl Record {
     /// Validates that `y` has one finite value per instant of `grid`.
     pub fn new(grid: SampleGrid, y: Vec<f64>) -> Result<Self, EstimateError> {
-        if y.len() != grid.len() {
-            return Err(EstimateError::DataLength {
-                expected: grid.len(),
-                got: y.len(),
-            });
-        }
-        if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(EstimateError::NonFiniteData { index, value });
-        }
+        check_samples(&grid, &y)?;
         Ok(Self {
             grid,
             y: Arc::new(y),
@@ -65,4 +57,19 @@ impl Record {
     pub fn y(&self) -> &[f64] {
         &self.y
     }
+}
+
+/// `y` holds one finite value per instant of `grid` (what [`Record::new`] checks, for callers
+/// that borrow the samples).
+pub(crate) fn check_samples(grid: &SampleGrid, y: &[f64]) -> Result<(), EstimateError> {
+    if y.len() != grid.len() {
+        return Err(EstimateError::DataLength {
+            expected: grid.len(),
+            got: y.len(),
+        });
+    }
+    if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(EstimateError::NonFiniteData { index, value });
+    }
+    Ok(())
 }

@@ -34,15 +34,7 @@ where
     J: JitterModel + Clone,
     N: NoiseModel,
 {
-    if y.len() != grid.len() {
-        return Err(EstimateError::DataLength {
-            expected: grid.len(),
-            got: y.len(),
-        });
-    }
-    if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        return Err(EstimateError::NonFiniteData { index, value });
-    }
+    crate::data::check_samples(grid, y)?;
     let moments = second_moments(structure, grid, noise_std, false)?;
     if let Some((index, &variance)) = moments
         .variance
