@@ -64,8 +64,7 @@ class Experiment(_jitterid.Experiment):
         result as ``jitterid fit --json``. The GIL is released while fitting."""
         if not isinstance(record, Mapping) or "y" not in record:
             raise TypeError("record: expected a mapping with at least `y` (as simulate returns)")
-        text = self.fit_json(record["y"], record.get("input_t"), record.get("input_u"), method)
-        return FitResult(json.loads(text))
+        return FitResult._of(self.fit_record(record["y"], record.get("input_t"), record.get("input_u"), method))
 
 
 def montecarlo(

@@ -69,13 +69,28 @@ class Experiment:
     @classmethod
     def from_sections(cls, sections: str, file: str) -> Experiment:
         """The experiment whose sections are the tables of ``sections`` (JSON text)."""
-    def fit_json(
+    def fit_record(
         self,
         y: npt.ArrayLike,
         input_t: Optional[npt.ArrayLike] = None,
         input_u: Optional[npt.ArrayLike] = None,
         method: Optional[str] = None,
-    ) -> str: ...
+    ) -> Fit:
+        """Fits the samples ``y`` (with the random input's realisation) as ``jitterid fit``."""
+
+class Fit:
+    """One fit as the library returns it (``jitterid.FitResult`` reads it)."""
+
+    def fields(
+        self,
+    ) -> Tuple[
+        str, bool, float, int, str, float, list[str], npt.NDArray[np.float64], npt.NDArray[np.float64], list[str],
+        Optional[npt.NDArray[np.float64]],
+    ]:
+        """``(method, converged, cost, iterations, termination, noise_std, names, params, std_errors,
+        covariance_names, covariance)``."""
+    def json(self) -> str:
+        """``jitterid fit --json`` with ``fitted_model``, ``estimated``, ``estimator_covariance``."""
 
 def jitter_families() -> str: ...
 def montecarlo(

@@ -6,6 +6,7 @@ Both keep the command line's JSON (``to_dict()``) and pickle through it, so Dask
 from __future__ import annotations
 
 import copy
+import json
 from typing import Any, Dict, List, Optional
 
 import numpy as np
@@ -28,7 +29,8 @@ class FitResult:
     _EXTRA = ("fitted_model", "estimated", "estimator_covariance")
 
     def __init__(self, data: Dict[str, Any]) -> None:
-        self._data = data
+        self._data: Optional[Dict[str, Any]] = data
+        self._fit: Any = None
         self.method: str = data["method"]
         self.converged: bool = data["converged"]
         self.cost: float = data["cost"]
@@ -44,7 +46,28 @@ class FitResult:
         cov = data.get("estimator_covariance")
         self.covariance_names: List[str] = list(data.get("estimated", []))
         self.covariance: Optional[np.ndarray] = None if cov is None else np.array(cov, dtype=float)
-        self.model: Dict[str, Any] = data["fitted_model"]
+
+    @classmethod
+    def _of(cls, fit: Any) -> "FitResult":
+        """The result of the library's fit ``fit`` (``_jitterid.Fit``): its numbers now, the
+        command line's JSON when first wanted."""
+        self = cls.__new__(cls)
+        self._data = None
+        self._fit = fit
+        (self.method, self.converged, self.cost, self.iterations, self.termination, self.noise_std,
+         self.names, self.params, self.std_errors, self.covariance_names, self.covariance) = fit.fields()
+        return self
+
+    def _json(self) -> Dict[str, Any]:
+        if self._data is None:
+            self._data = json.loads(self._fit.json())
+        return self._data
+
+    @property
+    def model(self) -> Dict[str, Any]:
+        """The fitted model: spec tables of the ``signal`` and the ``jitter``, the ``noise``
+        parameters and ``noise_std``."""
+        return self._json()["fitted_model"]
 
     @property
     def jitter(self):
@@ -64,14 +87,14 @@ class FitResult:
     def to_dict(self, model: bool = False) -> Dict[str, Any]:
         """The command line's ``fit --json`` output (with the fitted model and the covariance
         if ``model``)."""
-        d = copy.deepcopy(self._data)
+        d = copy.deepcopy(self._json())
         if not model:
             for key in self._EXTRA:
                 d.pop(key, None)
         return d
 
     def __reduce__(self) -> Any:
-        return (FitResult, (self._data,))
+        return (FitResult, (self._json(),))
 
     def __repr__(self) -> str:
         rows = ", ".join(f"{n}={v:.6g}" for n, v in zip(self.names, self.params))

@@ -5,12 +5,13 @@ use crate::arrays::{finite_samples, SamplesIn};
 use crate::errors::{json_text, spec_table, value_error};
 use crate::toml_text;
 use jitterid::signal::Input;
+use jitterid::signal::{PiecewiseConstant, SampleGrid};
 use jitterid_cli::commands::{self, DEFAULT_SEED};
 use jitterid_cli::csvio;
 use jitterid_cli::experiment::{self, InputSpec, Method, Purpose};
 use jitterid_cli::fingerprint::experiment_fingerprint;
 use jitterid_cli::{fitting, inputs};
-use numpy::IntoPyArray;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
@@ -202,16 +203,16 @@ impl Experiment {
 
     /// Fits the samples `y` (with the record's input switch times and levels `input_t`,
     /// `input_u` for a random-binary experiment) with `method` (the file's if `None`), as
-    /// `jitterid fit --json` does; returns the result as JSON text.
+    /// `jitterid fit` does; the GIL is released while fitting.
     #[pyo3(signature = (y, input_t = None, input_u = None, method = None))]
-    fn fit_json(
+    fn fit_record(
         &self,
         py: Python<'_>,
         y: SamplesIn<'_>,
         input_t: Option<SamplesIn<'_>>,
         input_u: Option<SamplesIn<'_>>,
         method: Option<&str>,
-    ) -> PyResult<String> {
+    ) -> PyResult<Fit> {
         let exp = self.for_method(method)?;
         let y = finite_samples(&y, "y")?;
         if y.len() != exp.grid.len() {
@@ -230,40 +231,14 @@ impl Experiment {
                         "input: the experiment's input is random-binary, so the fit needs the record's input realisation (input_t and input_u, as simulate returns them)",
                     ));
                 };
-                let values = vec![
-                    finite_samples(&t, "input_t")?,
-                    finite_samples(&u, "input_u")?,
-                ];
-                let table = csvio::Table {
-                    name: "input".into(),
-                    header_line: 1,
-                    columns: vec!["t".into(), "u".into()],
-                    lines: (2..2 + values[0].len()).collect(),
-                    values,
-                };
-                if table.values[0].len() != table.values[1].len() {
-                    return Err(value_error(format!(
-                        "input_t and input_u: expected equal lengths, found {} and {}",
-                        table.values[0].len(),
-                        table.values[1].len()
-                    )));
-                }
-                let p = inputs::piecewise_from_table(&table, "t", "u", &exp.grid)
-                    .map_err(value_error)?;
-                Some(Input::Piecewise(p))
+                Some(Input::Piecewise(realisation(&t, &u, &exp.grid)?))
             }
         };
         let fit = py.detach(|| {
             let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
             commands::fit_values(&exp, signal, y, "y")
         });
-        let fit = fit.map_err(value_error)?;
-        json_text(&FitOut {
-            cli: commands::fit_json(&fit),
-            fitted_model: Model::of(&fit.fitted),
-            estimated: &fit.estimated,
-            estimator_covariance: fit.estimator_covariance.as_deref(),
-        })
+        fit.map(|fit| Fit { fit }).map_err(value_error)
     }
 
     fn __getnewargs__(&self) -> (String, String, String) {
@@ -276,6 +251,104 @@ impl Experiment {
 
     fn __repr__(&self) -> String {
         format!("Experiment.from_toml({:?})", self.exp.file)
+    }
+}
+
+/// The random input's realisation from its switch times `t` and levels `u` (the side file's
+/// columns, levels closed by a 0), checked as `jitterid fit` checks the side file.
+fn realisation(
+    t: &SamplesIn<'_>,
+    u: &SamplesIn<'_>,
+    grid: &SampleGrid,
+) -> PyResult<PiecewiseConstant> {
+    let values = vec![finite_samples(t, "input_t")?, finite_samples(u, "input_u")?];
+    if values[0].len() != values[1].len() {
+        return Err(value_error(format!(
+            "input_t and input_u: expected equal lengths, found {} and {}",
+            values[0].len(),
+            values[1].len()
+        )));
+    }
+    let table = csvio::Table {
+        name: "input".into(),
+        header_line: 1,
+        columns: vec!["t".into(), "u".into()],
+        lines: (2..2 + values[0].len()).collect(),
+        values,
+    };
+    inputs::piecewise_from_table(&table, "t", "u", grid).map_err(value_error)
+}
+
+/// One fit as the library returns it. `FitResult` takes its numbers from [`Fit::fields`] and
+/// asks for the command line's JSON ([`Fit::json`]) only when it is wanted (`to_dict`,
+/// `model`, pickling): forming it costs more than the rest of the result.
+#[pyclass(module = "jitterid._jitterid", frozen, skip_from_py_object)]
+pub struct Fit {
+    fit: fitting::Fit,
+}
+
+#[pymethods]
+impl Fit {
+    /// `(method, converged, cost, iterations, termination, noise_std, names, params,
+    /// std_errors, covariance_names, covariance)`: the reported parameters' names, estimates
+    /// and standard errors (NaN where undefined), and the estimator's covariance (`None` where
+    /// undefined) of the estimated parameters `covariance_names`, in the estimator's order.
+    #[allow(clippy::type_complexity)]
+    fn fields<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        &'static str,
+        bool,
+        f64,
+        u64,
+        &str,
+        f64,
+        Vec<String>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Vec<String>,
+        Option<Bound<'py, PyArray2<f64>>>,
+    )> {
+        let f = &self.fit;
+        let names = f.params.iter().map(|p| p.name.clone()).collect();
+        let params: Vec<f64> = f.params.iter().map(|p| p.estimate).collect();
+        let std_errors: Vec<f64> = f
+            .params
+            .iter()
+            .map(|p| p.stderr.unwrap_or(f64::NAN))
+            .collect();
+        let covariance = f
+            .estimator_covariance
+            .as_ref()
+            .map(|c| PyArray2::from_vec2(py, c))
+            .transpose()
+            .map_err(|e| value_error(format!("covariance: {e}")))?;
+        Ok((
+            f.method.as_str(),
+            f.converged,
+            f.cost,
+            f.iterations,
+            &f.termination,
+            f.noise_std,
+            names,
+            params.into_pyarray(py),
+            std_errors.into_pyarray(py),
+            f.estimated.clone(),
+            covariance,
+        ))
+    }
+
+    /// The result as `jitterid fit --json` prints it, with the fitted model's parts as spec
+    /// tables (`fitted_model`), and `estimated` and `estimator_covariance`, as JSON text.
+    fn json(&self) -> PyResult<String> {
+        let fit = &self.fit;
+        json_text(&FitOut {
+            cli: commands::fit_json(fit),
+            fitted_model: Model::of(&fit.fitted),
+            estimated: &fit.estimated,
+            estimator_covariance: fit.estimator_covariance.as_deref(),
+        })
     }
 }
 

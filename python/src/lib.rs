@@ -24,6 +24,7 @@ use pyo3::prelude::*;
 fn _jitterid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<jitter::Jitter>()?;
     m.add_class::<experiment::Experiment>()?;
+    m.add_class::<experiment::Fit>()?;
     m.add_class::<system::System>()?;
     m.add_class::<input::Input>()?;
     m.add_function(wrap_pyfunction!(system::system_kinds, m)?)?;

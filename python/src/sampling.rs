@@ -6,6 +6,7 @@ use crate::errors::value_error;
 use crate::input::Input;
 use crate::jitter::Jitter;
 use crate::system::System;
+use jitterid::estimate::ml::second_moments_of;
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::SeedableRng;
 use jitterid::signal::{AnySignal, SampleGrid, Signal};
@@ -89,7 +90,7 @@ pub fn first_moment<'py>(
 }
 
 /// `λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²` at `t_k = start + k·interval`, exact
-/// (the jitter's part clamped at 0 against rounding).
+/// (the jitter's part clamped at 0 against rounding), by the library's `second_moments_of`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn second_moment<'py>(
@@ -108,14 +109,8 @@ pub fn second_moment<'py>(
         )));
     }
     let (grid, signal) = setup(system, input, samples, interval, start)?;
-    let j = jitter.model.model();
-    let lambda: Vec<f64> = py.detach(|| {
-        let m = signal.expected_values(&grid, j);
-        let s2 = signal.expected_squares(&grid, j);
-        m.iter()
-            .zip(&s2)
-            .map(|(m, s2)| noise_std * noise_std + (s2 - m * m).max(0.0))
-            .collect()
-    });
-    Ok(lambda.into_pyarray(py))
+    let moments = py
+        .detach(|| second_moments_of(&signal, jitter.model.model(), &grid, noise_std))
+        .map_err(value_error)?;
+    Ok(moments.variance.into_pyarray(py))
 }

@@ -124,6 +124,65 @@ fn exact_likelihood_matches_brute_force() {
     }
 }
 
+#[test]
+fn second_moments_of_a_bare_signal_is_the_structures_and_the_formula() {
+    // The signal-level route against the structure-level one (which now calls it) and against
+    // `λ_k = σ_v² + max(E[s²] − m², 0)` written out from the signal's own exact moments.
+    let n = 60;
+    let signal = table1_signal(5, n);
+    let grid = SampleGrid::new(0.25, 1.0, n).unwrap();
+    let sigma = 0.03;
+    let jitters: [Box<dyn JitterModel>; 2] = [
+        Box::new(UniformSum::new(2, 0.4).unwrap()),
+        Box::new(Gaussian::new(0.2).unwrap()),
+    ];
+    for jitter in &jitters {
+        let bare = second_moments_of(&signal, jitter.as_ref(), &grid, sigma).unwrap();
+        let m = signal.expected_values(&grid, jitter.as_ref());
+        let s2 = signal.expected_squares(&grid, jitter.as_ref());
+        let by_hand: Vec<f64> = m
+            .iter()
+            .zip(&s2)
+            .map(|(m, s2)| sigma * sigma + (s2 - m * m).max(0.0))
+            .collect();
+        assert_eq!(bare.mean, m);
+        assert_eq!(bare.variance, by_hand);
+        assert_eq!(bare.noise_std, sigma);
+        assert!(bare.names.is_empty() && bare.mean_gradient.is_none());
+        assert!(
+            bare.jitter_variance.iter().any(|&v| v > 1e-4),
+            "the jitter matters here"
+        );
+        for (v, j) in bare.variance.iter().zip(&bare.jitter_variance) {
+            assert_eq!(*v, j + sigma * sigma);
+        }
+    }
+    let jitter = UniformSum::new(2, 0.4).unwrap();
+    let structure = ModelStructure::oe(signal.clone(), jitter);
+    let whole = second_moments(&structure, &grid, sigma, false).unwrap();
+    let bare = second_moments_of(&signal, &jitter, &grid, sigma).unwrap();
+    assert_eq!(
+        (
+            &bare.mean,
+            &bare.jitter_variance,
+            &bare.variance,
+            bare.noise_std
+        ),
+        (
+            &whole.mean,
+            &whole.jitter_variance,
+            &whole.variance,
+            whole.noise_std
+        )
+    );
+    for bad in [-0.1, f64::NAN, f64::INFINITY] {
+        assert!(
+            second_moments_of(&signal, &jitter, &grid, bad).is_err(),
+            "{bad}"
+        );
+    }
+}
+
 /// A standard normal draw (Box–Muller).
 fn normal(rng: &mut StdRng) -> f64 {
     let u: f64 = rng.random::<f64>().max(1e-300);

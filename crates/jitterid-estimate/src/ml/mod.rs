@@ -5,7 +5,8 @@
 //! variance `λ_k = σ_v² + E[s(t_k+τ)²] − m_k²` carries much more, because it is large exactly
 //! where the signal moves fast (`docs/method.md`, "Second moments"). This module uses it:
 //!
-//! * [`second_moments`]: `m_k`, `λ_k` and their gradients; [`dtft_covariance`]: the covariance
+//! * [`second_moments`]: `m_k`, `λ_k` and their gradients ([`second_moments_of`]: of a bare
+//!   signal, without gradients); [`dtft_covariance`]: the covariance
 //!   of the residual DTFT over a frequency set that follows from them.
 //! * Two [`LikelihoodCriterion`]s: [`QuasiMl`], the Gaussian likelihood of the first two
 //!   moments (white or Box–Jenkins noise), and [`ExactMl`], the exact likelihood
@@ -85,7 +86,8 @@ pub use fisher::{
 };
 pub use fit::{ml_estimate, ml_profile, MlOptions, PROFILE_MARGIN};
 pub use moments::{
-    dtft_covariance, expected_squares_gradient, second_moments, DtftCovariance, SecondMoments,
+    dtft_covariance, expected_squares_gradient, second_moments, second_moments_of, DtftCovariance,
+    SecondMoments,
 };
 pub use objective::{LikelihoodObjective, TransformedObjective};
 pub use param::{default_transforms, likelihood_param_names, likelihood_params, NOISE_STD_NAME};

@@ -78,15 +78,53 @@ pub fn expected_squares_gradient<S: Signal + ?Sized>(
 }
 
 /// `(m, E[s²])` of the structure's signal under its jitter.
-fn moments_of<S: Signal, J: JitterModel>(
+fn moments_of<S: Signal + ?Sized>(
     signal: &S,
-    jitter: &J,
+    jitter: &dyn JitterModel,
     grid: &SampleGrid,
 ) -> (Vec<f64>, Vec<f64>) {
     (
         signal.expected_values(grid, jitter),
         signal.expected_squares(grid, jitter),
     )
+}
+
+/// The first two moments of every sample of `grid` for `signal` under `jitter` with
+/// measurement-noise level `noise_std`: `m_k`, the jitter's part `E[s²] − m_k²` (clamped at 0
+/// against rounding) and `λ_k`, without gradients (`names` is empty). The one place `λ_k` is
+/// formed: [`second_moments`] and the bindings call it.
+///
+/// # Errors
+///
+/// A negative or non-finite noise level.
+pub fn second_moments_of<S: Signal + ?Sized>(
+    signal: &S,
+    jitter: &dyn JitterModel,
+    grid: &SampleGrid,
+    noise_std: f64,
+) -> Result<SecondMoments, MlError> {
+    if !(noise_std.is_finite() && noise_std >= 0.0) {
+        return Err(crate::EstimateError::BadNoiseStd { value: noise_std }.into());
+    }
+    let (mean, sq) = moments_of(signal, jitter, grid);
+    let jitter_variance: Vec<f64> = sq
+        .iter()
+        .zip(&mean)
+        .map(|(s, m)| (s - m * m).max(0.0))
+        .collect();
+    let variance = jitter_variance
+        .iter()
+        .map(|v| v + noise_std * noise_std)
+        .collect();
+    Ok(SecondMoments {
+        mean,
+        jitter_variance,
+        variance,
+        noise_std,
+        names: Vec::new(),
+        mean_gradient: None,
+        variance_gradient: None,
+    })
 }
 
 /// The second moments of every sample of `grid` under `structure`, with measurement-noise
@@ -112,16 +150,8 @@ where
     N: NoiseModel,
 {
     let sigma = structure.noise_std.unwrap_or(noise_std);
-    if !(sigma.is_finite() && sigma >= 0.0) {
-        return Err(crate::EstimateError::BadNoiseStd { value: sigma }.into());
-    }
-    let (m, sq) = moments_of(&structure.signal, &structure.jitter, grid);
-    let jv: Vec<f64> = sq
-        .iter()
-        .zip(&m)
-        .map(|(s, m)| (s - m * m).max(0.0))
-        .collect();
-    let variance: Vec<f64> = jv.iter().map(|v| v + sigma * sigma).collect();
+    let moments = second_moments_of(&structure.signal, &structure.jitter, grid, sigma)?;
+    let m = &moments.mean;
     let layout = Layout::of(structure);
     let names = super::likelihood_param_names(structure);
     let (mean_gradient, variance_gradient) = if gradient {
@@ -181,13 +211,10 @@ where
         (None, None)
     };
     Ok(SecondMoments {
-        mean: m,
-        jitter_variance: jv,
-        variance,
-        noise_std: sigma,
         names,
         mean_gradient,
         variance_gradient,
+        ..moments
     })
 }
 
