@@ -104,7 +104,7 @@ def _grid(samples: int, interval: float, start: float) -> tuple:
     return int(samples), float(interval), float(start)
 
 
-def simulate(system: System, jitter: "jitter.Jitter", input: Optional[Input] = None, *, samples: int,
+def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
              interval: float, start: float = 0.0, noise_std: float = 0.0, seed: int = DEFAULT_SEED,
              truth: bool = False) -> dict:
     """``samples`` jittered samples ``y_k = s(t_k + τ_k) + v_k`` of ``system`` driven by
@@ -115,29 +115,49 @@ def simulate(system: System, jitter: "jitter.Jitter", input: Optional[Input] = N
                               int(seed), bool(truth))
 
 
-def first_moment(system: System, jitter: "jitter.Jitter", input: Optional[Input] = None, *, samples: int,
-                 interval: float, start: float = 0.0) -> "np.ndarray":
+def first_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
+                 interval: float, start: float = 0.0) -> np.ndarray:
     """``m_k = E[s(t_k + τ)]`` at ``t_k = start + k·interval``, exact."""
     return _jitterid.first_moment(system, jitter, input, *_grid(samples, interval, start))
 
 
-def second_moment(system: System, jitter: "jitter.Jitter", input: Optional[Input] = None, *, samples: int,
-                  interval: float, start: float = 0.0, noise_std: float = 0.0) -> "np.ndarray":
+def second_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
+                  interval: float, start: float = 0.0, noise_std: float = 0.0) -> np.ndarray:
     """``λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²`` at ``t_k = start + k·interval``, exact."""
     return _jitterid.second_moment(system, jitter, input, *_grid(samples, interval, start), float(noise_std))
 
 
-def fit(record: Mapping[str, Any], system: System, jitter: "jitter.Jitter", method: str = "bcls", *,
+def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method: str = "bcls", *,
         estimate: Iterable[str] = ("system",), interval: Optional[float] = None,
         start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
         options: Optional[Mapping[str, Any]] = None) -> FitResult:
-    """Fits the samples ``record["y"]`` with ``method`` (``"ls"``, ``"bcls"``, ``"bj"``,
-    ``"ml"``, …), starting from ``system`` and ``jitter``; ``estimate`` names the estimated
-    parts (``"system"``, ``"jitter"``, ``"noise"``). The grid is ``interval`` and ``start``
-    (else the record's ``T``/``t0``, else its ``t`` column); the input is ``input`` (else the
-    record's ``input``, or its ``input_t``/``input_u``). ``options`` holds further keys of the
-    experiment file's ``[estimate]`` section (``solver``, ``frequencies``, ``max_iterations``…).
-    The result equals ``Experiment.fit`` on an experiment with the same sections."""
+    """Fits a record's samples with ``method``, starting from ``system`` and ``jitter``.
+
+    Arguments:
+
+    * ``record``: a mapping with the samples ``y`` and optionally ``T`` and ``t0`` (or ``t``)
+      and the input (``input``, or ``input_t`` and ``input_u`` as ``simulate`` gives them).
+    * ``system``, ``jitter``: the model, and the start of the estimated parts.
+    * ``method``: ``"ls"``, ``"bcls"``, ``"bj"``, ``"ml"``, … (the command line's methods).
+    * ``estimate``: the estimated parts among ``"system"``, ``"jitter"`` and ``"noise"``.
+    * ``interval``, ``start``: the grid (default: the record's ``T``/``t0``, else its ``t``).
+    * ``input``: the known input (default: the record's).
+    * ``noise_std``: the measurement-noise level (known, or the start when estimated).
+    * ``options``: further keys of the experiment file's ``[estimate]`` section
+      (``solver``, ``frequencies``, ``max_iterations``, …).
+
+    Returns a ``FitResult`` (``names``, ``params``, ``std_errors``, ``covariance``, …), equal
+    to ``Experiment.fit`` on an experiment with the same sections. Raises ``ValueError``
+    naming the argument or key at fault, ``TypeError`` for a record that is not a mapping.
+    Each call reads the experiment its arguments spell: for many fits of one set-up, make an
+    ``Experiment`` once and call its ``fit``.
+
+    Example::
+
+        record = jitterid.simulate(G, J, u, samples=200, interval=1.0, noise_std=0.01)
+        fit = jitterid.fit(dict(record, input=u), G, J, "bcls", noise_std=0.01)
+        fit.params, fit.std_errors
+    """
     if not isinstance(record, Mapping) or "y" not in record:
         raise TypeError("record: expected a mapping with at least `y`")
     parts = set(estimate)

@@ -103,6 +103,25 @@ def test_bad_arguments(table2, tmp_path):
         jitterid.montecarlo("table2.toml", runs=4)
 
 
+def test_fit_fields_equal_their_json(table2):
+    # A fit's numbers are read from the library's result; its JSON (to_dict, pickling) is formed
+    # on demand. Both routes give the same values, bit for bit (NaN where a value is undefined).
+    record = table2.simulate(seed=6)
+    for method in ["bcls", "ls"]:
+        fit = table2.fit(record, method=method)
+        assert isinstance(fit.params, np.ndarray) and fit.params.dtype == np.float64
+        via_json = jitterid.FitResult(fit.to_dict(model=True))
+        for key in ["method", "converged", "cost", "iterations", "termination", "noise_std", "names",
+                    "covariance_names", "model"]:
+            assert getattr(fit, key) == getattr(via_json, key), (method, key)
+        for key in ["params", "std_errors", "covariance"]:
+            a, b = getattr(fit, key), getattr(via_json, key)
+            assert (a is None) == (b is None), (method, key)
+            if a is not None:
+                np.testing.assert_array_equal(a, b, err_msg=f"{method} {key}")
+        assert repr(fit) == repr(via_json)
+
+
 def test_pickling_experiments_and_results(table2):
     again = pickle.loads(pickle.dumps(table2))
     assert isinstance(again, jitterid.Experiment)
