@@ -3,6 +3,16 @@
 //! including NaN, infinite, huge and tiny values — through [`estimate`] and the initializer
 //! ([`initialize`], then [`estimate`] from its start with [`MultiStart`]).
 //!
+//! Every run-time choice is drawn as a front end holds it, a spec table (key/value pairs),
+//! and built through its registry: the signal kind ([`SignalRegistry`]), the jitter family
+//! ([`JitterRegistry`]), the criterion ([`CriterionRegistry`]), the noise model
+//! ([`NoiseRegistry`]) and the solver ([`SolverRegistry`]). The entry is picked by index into
+//! the registry's list and each of its keys drawn by its description, so an entry added to a
+//! registry is fuzzed with no edit here (and the run checks that every entry was drawn).
+//! JSON holds no NaN or ±∞: in a spec table they are null, as in a table read from a file;
+//! the record's data, the input (built by its constructors: there is no registry of inputs)
+//! and the frequency set still carry them.
+//!
 //! The properties: no panic; no hang (every solver runs with a small iteration budget, and the
 //! whole run is timed); an `Ok` estimate is internally consistent (finite non-negative cost,
 //! parameters of the right length and valid for the structure, finite parameters when
