@@ -3,6 +3,16 @@
 //! including NaN, infinite, huge and tiny values — through [`estimate`] and the initializer
 //! ([`initialize`], then [`estimate`] from its start with [`MultiStart`]).
 //!
+//! Every run-time choice is drawn as a front end holds it, a spec table (key/value pairs),
+//! and built through its registry: the signal kind ([`SignalRegistry`]), the jitter family
+//! ([`JitterRegistry`]), the criterion ([`CriterionRegistry`]), the noise model
+//! ([`NoiseRegistry`]) and the solver ([`SolverRegistry`]). The entry is picked by index into
+//! the registry's list and each of its keys drawn by its description, so an entry added to a
+//! registry is fuzzed with no edit here (and the run checks that every entry was drawn).
+//! JSON holds no NaN or ±∞: in a spec table they are null, as in a table read from a file;
+//! the record's data, the input (built by its constructors: there is no registry of inputs)
+//! and the frequency set still carry them.
+//!
 //! The properties: no panic; no hang (every solver runs with a small iteration budget, and the
 //! whole run is timed); an `Ok` estimate is internally consistent (finite non-negative cost,
 //! parameters of the right length and valid for the structure, finite parameters when
@@ -18,20 +28,22 @@
 //! printed with `--nocapture`.)
 
 use jitterid::estimate::solver::{
-    AnySolver, LevenbergMarquardt, LmOptions, MultiStart, NelderMead, Scaling,
+    AnySolver, LevenbergMarquardt, MultiStart, NelderMead, SolverRegistry,
 };
 use jitterid::estimate::{
-    estimate, initialize, AnyCriterion, ArmaNoise, Bcls, Criterion, CriterionRegistry,
-    EstimateError, EstimateOptions, Fit, Frequencies, InitOptions, InitialModel, Ls,
-    ModelStructure, NoiseModel, Record,
+    estimate, initialize, Bcls, Criterion, CriterionRegistry, EstimateError, EstimateOptions, Fit,
+    Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, NoiseRegistry, Record,
+    Registry,
 };
 use jitterid::jitter::registry::{JitterRegistry, Spec};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel};
 use jitterid::prelude::*;
-use jitterid::signal::Tone;
+use jitterid::signal::registry::{SignalRegistry, SpecReader, KIND_KEY};
+use jitterid::signal::{AnySignal, SignalError, Tone};
 use jitterid::window::{DirichletWindow, HannWindow};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
+use serde_json::Value;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -107,73 +119,264 @@ fn param(stable: bool) -> impl Strategy<Value = f64> {
     ]
 }
 
-#[derive(Debug, Clone)]
-enum RootSpec {
-    Real(f64),
-    Pair(f64, f64),
+/// A spec-table value: a JSON number, or null for what JSON cannot hold (NaN, ±∞), as a
+/// table read from an experiment file holds it.
+fn number(x: f64) -> Value {
+    Value::from(x)
 }
 
-fn root(stable: bool) -> impl Strategy<Value = RootSpec> {
+fn numbers(v: Vec<f64>) -> Value {
+    Value::Array(v.into_iter().map(number).collect())
+}
+
+/// A list of roots as a spec table writes them: a number (a real root) or `[re, im]` (a pair);
+/// mostly stable and non-empty, sometimes of either sign and empty.
+fn roots_value() -> impl Strategy<Value = Value> {
+    let root = |stable: bool| {
+        prop_oneof![
+            param(stable).prop_map(number),
+            (param(stable), param(false))
+                .prop_map(|(re, im)| Value::Array(vec![number(re), number(im.abs())])),
+        ]
+    };
     prop_oneof![
-        param(stable).prop_map(RootSpec::Real),
-        (param(stable), param(false)).prop_map(|(re, im)| RootSpec::Pair(re, im.abs())),
+        3 => prop::collection::vec(root(true), 1..3),
+        1 => prop::collection::vec(root(false), 0..3),
+    ]
+    .prop_map(Value::Array)
+}
+
+/// A list of numbers within the documented `constraint`: small coefficients (an ARMA
+/// polynomial with its roots inside the unit circle) where it mentions the unit circle;
+/// weights (non-negative, now and then non-finite, of any length) where it asks for `>= 0`;
+/// else a monic polynomial with positive coefficients (a stable-looking denominator) or
+/// coefficients of any sign and size.
+fn list_value(constraint: &str) -> BoxedStrategy<Value> {
+    let small = || prop::collection::vec(-0.9f64..0.9, 0..3);
+    let weights = || {
+        (1usize..40, values(40, 3.0), any::<bool>()).prop_map(|(n, w, plain)| {
+            w[..n]
+                .iter()
+                .map(|x| match (x.is_finite(), plain) {
+                    (true, _) => x.abs(),
+                    (false, true) => 1.0,
+                    (false, false) => *x,
+                })
+                .collect::<Vec<f64>>()
+        })
+    };
+    let lists = if constraint.contains("unit circle") {
+        small().boxed()
+    } else if constraint.contains(">= 0") || constraint.contains("≥ 0") {
+        weights().boxed()
+    } else {
+        prop_oneof![
+            3 => prop::collection::vec(log_value(-2.0, 2.0, false), 1..4).prop_map(|mut v| {
+                v.insert(0, 1.0);
+                v
+            }),
+            2 => prop::collection::vec(param(false), 1..3),
+        ]
+        .boxed()
+    };
+    lists.prop_map(numbers).boxed()
+}
+
+/// A number for the key `p` within its documented constraint: whole-number keys small (an
+/// iteration limit at most 24, so that every solver runs on a small budget; a count or seed
+/// whose default is small, such as the number of perturbed starts, at most 3), real keys
+/// their default or a magnitude over several decades, positive where the constraint asks
+/// for `>` or `≥`, of either sign otherwise. Values outside the constraint come from
+/// [`entry_table`]'s corruption.
+fn number_value(p: &ParamSpec) -> BoxedStrategy<Value> {
+    if p.boolean {
+        return any::<bool>().prop_map(|b| Value::from(u8::from(b))).boxed();
+    }
+    if p.integer {
+        return match p.default {
+            Some(d) if d <= 3.0 => (0u64..4).prop_map(Value::from).boxed(),
+            _ => (1u64..25).prop_map(Value::from).boxed(),
+        };
+    }
+    let positive = p.constraint.contains('>') || p.constraint.contains('≥');
+    let typical = match p.default {
+        Some(d) => Just(d).boxed(),
+        None => log_value(-3.0, 2.0, false).boxed(),
+    };
+    prop_oneof![
+        2 => typical,
+        3 => log_value(-3.0, 2.0, !positive),
+        1 => log_value(-12.0, 12.0, !positive),
+    ]
+    .prop_map(number)
+    .boxed()
+}
+
+/// A value of any shape (an awkward number, a list, a list of roots, a boolean, a string):
+/// what a spec table holds when its author writes the wrong kind of value.
+fn any_shape() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        3 => awkward().prop_map(number),
+        1 => list_value(""),
+        1 => list_value("unit circle"),
+        1 => roots_value(),
+        1 => Just(Value::Bool(true)),
+        1 => Just(Value::from("x")),
     ]
 }
 
-impl RootSpec {
-    fn root(&self) -> Root {
-        match *self {
-            RootSpec::Real(x) => Root::Real(x),
-            RootSpec::Pair(re, im) => Root::Pair { re, im },
-        }
+/// A value for the key `p`, of the shape its description documents: a list of roots where
+/// it mentions `[re, im]`, a list of numbers where it mentions a list, coefficients or `…`,
+/// else a number. A key added to a registry is drawn with no edit here.
+fn key_value(p: &ParamSpec) -> BoxedStrategy<Value> {
+    let text = format!("{} {}", p.meaning, p.constraint);
+    if text.contains("[re, im]") {
+        roots_value().boxed()
+    } else if text.contains("list") || text.contains("coefficients") || text.contains('…') {
+        list_value(&p.constraint)
+    } else {
+        number_value(p)
     }
 }
 
-#[derive(Debug, Clone)]
-enum ModelSpec {
-    Zpk(f64, Vec<RootSpec>, Vec<RootSpec>),
-    Tf(Vec<f64>, Vec<f64>),
+/// The keys of one entry: whole-number keys always (budgets: their defaults are sized for
+/// real fits, not for hundreds of fuzz cases), required keys always (a missing one comes from
+/// [`entry_table`]'s corruption), optional ones and those with a default now and then.
+fn keys_of(params: &[ParamSpec]) -> Vec<BoxedStrategy<Option<(String, Value)>>> {
+    params
+        .iter()
+        .map(|p| {
+            let required = p.default.is_none() && !p.constraint.starts_with("optional");
+            let key = p.key.clone();
+            let value = key_value(p).prop_map(move |v| (key.clone(), v));
+            if p.integer || required {
+                value.prop_map(Some).boxed()
+            } else {
+                prop::option::weighted(0.2, value).boxed()
+            }
+        })
+        .collect()
 }
 
-fn model() -> impl Strategy<Value = ModelSpec> {
-    prop_oneof![
+/// How a drawn table is spoiled, now and then: one key's value replaced by one of any shape,
+/// one key removed, or a key the entry does not take added (a typed error naming the key is
+/// then expected).
+#[derive(Debug, Clone)]
+struct Corruption {
+    /// Which key (an index taken modulo the table's keys).
+    key: usize,
+    /// `Some`: the new value; `None`: the key is removed.
+    value: Option<Value>,
+    /// Whether an unknown key is added instead.
+    unknown: bool,
+}
+
+fn corruption() -> impl Strategy<Value = Option<Corruption>> {
+    prop::option::weighted(
+        0.04,
         (
-            param(false),
-            prop::collection::vec(root(false), 0..2),
-            prop::collection::vec(root(true), 1..3)
+            any::<usize>(),
+            prop::option::weighted(0.8, any_shape()),
+            prop::bool::weighted(0.15),
         )
-            .prop_map(|(k, z, p)| ModelSpec::Zpk(k, z, p)),
-        (
-            prop::collection::vec(param(false), 1..3),
-            prop::collection::vec(log_value(-2.0, 2.0, false), 1..4)
-        )
-            .prop_map(|(num, mut den)| {
-                den.insert(0, 1.0);
-                ModelSpec::Tf(num, den)
+            .prop_map(|(key, value, unknown)| Corruption {
+                key,
+                value,
+                unknown,
             }),
-    ]
+    )
 }
 
-#[derive(Debug, Clone)]
-enum InputSpec {
-    Steps {
-        start: f64,
-        widths: Vec<f64>,
-        levels: Vec<f64>,
-    },
-    Tones(Vec<(f64, f64, f64)>),
+/// A spec table naming, under `name_key`, one of `entries` (name and keys) picked by index,
+/// with values for its keys and for `common` (keys every entry takes), spoiled now and then
+/// (see [`Corruption`]). Everything a registry lists is drawn, so an entry added to it is
+/// fuzzed with no edit here.
+fn entry_table(
+    name_key: &'static str,
+    entries: Vec<(String, Vec<ParamSpec>)>,
+    common: Vec<ParamSpec>,
+) -> BoxedStrategy<Spec> {
+    let count = entries.len();
+    (0..count)
+        .prop_flat_map(move |i| {
+            let (name, params) = entries[i].clone();
+            let mut keys = keys_of(&params);
+            keys.extend(keys_of(&common));
+            (keys, corruption()).prop_map(move |(pairs, corruption)| {
+                let mut table = Spec::new();
+                table.insert(name_key.into(), name.clone().into());
+                table.extend(pairs.into_iter().flatten());
+                if let Some(c) = corruption {
+                    let keys: Vec<String> =
+                        table.keys().filter(|k| *k != name_key).cloned().collect();
+                    match (c.unknown || keys.is_empty(), c.value) {
+                        (true, v) => {
+                            table.insert("unknown".into(), v.unwrap_or(Value::from(1.0)));
+                        }
+                        (false, Some(v)) => {
+                            table.insert(keys[c.key % keys.len()].clone(), v);
+                        }
+                        (false, None) => {
+                            table.remove(&keys[c.key % keys.len()]);
+                        }
+                    }
+                }
+                table
+            })
+        })
+        .boxed()
 }
 
-fn input() -> impl Strategy<Value = InputSpec> {
+/// The entries of an estimation-crate registry, by name and keys.
+fn entries<T>(registry: &Registry<T>) -> Vec<(String, Vec<ParamSpec>)> {
+    registry
+        .entries()
+        .iter()
+        .map(|e| (e.name.to_string(), e.params.clone()))
+        .collect()
+}
+
+/// A signal as a spec table of the signal registry: any kind it lists (`zpk`, `tf`,
+/// `sinusoid`, `pulse-response`, and whatever is added), with its keys.
+fn signal() -> BoxedStrategy<Spec> {
+    entry_table(KIND_KEY, signal_kinds(), Vec::new())
+}
+
+/// The signal registry's kinds, by name and keys.
+fn signal_kinds() -> Vec<(String, Vec<ParamSpec>)> {
+    SignalRegistry::builtin()
+        .kinds()
+        .map(|k| (k.name().to_string(), k.params().to_vec()))
+        .collect()
+}
+
+/// The known input, built by its validating constructors (there is no registry of inputs;
+/// JSON could not hold the NaN and ±∞ planted in the levels): steps, or a few tones. An
+/// invalid one is kept as its typed error's text.
+fn input() -> impl Strategy<Value = Result<Input, String>> {
     prop_oneof![
         4 => (
             -50.0f64..10.0,
             prop::collection::vec(log_value(-3.0, 2.5, false), 1..12),
             values(12, 2.0)
         )
-            .prop_map(|(start, widths, levels)| InputSpec::Steps { start, widths, levels }),
+            .prop_map(|(start, widths, levels)| {
+                let mut edges = vec![start];
+                for w in &widths {
+                    edges.push(edges[edges.len() - 1] + w);
+                }
+                PiecewiseConstant::new(edges, levels[..widths.len()].to_vec())
+                    .map(Input::from)
+                    .map_err(|e| e.to_string())
+            }),
         1 => prop::collection::vec((log_value(-3.0, 1.0, false), any_value(3.0), -3.0f64..3.0), 1..3)
-            .prop_map(InputSpec::Tones),
+            .prop_map(|tones| {
+                let tones = tones
+                    .into_iter()
+                    .map(|(frequency, amplitude, phase)| Tone { frequency, amplitude, phase })
+                    .collect();
+                Multisine::new(tones).map(Input::from).map_err(|e| e.to_string())
+            }),
     ]
 }
 
@@ -236,136 +439,100 @@ fn jitter() -> impl Strategy<Value = JitterSpec> {
         })
 }
 
-/// The spec table naming one criterion of the registry.
-fn named_criterion(name: &str) -> Spec {
-    let mut t = Spec::new();
-    t.insert("criterion".into(), name.into());
-    t
+/// The criterion registry's entries except those that build, with their defaults, into a
+/// likelihood (this harness runs the first-moment estimator); an entry that needs keys to
+/// build is kept.
+fn first_moment_criteria() -> Vec<(String, Vec<ParamSpec>)> {
+    let registry = CriterionRegistry::builtin();
+    entries(&registry)
+        .into_iter()
+        .filter(|(name, _)| {
+            let mut t = Spec::new();
+            t.insert(registry.key().into(), name.as_str().into());
+            registry
+                .build(&t)
+                .map_or(true, |c| c.as_first_moment().is_some())
+        })
+        .collect()
 }
 
-/// A first-moment criterion as a registry spec table; weighted BCLS gets weights that are
-/// occasionally invalid (negative, or non-finite, which JSON holds as null).
-fn criterion() -> impl Strategy<Value = Spec> {
+/// A first-moment criterion as a spec table of the criterion registry.
+fn criterion() -> BoxedStrategy<Spec> {
+    let key = CriterionRegistry::builtin().key();
+    entry_table(key, first_moment_criteria(), Vec::new())
+}
+
+/// A noise model as a spec table of the noise registry (used by the BJ and JBJ structures).
+fn noise() -> BoxedStrategy<Spec> {
+    let registry = NoiseRegistry::builtin();
+    entry_table(registry.key(), entries(&registry), Vec::new())
+}
+
+/// A solver as a spec table of the solver registry: any entry, with its keys and the
+/// multi-start keys every solver takes.
+fn solver() -> BoxedStrategy<Spec> {
+    let registry = SolverRegistry::builtin();
+    let common = registry.common_keys().to_vec();
+    entry_table(registry.key(), entries(&registry), common)
+}
+
+/// A frequency set in units of `1/T` (converted by [`in_hertz`] for the case's `T`),
+/// occasionally invalid. A frequency set is an option of the estimator, not a run-time family:
+/// its variants are the library's own [`Frequencies`].
+fn frequencies() -> impl Strategy<Value = Frequencies> {
     prop_oneof![
-        Just(named_criterion("ls")),
-        Just(named_criterion("bcls")),
-        (1usize..40, values(40, 3.0), any::<bool>()).prop_map(|(n, w, plain)| {
-            let weights: Vec<f64> = if plain {
-                w[..n]
-                    .iter()
-                    .map(|x| if x.is_finite() { x.abs() } else { 1.0 })
-                    .collect()
-            } else {
-                w[..n]
-                    .iter()
-                    .map(|x| if x.is_finite() { x.abs() } else { *x })
-                    .collect()
-            };
-            let mut t = named_criterion("weighted-bcls");
-            t.insert("weights".into(), serde_json::json!(weights));
-            t
-        }),
-        Just(named_criterion("bj")),
-    ]
-}
-
-/// A frequency set, in units of `1/T` (converted for the case's `T`), occasionally invalid.
-#[derive(Debug, Clone)]
-enum FreqSpec {
-    Dft,
-    Band(f64, f64),
-    List(Vec<f64>),
-}
-
-fn frequencies() -> impl Strategy<Value = FreqSpec> {
-    prop_oneof![
-        3 => Just(FreqSpec::Dft),
+        3 => Just(Frequencies::Dft),
         1 => (prop_oneof![6 => 0.0f64..0.5, 1 => awkward()], prop_oneof![6 => 0.0f64..0.5, 1 => awkward()])
-            .prop_map(|(min, width)| FreqSpec::Band(min, width)),
+            .prop_map(|(min, width)| Frequencies::Band { min, max: min + width }),
         1 => (0usize..12, values(12, 1.0))
-            .prop_map(|(n, v)| FreqSpec::List(v[..n].iter().map(|x| if x.is_finite() { x.abs() } else { *x }).collect())),
+            .prop_map(|(n, v)| Frequencies::List(v[..n].iter().map(|x| if x.is_finite() { x.abs() } else { *x }).collect())),
     ]
 }
 
-impl FreqSpec {
-    fn resolve(&self, interval: f64) -> Frequencies {
-        match self {
-            FreqSpec::Dft => Frequencies::Dft,
-            FreqSpec::Band(min, width) => Frequencies::Band {
-                min: min / interval,
-                max: (min + width) / interval,
-            },
-            FreqSpec::List(v) => Frequencies::List(v.iter().map(|f| f / interval).collect()),
-        }
+/// `f`, given in units of `1/T`, in hertz for the sampling interval `interval`.
+fn in_hertz(f: &Frequencies, interval: f64) -> Frequencies {
+    match f {
+        Frequencies::Dft => Frequencies::Dft,
+        Frequencies::Band { min, max } => Frequencies::Band {
+            min: min / interval,
+            max: max / interval,
+        },
+        Frequencies::List(v) => Frequencies::List(v.iter().map(|f| f / interval).collect()),
     }
 }
 
-#[derive(Debug, Clone)]
-struct SolverSpec {
-    kind: u8,
-    max_iters: u64,
-    tol: f64,
-    scaling: bool,
-    starts: usize,
-    radius: f64,
-}
-
-fn solver() -> impl Strategy<Value = SolverSpec> {
-    (
-        0u8..3,
-        0u64..25,
-        prop_oneof![4 => Just(1e-10), 1 => any_value(1.0)],
-        any::<bool>(),
-        0usize..3,
-        prop_oneof![4 => 0.0f64..1.0, 1 => any_value(1.0)],
-    )
-        .prop_map(
-            |(kind, max_iters, tol, scaling, starts, radius)| SolverSpec {
-                kind,
-                max_iters,
-                tol,
-                scaling,
-                starts,
-                radius,
-            },
-        )
-}
-
+/// One case: the record, and spec tables for everything a front end chooses at run time.
 #[derive(Debug, Clone)]
 struct Case {
     n: usize,
     interval: f64,
     start: f64,
     data: Vec<f64>,
-    model: ModelSpec,
-    input: InputSpec,
+    signal: Spec,
+    input: Result<Input, String>,
     jitter: JitterSpec,
     /// 0 OE, 1 JOE, 2 BJ, 3 JBJ; then what is estimated (when not the structure's default), the
-    /// noise filter, a known noise level.
+    /// noise model (BJ and JBJ), a known noise level.
     structure: u8,
     estimated: Option<(bool, bool, bool)>,
-    arma: (Vec<f64>, Vec<f64>),
+    noise: Spec,
     noise_std: Option<f64>,
     criterion: Spec,
-    frequencies: FreqSpec,
+    frequencies: Frequencies,
     hann: bool,
-    solver: SolverSpec,
+    solver: Spec,
     covariance: bool,
 }
 
 fn case() -> impl Strategy<Value = Case> {
     let grid = (1usize..65, log_value(-2.0, 1.0, false), -20.0f64..20.0);
     let data = values(64, 1.0);
-    let noise = (
-        prop::collection::vec(-0.9f64..0.9, 0..2),
-        prop::collection::vec(-0.9f64..0.9, 0..2),
-    );
     (
-        (grid, data, model(), input(), jitter()),
+        (grid, data, signal(), input(), jitter()),
         (
             0u8..4,
             prop::option::weighted(0.25, (any::<bool>(), any::<bool>(), any::<bool>())),
-            noise,
+            noise(),
             prop::option::of(any_value(0.1).prop_map(|x| if x.is_finite() { x.abs() } else { x })),
             criterion(),
             frequencies(),
@@ -376,11 +543,11 @@ fn case() -> impl Strategy<Value = Case> {
     )
         .prop_map(
             |(
-                ((n, interval, start), data, model, input, jitter),
+                ((n, interval, start), data, signal, input, jitter),
                 (
                     structure,
                     estimated,
-                    arma,
+                    noise,
                     noise_std,
                     criterion,
                     frequencies,
@@ -393,12 +560,12 @@ fn case() -> impl Strategy<Value = Case> {
                 interval,
                 start,
                 data,
-                model,
+                signal,
                 input,
                 jitter,
                 structure,
                 estimated,
-                arma,
+                noise,
                 noise_std,
                 criterion,
                 frequencies,
@@ -436,6 +603,32 @@ static TALLY: Tally = Tally {
 
 static ERRORS: Mutex<Vec<(String, usize)>> = Mutex::new(Vec::new());
 
+/// The registry entries the cases drew (`"solver lm"`, …), with how often.
+static DRAWN: Mutex<Vec<(String, usize)>> = Mutex::new(Vec::new());
+
+fn count(list: &Mutex<Vec<(String, usize)>>, key: String) {
+    let mut v = list.lock().unwrap();
+    match v.iter_mut().find(|(k, _)| *k == key) {
+        Some((_, n)) => *n += 1,
+        None => v.push((key, 1)),
+    }
+}
+
+/// Notes which entry each of the case's spec tables names.
+fn note_drawn(case: &Case) {
+    let tables = [
+        (KIND_KEY, &case.signal),
+        (CriterionRegistry::builtin().key(), &case.criterion),
+        (NoiseRegistry::builtin().key(), &case.noise),
+        (SolverRegistry::builtin().key(), &case.solver),
+    ];
+    for (key, table) in tables {
+        if let Some(name) = table.get(key).and_then(Value::as_str) {
+            count(&DRAWN, format!("{key} {name}"));
+        }
+    }
+}
+
 fn bump(c: &AtomicUsize) {
     c.fetch_add(1, Ordering::Relaxed);
 }
@@ -448,11 +641,7 @@ fn note_error(e: &dyn std::fmt::Display) {
         .filter(|c| !c.is_ascii_digit() && !matches!(c, '.' | '-' | '+'))
         .take(60)
         .collect();
-    let mut v = ERRORS.lock().unwrap();
-    match v.iter_mut().find(|(k, _)| *k == key) {
-        Some((_, n)) => *n += 1,
-        None => v.push((key, 1)),
-    }
+    count(&ERRORS, key);
 }
 
 fn build_jitter(spec: &JitterSpec) -> Result<AnyJitter, JitterError> {
@@ -465,71 +654,6 @@ fn build_jitter(spec: &JitterSpec) -> Result<AnyJitter, JitterError> {
         table.insert("offset".into(), c.into());
     }
     JitterRegistry::builtin().build(&table)
-}
-
-fn build_input(spec: &InputSpec) -> Option<Input> {
-    match spec {
-        InputSpec::Steps {
-            start,
-            widths,
-            levels,
-        } => {
-            let mut edges = vec![*start];
-            for w in widths {
-                edges.push(edges[edges.len() - 1] + w);
-            }
-            PiecewiseConstant::new(edges, levels[..widths.len()].to_vec())
-                .ok()
-                .map(Input::from)
-        }
-        InputSpec::Tones(tones) => Multisine::new(
-            tones
-                .iter()
-                .map(|&(frequency, amplitude, phase)| Tone {
-                    frequency,
-                    amplitude,
-                    phase,
-                })
-                .collect(),
-        )
-        .ok()
-        .map(Input::from),
-    }
-}
-
-fn build_criterion(spec: &Spec) -> Option<AnyCriterion> {
-    CriterionRegistry::builtin()
-        .build(spec)
-        .map_err(|e| note_error(&e))
-        .ok()
-}
-
-fn build_solver(spec: &SolverSpec) -> AnySolver {
-    let lm = LevenbergMarquardt::new(LmOptions {
-        max_iters: spec.max_iters,
-        xtol: spec.tol,
-        ftol: spec.tol,
-        gtol: spec.tol,
-        scaling: if spec.scaling {
-            Scaling::Marquardt
-        } else {
-            Scaling::Identity
-        },
-        ..LmOptions::default()
-    });
-    match spec.kind {
-        0 => AnySolver::new(lm),
-        1 => AnySolver::new(MultiStart::new(
-            AnySolver::new(lm),
-            spec.starts,
-            spec.radius,
-            7,
-        )),
-        _ => AnySolver::new(NelderMead {
-            max_iters: 20 * spec.max_iters,
-            ..NelderMead::default()
-        }),
-    }
 }
 
 /// The invariants of an `Ok` estimate.
@@ -564,50 +688,38 @@ where
     Ok(())
 }
 
-/// Estimates with `structure`, then (for an LTI signal) initializes and estimates again.
-fn run_structure<M, N>(
-    case: &Case,
-    structure: ModelStructure<LtiResponse<M>, AnyJitter, N>,
+/// The structure `st` with its signal replaced by `model` driven by `input`.
+fn typed<M, N>(
+    st: &ModelStructure<AnySignal, AnyJitter, N>,
+    model: M,
+    input: &Input,
+) -> ModelStructure<LtiResponse<M>, AnyJitter, N>
+where
+    M: InitialModel,
+    N: NoiseModel + Clone,
+{
+    ModelStructure {
+        signal: LtiResponse::new(model, input.clone()),
+        jitter: st.jitter.clone(),
+        noise: st.noise.clone(),
+        estimate_signal: st.estimate_signal,
+        estimate_jitter: st.estimate_jitter,
+        estimate_noise: st.estimate_noise,
+        noise_std: st.noise_std,
+    }
+}
+
+/// The default robust path from `structure`'s model: the initializer, then multi-start LM
+/// (small budgets).
+fn run_initializer<M, N>(
+    structure: &ModelStructure<LtiResponse<M>, AnyJitter, N>,
     record: &Record,
-    criterion: &dyn Criterion,
 ) -> Result<(), TestCaseError>
 where
     M: InitialModel,
-    N: NoiseModel,
+    N: NoiseModel + Clone,
 {
-    let solver = build_solver(&case.solver);
-    let result = if case.hann {
-        let options = EstimateOptions {
-            frequencies: case.frequencies.resolve(case.interval),
-            window: HannWindow,
-            solver,
-            covariance: case.covariance,
-        };
-        estimate(&structure, record, criterion, &options)
-    } else {
-        let options = EstimateOptions {
-            frequencies: case.frequencies.resolve(case.interval),
-            window: DirichletWindow,
-            solver,
-            covariance: case.covariance,
-        };
-        estimate(&structure, record, criterion, &options)
-    };
-    match result {
-        Ok(e) => {
-            bump(&TALLY.estimate_ok);
-            if e.converged {
-                bump(&TALLY.converged);
-            }
-            check_estimate(&e, &structure)?;
-        }
-        Err(e) => {
-            bump(&TALLY.estimate_err);
-            note_error(&e);
-        }
-    }
-    // The default robust path: initializer, then multi-start LM (small budgets).
-    match initialize(&structure, record, &InitOptions::default()) {
+    match initialize(structure, record, &InitOptions::default()) {
         Ok(start) => {
             bump(&TALLY.init_ok);
             let options = EstimateOptions {
@@ -634,58 +746,93 @@ where
     Ok(())
 }
 
-fn run_model<M: InitialModel>(
-    case: &Case,
-    model: M,
-    input: Input,
-    jitter: AnyJitter,
+/// Runs the initializer on `structure`'s model when the initializer has a type for its kind.
+/// The initializer is typed: it fits the rational models that implement [`InitialModel`]
+/// (`Zpk`, `TransferFunction`), so the registry's `zpk` and `tf` tables are read back into
+/// those types with the registry's own [`SpecReader`]. Every other kind, including one added
+/// to the registry, is fuzzed through [`estimate`] only.
+fn run_initializer_for<N: NoiseModel + Clone>(
+    structure: &ModelStructure<AnySignal, AnyJitter, N>,
+    input: &Input,
     record: &Record,
-    criterion: &dyn Criterion,
 ) -> Result<(), TestCaseError> {
-    let signal = LtiResponse::new(model, input);
-    let with_std = |x: Result<_, EstimateError>| match x {
-        Ok(x) => Some(x),
+    let spec = structure.signal.spec();
+    let Some(kind) = SignalRegistry::builtin().kind(structure.signal.kind()) else {
+        return Ok(());
+    };
+    let reader = match SpecReader::new(kind, &spec) {
+        Ok(r) => r,
         Err(e) => {
-            note_error(&e);
-            None
+            return Err(TestCaseError::fail(format!(
+                "{spec:?} does not read back: {e}"
+            )))
         }
     };
-    if case.structure < 2 {
-        let mut st = if case.structure == 0 {
-            ModelStructure::oe(signal, jitter)
-        } else {
-            ModelStructure::joe(signal, jitter)
-        };
-        if let Some((s, j, n)) = case.estimated {
-            st = st.with_estimated(s, j, n);
+    let read = |e: SignalError| TestCaseError::fail(format!("{spec:?} does not read back: {e}"));
+    match kind.name() {
+        "zpk" => {
+            let (k, z, p) = (
+                reader.f64("gain").map_err(read)?,
+                reader.roots("zeros").map_err(read)?,
+                reader.roots("poles").map_err(read)?,
+            );
+            let model = Zpk::new(k, z, p).map_err(read)?;
+            run_initializer(&typed(structure, model, input), record)
         }
-        if let Some(sd) = case.noise_std {
-            let Some(x) = with_std(st.clone().with_noise_std(sd)) else {
-                bump(&TALLY.rejected_setup);
-                return Ok(());
-            };
-            st = x;
+        "tf" => {
+            let (num, den) = (
+                reader.f64_list("num").map_err(read)?,
+                reader.f64_list("den").map_err(read)?,
+            );
+            let model = TransferFunction::new(&num, &den).map_err(read)?;
+            run_initializer(&typed(structure, model, input), record)
         }
-        run_structure(case, st, record, criterion)
-    } else {
-        let noise = match ArmaNoise::new(case.arma.0.clone(), case.arma.1.clone()) {
-            Ok(x) => x,
-            Err(e) => {
-                note_error(&e);
-                bump(&TALLY.rejected_setup);
-                return Ok(());
-            }
-        };
-        let mut st = if case.structure == 2 {
-            ModelStructure::bj(signal, jitter, noise)
-        } else {
-            ModelStructure::jbj(signal, jitter, noise)
-        };
-        if let Some((s, j, n)) = case.estimated {
-            st = st.with_estimated(s, j, n);
-        }
-        run_structure(case, st, record, criterion)
+        _ => Ok(()),
     }
+}
+
+/// Estimates with `structure`, then runs the initializer from its model.
+fn run_structure<N: NoiseModel + Clone>(
+    case: &Case,
+    structure: ModelStructure<AnySignal, AnyJitter, N>,
+    input: &Input,
+    record: &Record,
+    criterion: &dyn Criterion,
+    solver: &AnySolver,
+) -> Result<(), TestCaseError> {
+    let frequencies = in_hertz(&case.frequencies, case.interval);
+    let solver = solver.clone();
+    let result = if case.hann {
+        let options = EstimateOptions {
+            frequencies,
+            window: HannWindow,
+            solver,
+            covariance: case.covariance,
+        };
+        estimate(&structure, record, criterion, &options)
+    } else {
+        let options = EstimateOptions {
+            frequencies,
+            window: DirichletWindow,
+            solver,
+            covariance: case.covariance,
+        };
+        estimate(&structure, record, criterion, &options)
+    };
+    match result {
+        Ok(e) => {
+            bump(&TALLY.estimate_ok);
+            if e.converged {
+                bump(&TALLY.converged);
+            }
+            check_estimate(&e, &structure)?;
+        }
+        Err(e) => {
+            bump(&TALLY.estimate_err);
+            note_error(&e);
+        }
+    }
+    run_initializer_for(&structure, input, record)
 }
 
 /// The case being run and when it started, for the watchdog.
@@ -698,8 +845,11 @@ fn run_case(case: &Case) -> Result<(), TestCaseError> {
     out
 }
 
+/// Builds a case's record and, through the registries, its model, criterion and solver; a
+/// setup refused with a typed error is counted, and the case ends there.
 fn run_case_inner(case: &Case) -> Result<(), TestCaseError> {
     bump(&TALLY.cases);
+    note_drawn(case);
     let reject = |e: &dyn std::fmt::Display| {
         note_error(e);
         bump(&TALLY.rejected_setup);
@@ -713,37 +863,63 @@ fn run_case_inner(case: &Case) -> Result<(), TestCaseError> {
         Ok(r) => r,
         Err(e) => return reject(&e),
     };
-    let Some(input) = build_input(&case.input) else {
-        bump(&TALLY.rejected_setup);
-        return Ok(());
+    let input = match &case.input {
+        Ok(u) => u,
+        Err(e) => return reject(e),
     };
     let jitter = match build_jitter(&case.jitter) {
         Ok(j) => j,
         Err(e) => return reject(&e),
     };
-    let Some(any_criterion) = build_criterion(&case.criterion) else {
-        bump(&TALLY.rejected_setup);
-        return Ok(());
+    let any_criterion = match CriterionRegistry::builtin().build(&case.criterion) {
+        Ok(c) => c,
+        Err(e) => return reject(&e),
     };
     let Some(criterion) = any_criterion.as_first_moment() else {
-        bump(&TALLY.rejected_setup);
-        return Ok(());
+        return Err(TestCaseError::fail(format!(
+            "{:?} is a likelihood; the strategy draws first-moment criteria only",
+            case.criterion
+        )));
     };
-    match &case.model {
-        ModelSpec::Zpk(k, z, p) => {
-            match Zpk::new(
-                *k,
-                z.iter().map(RootSpec::root).collect(),
-                p.iter().map(RootSpec::root).collect(),
-            ) {
-                Ok(m) => run_model(case, m, input, jitter, &record, criterion),
-                Err(e) => reject(&e),
-            }
+    let solver = match SolverRegistry::builtin().build(&case.solver) {
+        Ok(s) => s,
+        Err(e) => return reject(&e),
+    };
+    // The registry hands the input to the kinds driven by one.
+    let signal = match SignalRegistry::builtin().build(&case.signal, Some(input)) {
+        Ok(s) => s,
+        Err(e) => return reject(&e),
+    };
+    if case.structure < 2 {
+        let mut st = if case.structure == 0 {
+            ModelStructure::oe(signal, jitter)
+        } else {
+            ModelStructure::joe(signal, jitter)
+        };
+        if let Some((s, j, n)) = case.estimated {
+            st = st.with_estimated(s, j, n);
         }
-        ModelSpec::Tf(num, den) => match TransferFunction::new(num, den) {
-            Ok(m) => run_model(case, m, input, jitter, &record, criterion),
-            Err(e) => reject(&e),
-        },
+        if let Some(sd) = case.noise_std {
+            st = match st.with_noise_std(sd) {
+                Ok(st) => st,
+                Err(e) => return reject(&e),
+            };
+        }
+        run_structure(case, st, input, &record, criterion, &solver)
+    } else {
+        let noise = match NoiseRegistry::builtin().build(&case.noise) {
+            Ok(x) => x,
+            Err(e) => return reject(&e),
+        };
+        let mut st = if case.structure == 2 {
+            ModelStructure::bj(signal, jitter, noise)
+        } else {
+            ModelStructure::jbj(signal, jitter, noise)
+        };
+        if let Some((s, j, n)) = case.estimated {
+            st = st.with_estimated(s, j, n);
+        }
+        run_structure(case, st, input, &record, criterion, &solver)
     }
 }
 
@@ -793,9 +969,44 @@ fn estimate_entry_points_never_panic_or_hang() {
     for (e, n) in &errors {
         eprintln!("  {n:5} × {e}");
     }
+    let drawn = DRAWN.lock().unwrap().clone();
+    eprintln!("  drawn: {drawn:?}");
     result.unwrap();
     // Every case ran at least once (shrinking only adds cases on failure).
     assert!(get(&TALLY.cases) >= cases as usize);
+    // With the CI's number of cases, every entry of every registry was drawn (the first-moment
+    // criteria only): an entry added to a registry is fuzzed.
+    if cases >= CI_CASES {
+        let named = |key: &str, names: Vec<String>| {
+            names
+                .into_iter()
+                .map(move |n| format!("{key} {n}"))
+                .collect::<Vec<_>>()
+        };
+        let (noise, solvers) = (NoiseRegistry::builtin(), SolverRegistry::builtin());
+        let expected = [
+            named(KIND_KEY, signal_kinds().into_iter().map(|k| k.0).collect()),
+            named(
+                CriterionRegistry::builtin().key(),
+                first_moment_criteria().into_iter().map(|k| k.0).collect(),
+            ),
+            named(
+                noise.key(),
+                entries(&noise).into_iter().map(|k| k.0).collect(),
+            ),
+            named(
+                solvers.key(),
+                entries(&solvers).into_iter().map(|k| k.0).collect(),
+            ),
+        ]
+        .concat();
+        for entry in expected {
+            assert!(
+                drawn.iter().any(|(k, _)| *k == entry),
+                "{entry} was never drawn in {cases} cases"
+            );
+        }
+    }
 }
 
 /// Regression test: the exact first moment of an LTI response once cost `O(reach · rate)`

@@ -1,4 +1,4 @@
-//! Reproduction cases of the maximum-likelihood issue: `table1-ml` and `sine`.
+//! Reproduction cases of maximum-likelihood estimation: `table1-ml` and `sine`.
 
 use crate::paper::{self, NOISE_STD, RUNS};
 use crate::reproduce::{runs_range, write_outputs};
@@ -59,19 +59,23 @@ fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
     (s.count > 0).then(|| s.mean.sqrt())
 }
 
-#[derive(Debug, Clone, Copy)]
-enum Truth {
-    Us(UniformSum),
-    Ga(Gaussian),
+/// The true jitter law of a Table 1 case, built by the jitter registry from its spec table.
+type Truth = AnyJitter;
+
+fn truth(spec: serde_json::Value) -> Truth {
+    let table = spec.as_object().expect("a spec table");
+    JitterRegistry::builtin().build(table).expect("valid")
 }
 
-impl Truth {
-    fn sigma(&self) -> f64 {
-        match self {
-            Truth::Us(j) => j.std_dev(),
-            Truth::Ga(j) => j.std_dev(),
-        }
-    }
+/// The true `n` and `a` when the truth is a uniform sum.
+fn uniform_sum_truth(truth: &Truth) -> (Option<f64>, Option<f64>) {
+    truth
+        .downcast_ref::<UniformSum>()
+        .map_or((None, None), |j| (Some(f64::from(j.n())), Some(j.a())))
+}
+
+fn is_gaussian(truth: &Truth) -> bool {
+    truth.downcast_ref::<Gaussian>().is_some()
 }
 
 /// Results of one realisation of one true pdf.
@@ -164,47 +168,35 @@ fn profile_ml<C: LikelihoodCriterion>(
 }
 
 /// The CRB std of σ and the Slepian–Bangs std at the truth for one input.
-fn bounds(signal: &LtiResponse<Zpk>, truth: Truth) -> (Option<f64>, Option<f64>) {
+fn bounds(signal: &LtiResponse<Zpk>, truth: &Truth) -> (Option<f64>, Option<f64>) {
     let grid = paper::grid();
     let fo = FisherOptions::default();
-    match truth {
-        Truth::Us(j) => {
-            let s = ModelStructure::oe(signal.clone(), j)
-                .with_estimated(false, true, false)
-                .with_noise_std(NOISE_STD)
-                .expect("valid noise");
-            // σ = a/√(3(n+1)): the delta method is a constant factor.
-            let f = 1.0 / paper::uniform_sum_ratio(i64::from(j.n()));
-            let e = exact_fisher(&s, &grid, NOISE_STD, &fo)
-                .ok()
-                .and_then(|i| i.crb_std())
-                .map(|c| c[0] * f);
-            let g = gaussian_fisher(&s, &grid, NOISE_STD)
-                .ok()
-                .and_then(|i| i.crb_std())
-                .map(|c| c[0] * f);
-            (e, g)
-        }
-        Truth::Ga(j) => {
-            let s = ModelStructure::oe(signal.clone(), j)
-                .with_estimated(false, true, false)
-                .with_noise_std(NOISE_STD)
-                .expect("valid noise");
-            let e = exact_fisher(&s, &grid, NOISE_STD, &fo)
-                .ok()
-                .and_then(|i| i.crb_std())
-                .map(|c| c[0]);
-            let g = gaussian_fisher(&s, &grid, NOISE_STD)
-                .ok()
-                .and_then(|i| i.crb_std())
-                .map(|c| c[0]);
-            (e, g)
-        }
-    }
+    let s = ModelStructure::oe(signal.clone(), truth.clone())
+        .with_estimated(false, true, false)
+        .with_noise_std(NOISE_STD)
+        .expect("valid noise");
+    // The family's own parameter is estimated; for the uniform sum (`a`) the bound on
+    // σ = a/√(3(n+1)) follows by the delta method, a constant factor.
+    let to_sigma = truth
+        .downcast_ref::<UniformSum>()
+        .map(|j| paper::uniform_sum_ratio(i64::from(j.n())));
+    let scale = |c: Vec<f64>| match to_sigma {
+        Some(ratio) => c[0] * (1.0 / ratio),
+        None => c[0],
+    };
+    let e = exact_fisher(&s, &grid, NOISE_STD, &fo)
+        .ok()
+        .and_then(|i| i.crb_std())
+        .map(scale);
+    let g = gaussian_fisher(&s, &grid, NOISE_STD)
+        .ok()
+        .and_then(|i| i.crb_std())
+        .map(scale);
+    (e, g)
 }
 
 fn one_record(
-    truth: Truth,
+    truth: &Truth,
     sigma: f64,
     seed: u64,
     r: u64,
@@ -215,11 +207,7 @@ fn one_record(
     let u = paper::input(rng, 8.0);
     let grid = paper::grid();
     let signal = LtiResponse::new(g, u);
-    let data = match truth {
-        Truth::Us(j) => simulate(&signal, &j, &grid, NOISE_STD, rng),
-        Truth::Ga(j) => simulate(&signal, &j, &grid, NOISE_STD, rng),
-    }
-    .ok()?;
+    let data = simulate(&signal, truth, &grid, NOISE_STD, rng).ok()?;
     let record = Record::new(grid, data.y).ok()?;
     let s0 = paper::perturb(&[sigma], 0.2, rng)[0];
     let start = paper::uniform_sum_with_std(s0)(0).ok()?;
@@ -255,7 +243,7 @@ fn one_record(
             ]);
         }
     }
-    if let Truth::Ga(_) = truth {
+    if is_gaussian(truth) {
         let gs = ModelStructure::oe(signal.clone(), Gaussian::new(s0).ok()?)
             .with_estimated(false, true, false)
             .with_noise_std(NOISE_STD)
@@ -279,8 +267,8 @@ fn one_record(
 /// The Table 1 cases: name, truth, paper means and stds of `[n, a, σ]`.
 fn cases() -> Vec<(&'static str, Truth, [f64; 3], [f64; 3])> {
     let s3 = 3f64.sqrt();
-    let us = |n, a| Truth::Us(UniformSum::new(n, a).expect("valid"));
-    let ga = |s| Truth::Ga(Gaussian::new(s).expect("valid"));
+    let us = |n: u32, a: f64| truth(json!({"family": "uniform-sum", "n": n, "a": a}));
+    let ga = |sigma: f64| truth(json!({"family": "gaussian", "sigma": sigma}));
     vec![
         (
             "uniform-sum n=0 a=1/2",
@@ -321,26 +309,24 @@ fn cases() -> Vec<(&'static str, Truth, [f64; 3], [f64; 3])> {
     ]
 }
 
-fn truth_json(t: Truth) -> serde_json::Value {
-    match t {
-        Truth::Us(j) => {
+fn truth_json(t: &Truth) -> serde_json::Value {
+    match (t.downcast_ref::<UniformSum>(), t.downcast_ref::<Gaussian>()) {
+        (Some(j), _) => {
             json!({"family": "uniform-sum", "n": j.n(), "a": j.a(), "sigma": j.std_dev()})
         }
-        Truth::Ga(j) => json!({"family": "gaussian", "sigma": j.sigma()}),
+        (_, Some(j)) => json!({"family": "gaussian", "sigma": j.sigma()}),
+        _ => json!({"family": t.family(), "sigma": t.std_dev()}),
     }
 }
 
 /// Rows `n, a, σ` of a uniform-sum estimator.
-fn us_rows(vals: &[[f64; 3]], truth: Truth, crb: Option<f64>, asym: Option<f64>) -> Vec<MlRow> {
-    let (tn, ta) = match truth {
-        Truth::Us(j) => (Some(f64::from(j.n())), Some(j.a())),
-        Truth::Ga(_) => (None, None),
-    };
+fn us_rows(vals: &[[f64; 3]], truth: &Truth, crb: Option<f64>, asym: Option<f64>) -> Vec<MlRow> {
+    let (tn, ta) = uniform_sum_truth(truth);
     let s = |i: usize| -> Summary { vals.iter().map(|v| v[i]).collect() };
     vec![
         ml_row("n", tn, &s(0), None, None),
         ml_row("a", ta, &s(1), None, None),
-        ml_row("sigma", Some(truth.sigma()), &s(2), crb, asym),
+        ml_row("sigma", Some(truth.std_dev()), &s(2), crb, asym),
     ]
 }
 
@@ -371,9 +357,9 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
     let mut out = Vec::new();
     let mut checks = Vec::new();
     for (name, truth, pm, ps) in cases() {
-        let sigma = truth.sigma();
+        let sigma = truth.std_dev();
         let results: Vec<Option<Rec>> = mc_run(o.seed, runs.clone(), |r, rng| {
-            one_record(truth, sigma, o.seed, r, rng)
+            one_record(&truth, sigma, o.seed, r, rng)
         });
         let recs: Vec<&Rec> = results.iter().flatten().collect();
         let crb = rms(recs.iter().filter_map(|r| r.crb));
@@ -400,11 +386,8 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
             crb_std: None,
             asymptotic_std: None,
         };
-        let (tn, ta) = match truth {
-            Truth::Us(j) => (Some(f64::from(j.n())), Some(j.a())),
-            Truth::Ga(_) => (None, None),
-        };
-        out.push(json!({"name": name, "truth": truth_json(truth), "estimator": "bcls-paper", "runs": 128,
+        let (tn, ta) = uniform_sum_truth(&truth);
+        out.push(json!({"name": name, "truth": truth_json(&truth), "estimator": "bcls-paper", "runs": 128,
             "parameters": [paper_row(0, "n", tn), paper_row(1, "a", ta), paper_row(2, "sigma", Some(sigma))]}));
         type Extract = fn(&Rec) -> Option<([f64; 3], Option<f64>)>;
         let estimators: [(&str, Extract); 4] = [
@@ -424,7 +407,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
             };
             // The CRB applies to the family of the truth; for Gaussian truths fitted with the
             // uniform sum it is the Gaussian family's bound on σ (a reference, not a bound).
-            let rows = us_rows(&v3, truth, if est == "bcls" { None } else { crb }, asym);
+            let rows = us_rows(&v3, &truth, if est == "bcls" { None } else { crb }, asym);
             let s = &rows[2];
             let eff = crb.map(|c| (s.std / c).powi(2));
             let _ = writeln!(
@@ -441,7 +424,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
                     s.std,
                     if s.std <= half { "PASS" } else { "FAIL" }
                 ));
-                if let Truth::Us(_) = truth {
+                if truth.downcast_ref::<UniformSum>().is_some() {
                     let z = (s.mean - sigma) / s.se;
                     checks.push(format!(
                         "{name}, {est}: mean σ̂ within 3 se of the truth (z = {z:+.2}): {}",
@@ -450,11 +433,11 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
                 }
             }
             out.push(
-                json!({"name": name, "truth": truth_json(truth), "estimator": est,
+                json!({"name": name, "truth": truth_json(&truth), "estimator": est,
                 "runs": n_runs, "converged": v3.len(), "parameters": rows}),
             );
         }
-        if let Truth::Ga(_) = truth {
+        if is_gaussian(&truth) {
             let vals: Vec<(f64, Option<f64>)> = recs.iter().filter_map(|r| r.gauss).collect();
             let sv: Summary = vals.iter().map(|v| v.0).collect();
             let asym = {
@@ -475,7 +458,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
                 if row.std <= half { "PASS" } else { "FAIL" }
             ));
             out.push(
-                json!({"name": name, "truth": truth_json(truth), "estimator": "exact-ml gaussian",
+                json!({"name": name, "truth": truth_json(&truth), "estimator": "exact-ml gaussian",
                 "runs": n_runs, "converged": vals.len(), "parameters": [row]}),
             );
         }
