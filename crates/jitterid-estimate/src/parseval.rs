@@ -13,7 +13,16 @@
 //! with `S(a) = Σ_k a_k = A_0` and `Alt(a) = Σ_k (−1)^k a_k = A_{N/2}`. So `JᵀJ` is a sum over
 //! samples of the time-domain sensitivities, accumulated sample by sample, and never needs the
 //! `2F × p` frequency-domain Jacobian. `Jᵀr` is taken in the frequency domain, one transformed
-//! column at a time, in the same order as the explicit product (bit-identical to it).
+//! column at a time, in the same order as the explicit product (bit-identical to it), except
+//! for long records ([`TIME_DOMAIN_GRADIENT_MIN_SAMPLES`]): there the same identity moves it to
+//! time,
+//!
+//! ```text
+//! Σ_{j=0}^{⌊N/2⌋} Re(A_j conj R_j) = Σ_k a_k g_k,   g_k = Re Σ_{j=0}^{⌊N/2⌋} R_j e^{i2πjk/N},
+//! ```
+//!
+//! with `R_j = r_{2j} + i r_{2j+1}` the residuals as a half spectrum: one FFT per evaluation
+//! (`g`), none per column, so no column's transform buffers add to the memory of the others.
 
 use crate::criterion::Criterion;
 use crate::finite_diff::{central_difference_vec, MOMENT_FD_STEP};
@@ -24,7 +33,16 @@ use crate::structure::ModelStructure;
 use faer::Mat;
 use jitterid_jitter::{JitterModel, NoJitter};
 use jitterid_signal::Signal;
-use jitterid_window::Window;
+use jitterid_window::{fft_in_place, Complex64, Window};
+
+/// Records of at least this many samples take `Jᵀr` in the time domain
+/// ([`residual_synthesis`], [`time_domain_gradient`]). The frequency-domain product transforms
+/// each sensitivity column while the others are live, and its FFT buffer and scratch (32 bytes
+/// per sample) set the peak memory of a long fit; the time-domain product needs one FFT of the
+/// residual spectrum before any column exists. It rounds differently, so shorter records keep
+/// the frequency-domain product, bit-identical to the explicit Jacobian's (the reproduced
+/// tables use a few hundred to a thousand samples, whose buffers are well under a MiB).
+pub(crate) const TIME_DOMAIN_GRADIENT_MIN_SAMPLES: usize = 1 << 16;
 
 /// The common weight `w` when the criterion on `data` is the half-grid, rectangular-window,
 /// equally weighted case that Parseval turns into sums over samples, and its free parameters
@@ -210,6 +228,27 @@ fn frequency_gradient<W: Window>(
         .collect()
 }
 
+/// `g_k = Re Σ_{j ≤ N/2} R_j e^{i2πjk/N}` for the residuals `r` (length `2(⌊N/2⌋ + 1)`) read as
+/// the half spectrum `R_j = r_{2j} + i r_{2j+1}`, `k < n`: the real part of the forward FFT of
+/// `conj R`, zero-padded to `n`. NaN residuals give NaN values.
+fn residual_synthesis(residuals: &[f64], n: usize) -> Vec<f64> {
+    let mut z = vec![Complex64::new(0.0, 0.0); n];
+    for (z, r) in z.iter_mut().zip(residuals.chunks_exact(2)) {
+        *z = Complex64::new(r[0], -r[1]);
+    }
+    fft_in_place(&mut z);
+    z.iter().map(|z| z.re).collect()
+}
+
+/// `Jᵀr` from the sensitivities and the [`residual_synthesis`] `g` of the residuals: the
+/// column of `J` for `a` is `−√w [Re A_j, Im A_j]`, so `(Jᵀr)_a = −√w Σ_k a_k g_k`.
+fn time_domain_gradient(cols: &[Vec<f64>], g: &[f64], weight: f64) -> Vec<f64> {
+    let sw = weight.sqrt();
+    cols.iter()
+        .map(|c| -sw * crate::solver::dot(c, g))
+        .collect()
+}
+
 /// `JᵀJ` and `Jᵀr` of `criterion` at `model`, without the `2F × p` Jacobian when the Parseval
 /// identity applies (from the sensitivities `known` at `model` when given), from the explicit
 /// Jacobian otherwise.
@@ -234,6 +273,16 @@ where
     };
     match parseval_weight(criterion, data, model) {
         Some(weight) if residuals.len() == data.num_residuals() => {
+            let n = data.record().grid().len();
+            if n >= TIME_DOMAIN_GRADIENT_MIN_SAMPLES {
+                // The synthesis first: its FFT buffers are freed before the columns exist.
+                let g = residual_synthesis(residuals, n);
+                let cols = known.unwrap_or_else(|| moment_sensitivities(criterion, data, model));
+                return NormalEquations {
+                    gram: parseval_gram(&cols, weight),
+                    gradient: time_domain_gradient(&cols, &g, weight),
+                };
+            }
             let cols = known.unwrap_or_else(|| moment_sensitivities(criterion, data, model));
             let gram = parseval_gram(&cols, weight);
             NormalEquations {
@@ -242,5 +291,115 @@ where
             }
         }
         _ => explicit(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Bcls, Record};
+    use jitterid_jitter::Gaussian;
+    use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
+    use jitterid_window::{DirichletWindow, FrequencySet};
+    use rand::SeedableRng;
+
+    type Sys = LtiResponse<Zpk>;
+
+    fn eq17(k: f64, z: f64, re: f64, im: f64) -> Zpk {
+        Zpk::new(k, vec![Root::Real(-z)], vec![Root::Pair { re, im }]).expect("valid")
+    }
+
+    /// A simulated record of `n` samples on the half DFT grid and a structure with the signal
+    /// and the Gaussian jitter estimated, started off the truth.
+    fn setup(
+        n: usize,
+        seed: u64,
+    ) -> (
+        FrequencyData<DirichletWindow>,
+        ModelStructure<Sys, Gaussian>,
+    ) {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let u = RandomBinary::paper()
+            .generate(0.0, n as f64 + 1.0, &mut rng)
+            .expect("input");
+        let grid = SampleGrid::new(0.0, 1.0, n).expect("grid");
+        let truth = LtiResponse::new(eq17(0.2, 0.5, -0.25, 0.3), u.clone());
+        let jitter = Gaussian::new(0.15).expect("jitter");
+        let y = simulate(&truth, &jitter, &grid, 0.01, &mut rng)
+            .expect("simulate")
+            .y;
+        let record = Record::new(grid, y).expect("record");
+        let data =
+            FrequencyData::new(record, DirichletWindow, FrequencySet::dft(&grid)).expect("data");
+        let start = LtiResponse::new(eq17(0.21, 0.45, -0.27, 0.33), u);
+        let structure = ModelStructure::joe(start, Gaussian::new(0.1).expect("jitter"));
+        (data, structure)
+    }
+
+    /// `Jᵀr` of the explicit frequency-domain Jacobian (the independent route).
+    fn explicit(
+        data: &FrequencyData<DirichletWindow>,
+        model: &ModelStructure<Sys, Gaussian>,
+        r: &[f64],
+    ) -> NormalEquations {
+        NormalEquations::from_jacobian(&data.jacobian(&Bcls, model), r).expect("explicit")
+    }
+
+    /// `|x − y| ≤ 1e-12 max|y|` componentwise: both routes sum the same `N` products of
+    /// transformed values in a different order (an FFT of the residuals instead of one per
+    /// column), a rounding difference of some `ε log N` relative to the largest term.
+    fn assert_close(x: &[f64], y: &[f64], what: &str) {
+        let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{what}: a zero gradient tests nothing");
+        for (a, (x, y)) in x.iter().zip(y).enumerate() {
+            assert!(
+                (x - y).abs() <= 1e-12 * scale,
+                "{what}: Jᵀr[{a}] {x} vs {y}"
+            );
+        }
+    }
+
+    #[test]
+    fn time_domain_gradient_equals_the_explicit_one() {
+        // Even and odd N (the Nyquist bin exists only for even N), short and long.
+        for (n, seed) in [(200, 1), (201, 2), (64, 3), (17, 4)] {
+            let (data, model) = setup(n, seed);
+            let r = data.residuals(&Bcls, &model);
+            let weight = parseval_weight(&Bcls, &data, &model).expect("Parseval case");
+            let cols = moment_sensitivities(&Bcls, &data, &model);
+            let g = residual_synthesis(&r, n);
+            let got = time_domain_gradient(&cols, &g, weight);
+            assert_close(
+                &got,
+                &explicit(&data, &model, &r).gradient,
+                &format!("N = {n}"),
+            );
+        }
+    }
+
+    #[test]
+    fn a_long_record_takes_the_time_domain_gradient() {
+        // Odd, just past the threshold: the public route gives the explicit normal equations
+        // to rounding, `JᵀJ` to 1e-12 of its largest entry as in the short-record route.
+        let n = TIME_DOMAIN_GRADIENT_MIN_SAMPLES + 1;
+        let (data, model) = setup(n, 6);
+        let r = data.residuals(&Bcls, &model);
+        let got = criterion_normal_equations(&Bcls, &data, &model, &r, None);
+        let want = explicit(&data, &model, &r);
+        assert_close(&got.gradient, &want.gradient, "long record");
+        let p = model.num_params();
+        let scale = (0..p * p).fold(0.0f64, |m, i| m.max(want.gram[(i / p, i % p)].abs()));
+        for a in 0..p {
+            for b in 0..p {
+                let (x, y) = (got.gram[(a, b)], want.gram[(a, b)]);
+                assert!((x - y).abs() <= 1e-12 * scale, "JᵀJ[{a},{b}] {x} vs {y}");
+            }
+        }
+    }
+
+    #[test]
+    fn non_finite_residuals_give_a_non_finite_gradient() {
+        let g = residual_synthesis(&[1.0, 0.0, f64::NAN, 0.0], 3);
+        assert!(g.iter().all(|v| v.is_nan()));
     }
 }

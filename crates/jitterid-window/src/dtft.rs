@@ -195,8 +195,10 @@ fn complex_buffer(values: &[f64]) -> Vec<Complex64> {
     values.iter().map(|&v| Complex64::new(v, 0.0)).collect()
 }
 
-/// Replaces `buffer` (any length) by its FFT.
-fn fft_in_place(buffer: &mut [Complex64]) {
+/// Replaces `buffer` (any length, empty included) by its forward DFT
+/// `X_j = Σ_k x_k e^{-i2πjk/N}`, with the plan of that length shared with [`transform`] and
+/// [`fft_grid`] (a long record's plan is held once).
+pub fn fft_in_place(buffer: &mut [Complex64]) {
     if !buffer.is_empty() {
         plan(buffer.len()).process(buffer);
     }

@@ -97,7 +97,7 @@ pub mod moment;
 mod phase;
 mod window;
 
-pub use dtft::{dtft, fft_grid, transform};
+pub use dtft::{dtft, fft_grid, fft_in_place, transform};
 pub use error::WindowError;
 pub use frequencies::FrequencySet;
 pub use moment::{first_moment, first_moment_integral, IntegralMoment, IntegralOptions};
