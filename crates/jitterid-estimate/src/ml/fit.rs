@@ -131,14 +131,17 @@ where
     C: LikelihoodCriterion,
     V: ObjectiveSolver,
 {
-    ml_estimate_with(structure, record, None, criterion, options)
+    ml_estimate_with(structure, record, None, None, criterion, options)
 }
 
-/// [`ml_estimate`] with optionally prepared data (valid for `structure`'s fixed parts).
+/// [`ml_estimate`] with optionally prepared data (valid for `structure`'s fixed parts) and
+/// optionally a value of the criterion already known (`(θ, −log L)`, computed on the same
+/// data), which is then not evaluated again.
 fn ml_estimate_with<S, J, N, C, V>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     data: Option<&LikelihoodData>,
+    known: Option<(&[f64], f64)>,
     criterion: &C,
     options: &MlOptions<V>,
 ) -> Result<Fit, MlError>
@@ -185,13 +188,24 @@ where
         Some(d) => LikelihoodObjective::with_data(structure, criterion, d.clone()),
         None => LikelihoodObjective::new(structure, criterion, record),
     };
-    // The typed reason if the criterion is not defined at the start.
-    objective.evaluate(&start)?;
+    if let Some((theta, value)) = known {
+        objective.keep(theta, value);
+    }
     let transforms = options
         .transforms
         .clone()
         .unwrap_or_else(|| default_transforms(structure));
-    let constrained = TransformedObjective::new(&objective, transforms)?;
+    let constrained = TransformedObjective::new(&objective, transforms);
+    // The typed reason if the criterion is not defined at the start, checked where the solver
+    // first evaluates it (the start through the transforms and back, which can differ from
+    // `start` in the last bit), so that the solver's first value is the kept one.
+    let solver_start = constrained
+        .as_ref()
+        .ok()
+        .and_then(|c| c.to_internal(&start).ok().map(|phi| c.to_external(&phi)))
+        .filter(|t| t.iter().all(|v| v.is_finite()));
+    objective.evaluate(solver_start.as_deref().unwrap_or(&start))?;
+    let constrained = constrained?;
     let phi0 = constrained.to_internal(&start)?;
     // The metric of BFGS: the inverse of the Gaussian (Slepian–Bangs) information at the start
     // in the unconstrained coordinates, which puts parameters of very different curvature
@@ -332,18 +346,18 @@ where
         covariance: false,
         ..options.clone()
     };
-    let fit_with =
-        |s: &ModelStructure<S, J, N>, staged_solver: Option<&MlOptions<Brent>>| match staged_solver
-        {
-            Some(o) => ml_estimate_with(s, record, data.as_ref(), criterion, o),
-            None => ml_estimate_with(s, record, data.as_ref(), criterion, &plain),
-        };
+    let fit_with = |s: &ModelStructure<S, J, N>,
+                    staged_solver: Option<&MlOptions<Brent>>,
+                    known: Option<(&[f64], f64)>| match staged_solver {
+        Some(o) => ml_estimate_with(s, record, data.as_ref(), known, criterion, o),
+        None => ml_estimate_with(s, record, data.as_ref(), known, criterion, &plain),
+    };
     let mut fits: Vec<(i64, Result<Fit, MlError>)> = values
         .par_iter()
         .map(|&v| {
             (
                 v,
-                at(v).and_then(|s| fit_with(&s, staged.then_some(&coarse))),
+                at(v).and_then(|s| fit_with(&s, staged.then_some(&coarse), None)),
             )
         })
         .collect();
@@ -369,10 +383,11 @@ where
             };
             if refine {
                 if let Ok(e) = fit {
-                    // Restart from the coarse minimum.
+                    // Restart from the coarse minimum, whose value (on the same data) is known.
+                    let known = e.cost.is_finite().then_some((e.params.as_slice(), e.cost));
                     let refined = at(*v).and_then(|s| {
                         let s = s.with_params(&e.params).map_err(MlError::from)?;
-                        fit_with(&s, Some(&fine))
+                        fit_with(&s, Some(&fine), known)
                     });
                     if let Ok(better) = refined {
                         *fit = Ok(better);
@@ -403,4 +418,59 @@ where
         estimate,
         costs,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ml::ExactMl;
+    use jitterid_jitter::UniformSum;
+    use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
+    use rand::rngs::StdRng;
+    use rand::SeedableRng;
+
+    /// A refinement handed the coarse fit's final value returns the same fit, to the bit, as
+    /// one that evaluates it again: the value a fit reports is the criterion's value at the
+    /// parameters it reports, on the same data.
+    #[test]
+    fn refinement_with_the_known_start_value_is_unchanged() {
+        let grid = SampleGrid::new(0.0, 1.0, 120).unwrap();
+        let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap();
+        let mut rng = StdRng::seed_from_u64(5);
+        let u = RandomBinary::paper()
+            .generate(0.0, 121.0, &mut rng)
+            .unwrap();
+        let signal = LtiResponse::new(g, u);
+        let truth = UniformSum::new(1, 0.4).unwrap();
+        let y = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap().y;
+        let record = Record::new(grid, y).unwrap();
+        let structure = ModelStructure::oe(signal, UniformSum::new(1, 0.3).unwrap())
+            .with_estimated(false, true, false)
+            .with_noise_std(0.01)
+            .unwrap();
+        let criterion = ExactMl::default();
+        let data = criterion.prepare(&structure, &record);
+        let coarse = MlOptions::default().with_solver(Brent {
+            tolerance: 3e-3,
+            ..Brent::default()
+        });
+        let first =
+            ml_estimate_with(&structure, &record, Some(&data), None, &criterion, &coarse).unwrap();
+        assert!(first.cost.is_finite());
+        // The premise: the reported cost is the criterion's value at the reported parameters.
+        let fresh = LikelihoodObjective::with_data(&structure, &criterion, data.clone());
+        assert_eq!(
+            fresh.evaluate(&first.params).unwrap().to_bits(),
+            first.cost.to_bits()
+        );
+        let fine = MlOptions::default().with_solver(Brent {
+            bracket_step: 0.01,
+            ..Brent::default()
+        });
+        let restart = structure.with_params(&first.params).unwrap();
+        let known = Some((first.params.as_slice(), first.cost));
+        let with = ml_estimate_with(&restart, &record, Some(&data), known, &criterion, &fine);
+        let without = ml_estimate_with(&restart, &record, Some(&data), None, &criterion, &fine);
+        assert_eq!(with.unwrap(), without.unwrap());
+    }
 }

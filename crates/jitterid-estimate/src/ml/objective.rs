@@ -11,6 +11,13 @@ use crate::solver::{SolverError, Transform};
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::Signal;
+use std::sync::Mutex;
+
+/// Values kept by a [`LikelihoodObjective`]: a fit asks for the value at its start twice (the
+/// typed check, then the solver's first step), and a refinement starts where a coarse fit
+/// ended, whose value is known. The criterion is deterministic (bit-identical for any number
+/// of threads), so a kept value is the value a new evaluation would return.
+const KEPT_VALUES: usize = 4;
 
 /// A likelihood criterion on a record as an [`Objective`] in the likelihood's parameter
 /// vector ([`likelihood_param_names`](super::likelihood_param_names)): the structure's free
@@ -24,6 +31,8 @@ pub struct LikelihoodObjective<'a, S, J, N, C> {
     criterion: &'a C,
     data: LikelihoodData,
     layout: Layout,
+    /// The last few `(θ bits, value)` evaluated or handed over (see [`KEPT_VALUES`]).
+    kept: Mutex<Vec<(Vec<u64>, f64)>>,
 }
 
 impl<'a, S, J, N, C> LikelihoodObjective<'a, S, J, N, C>
@@ -44,6 +53,7 @@ where
             criterion,
             data: criterion.prepare(structure, record),
             layout: Layout::of(structure),
+            kept: Mutex::new(Vec::new()),
         }
     }
 
@@ -58,6 +68,7 @@ where
             criterion,
             data,
             layout: Layout::of(structure),
+            kept: Mutex::new(Vec::new()),
         }
     }
 
@@ -67,11 +78,40 @@ where
     ///
     /// An invalid parameter vector or any error of the criterion (see [`MlError`]).
     pub fn evaluate(&self, theta: &[f64]) -> Result<f64, MlError> {
+        if let Some(v) = self.kept_value(theta) {
+            return Ok(v);
+        }
         let (model, sigma) = split(self.structure, theta)?;
-        Ok(self
+        let v = self
             .criterion
             .evaluate(&self.data, &model, sigma, GradientRequest::default())?
-            .nll)
+            .nll;
+        self.keep(theta, v);
+        Ok(v)
+    }
+
+    /// Records that the criterion's value at `theta` is `value` (a value this objective, or
+    /// one on the same data and structure, computed), so that it is not evaluated again.
+    pub(crate) fn keep(&self, theta: &[f64], value: f64) {
+        let key: Vec<u64> = theta.iter().map(|v| v.to_bits()).collect();
+        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.iter().any(|(k, _)| *k == key) {
+            return;
+        }
+        if kept.len() == KEPT_VALUES {
+            kept.remove(0);
+        }
+        kept.push((key, value));
+    }
+
+    /// The kept value at exactly `theta`, if any.
+    fn kept_value(&self, theta: &[f64]) -> Option<f64> {
+        let kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        kept.iter()
+            .find(|(k, _)| {
+                k.len() == theta.len() && k.iter().zip(theta).all(|(b, v)| *b == v.to_bits())
+            })
+            .map(|&(_, v)| v)
     }
 
     /// The prepared data.
