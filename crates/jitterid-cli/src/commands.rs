@@ -70,9 +70,11 @@ pub struct SimulatedData {
 /// Carlo run `run`.
 pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> CliResult<SimulatedData> {
     let mut rng = realization_rng(seed, run);
-    let input = fitting::realize_input(exp, &mut rng)?;
-    let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+    let truth = fitting::realize_input(exp, &mut rng)?;
+    let signal = fitting::signal_of(&exp.system.kind, truth.as_ref())?;
     let sim = fitting::simulate_record(exp, &signal, &mut rng)?;
+    // What a measurement records, and what the side file holds: the input from t0 on.
+    let input = fitting::seen_input(exp, truth.as_ref())?;
     if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
         return Err(cli_err!(
             "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
@@ -679,10 +681,13 @@ fn one_run(
 ) -> RunOut {
     let mut go = || -> Result<Fit, String> {
         let text = |e: CliError| e.to_string();
-        let input = fitting::realize_input(exp, rng).map_err(text)?;
-        let signal = fitting::signal_of(&exp.system.kind, input.as_ref()).map_err(text)?;
+        let truth = fitting::realize_input(exp, rng).map_err(text)?;
+        let signal = fitting::signal_of(&exp.system.kind, truth.as_ref()).map_err(text)?;
         let sim = fitting::simulate_record(exp, &signal, rng).map_err(text)?;
-        let s = fitting::structure(exp, signal, method).map_err(text)?;
+        // The model sees the input from t0 on only, as a fit of measured data would.
+        let seen = fitting::seen_input(exp, truth.as_ref()).map_err(text)?;
+        let model = fitting::signal_of(&exp.system.kind, seen.as_ref()).map_err(text)?;
+        let s = fitting::structure(exp, model, method).map_err(text)?;
         let start = fitting::perturb(&s.params(), exp.estimate.perturb, rng);
         let s0 = s.with_params(&start).map_err(|e| e.to_string())?;
         let record = fitting::record(&exp.grid, sim.y).map_err(|e| e.to_string())?;
@@ -793,7 +798,8 @@ fn run_study(
     }
     // The names and truths, from realisation 0's setup (they do not depend on the input).
     let mut rng0 = realization_rng(seed, 0);
-    let input0 = fitting::realize_input(exp, &mut rng0)?;
+    let truth0 = fitting::realize_input(exp, &mut rng0)?;
+    let input0 = fitting::seen_input(exp, truth0.as_ref())?;
     let signal0 = fitting::signal_of(&exp.system.kind, input0.as_ref())?;
     let names = fitting::param_names(exp, &signal0, method)?;
     let truth = fitting::truth_values(exp, &signal0, method)?;
