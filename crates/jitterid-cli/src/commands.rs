@@ -870,6 +870,35 @@ fn run_study(
     })
 }
 
+/// Every realisation of a study, with the reported parameters' names and true values.
+#[derive(Debug, Clone)]
+pub struct Realizations {
+    /// Names of the reported parameters, in order.
+    pub names: Vec<String>,
+    /// Their true values (`None` where a parameter has no single truth, such as the free
+    /// response's coefficients after an input with a history).
+    pub truth: Vec<Option<f64>>,
+    /// Every run, in run order.
+    pub runs: Vec<Realization>,
+}
+
+/// Every realisation of a study of `runs` runs: the estimates of runs that
+/// [`montecarlo_values`] leaves out of its summary too, such as fits whose residual spectrum
+/// is not flat, for studies of a model's bias.
+pub fn montecarlo_realizations(
+    exp: &Experiment,
+    runs: u64,
+    seed: u64,
+    threads: Option<usize>,
+) -> CliResult<Realizations> {
+    let s = run_study(exp, runs, seed, None, threads, false)?;
+    Ok(Realizations {
+        names: s.names,
+        truth: s.truth,
+        runs: s.outs.into_iter().map(|o| o.realization).collect(),
+    })
+}
+
 /// The result of `jitterid montecarlo --json` (with `--shard` when `shard` is given) for an
 /// experiment already read, as values.
 pub fn montecarlo_values(
