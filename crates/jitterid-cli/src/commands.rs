@@ -664,6 +664,8 @@ pub fn summarize(
 
 struct RunOut {
     realization: Realization,
+    /// The standard error the fit reported for each estimate (`None` where undefined).
+    stderr: Vec<Option<f64>>,
     fitted: Option<Structure>,
 }
 
@@ -702,6 +704,7 @@ fn one_run(
     };
     match go() {
         Ok(f) => RunOut {
+            stderr: f.params.iter().map(|p| p.stderr.and_then(finite)).collect(),
             realization: Realization {
                 run: r,
                 converged: f.converged,
@@ -711,6 +714,7 @@ fn one_run(
             fitted: keep.then_some(f.fitted),
         },
         Err(e) => RunOut {
+            stderr: vec![None; n],
             realization: Realization {
                 run: r,
                 converged: false,
@@ -880,6 +884,8 @@ pub struct Realizations {
     pub truth: Vec<Option<f64>>,
     /// Every run, in run order.
     pub runs: Vec<Realization>,
+    /// The standard errors each run's fit reported, in the order of `runs` and `names`.
+    pub stderr: Vec<Vec<Option<f64>>>,
 }
 
 /// Every realisation of a study of `runs` runs: the estimates of runs that
@@ -892,10 +898,16 @@ pub fn montecarlo_realizations(
     threads: Option<usize>,
 ) -> CliResult<Realizations> {
     let s = run_study(exp, runs, seed, None, threads, false)?;
+    let (runs, stderr) = s
+        .outs
+        .into_iter()
+        .map(|o| (o.realization, o.stderr))
+        .unzip();
     Ok(Realizations {
         names: s.names,
         truth: s.truth,
-        runs: s.outs.into_iter().map(|o| o.realization).collect(),
+        runs,
+        stderr,
     })
 }
 
