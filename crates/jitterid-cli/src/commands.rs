@@ -672,6 +672,15 @@ struct RunOut {
 /// Realisations whose fitted models are kept for the figures.
 const KEEP_FITTED: u64 = 32;
 
+/// What a study keeps of each fit besides its estimates.
+#[derive(Debug, Clone, Copy, Default)]
+struct Keep {
+    /// The fitted models of the first [`KEEP_FITTED`] runs (for the figures).
+    fitted: bool,
+    /// Every fit's standard errors (the covariance is computed for every fit).
+    stderr: bool,
+}
+
 fn one_run(
     exp: &Experiment,
     method: Method,
@@ -679,7 +688,7 @@ fn one_run(
     n: usize,
     r: u64,
     rng: &mut jitterid::rand::rngs::StdRng,
-    keep: bool,
+    keep: Keep,
 ) -> RunOut {
     let mut go = || -> Result<Fit, String> {
         let text = |e: CliError| e.to_string();
@@ -699,7 +708,7 @@ fn one_run(
             &record,
             method,
             realization_seed(seed, r) ^ 0x6d73,
-            exp.noise.estimate,
+            exp.noise.estimate || keep.stderr,
         )
     };
     match go() {
@@ -711,7 +720,7 @@ fn one_run(
                 termination: f.termination.clone(),
                 values: f.params.iter().map(|p| finite(p.estimate)).collect(),
             },
-            fitted: keep.then_some(f.fitted),
+            fitted: keep.fitted.then_some(f.fitted),
         },
         Err(e) => RunOut {
             stderr: vec![None; n],
@@ -785,14 +794,14 @@ struct StudyRun {
 
 /// Runs `runs` realisations (or shard `shard` of them) of the experiment with its method on
 /// `threads` worker threads (rayon's default if `None`), keeping the fitted models of the first
-/// runs when `keep_fitted`.
+/// runs when `keep.fitted`, and every fit's standard errors when `keep.stderr`.
 fn run_study(
     exp: &Experiment,
     runs: u64,
     seed: u64,
     shard: Option<Shard>,
     threads: Option<usize>,
-    keep_fitted: bool,
+    keep: Keep,
 ) -> CliResult<StudyRun> {
     let method = exp.estimate.method;
     if runs == 0 || runs > MAX_RUNS {
@@ -833,7 +842,10 @@ fn run_study(
                 n,
                 r,
                 rng,
-                keep_fitted && r < first + KEEP_FITTED,
+                Keep {
+                    fitted: keep.fitted && r < first + KEEP_FITTED,
+                    stderr: keep.stderr,
+                },
             );
             progress.tick();
             out
@@ -884,7 +896,8 @@ pub struct Realizations {
     pub truth: Vec<Option<f64>>,
     /// Every run, in run order.
     pub runs: Vec<Realization>,
-    /// The standard errors each run's fit reported, in the order of `runs` and `names`.
+    /// The standard errors each run's fit reported (`None` where undefined or for a failed
+    /// run), in the order of `runs` and `names`.
     pub stderr: Vec<Vec<Option<f64>>>,
 }
 
@@ -897,7 +910,11 @@ pub fn montecarlo_realizations(
     seed: u64,
     threads: Option<usize>,
 ) -> CliResult<Realizations> {
-    let s = run_study(exp, runs, seed, None, threads, false)?;
+    let keep = Keep {
+        fitted: false,
+        stderr: true,
+    };
+    let s = run_study(exp, runs, seed, None, threads, keep)?;
     let (runs, stderr) = s
         .outs
         .into_iter()
@@ -920,7 +937,7 @@ pub fn montecarlo_values(
     shard: Option<Shard>,
     threads: Option<usize>,
 ) -> CliResult<McJson> {
-    run_study(exp, runs, seed, shard, threads, false).map(|s| s.json)
+    run_study(exp, runs, seed, shard, threads, Keep::default()).map(|s| s.json)
 }
 
 /// `jitterid montecarlo`: the text to print (empty if the JSON is written to `--out`), and exit
@@ -932,7 +949,11 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
         o.max_iterations,
         o.time_limit,
     )?;
-    let study = run_study(&exp, o.runs, o.seed, o.shard, o.threads, o.plot.is_some())?;
+    let keep = Keep {
+        fitted: o.plot.is_some(),
+        stderr: false,
+    };
+    let study = run_study(&exp, o.runs, o.seed, o.shard, o.threads, keep)?;
     let j = &study.json;
     let mut outputs = OutputSet::new();
     if let Some(dir) = &o.plot {
