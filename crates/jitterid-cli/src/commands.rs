@@ -70,9 +70,11 @@ pub struct SimulatedData {
 /// Carlo run `run`.
 pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> CliResult<SimulatedData> {
     let mut rng = realization_rng(seed, run);
-    let input = fitting::realize_input(exp, &mut rng)?;
-    let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+    let truth = fitting::realize_input(exp, &mut rng)?;
+    let signal = fitting::signal_of(&exp.system.kind, truth.as_ref())?;
     let sim = fitting::simulate_record(exp, &signal, &mut rng)?;
+    // What a measurement records, and what the side file holds: the input from t0 on.
+    let input = fitting::seen_input(exp, truth.as_ref())?;
     if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
         return Err(cli_err!(
             "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
@@ -662,11 +664,22 @@ pub fn summarize(
 
 struct RunOut {
     realization: Realization,
+    /// The standard error the fit reported for each estimate (`None` where undefined).
+    stderr: Vec<Option<f64>>,
     fitted: Option<Structure>,
 }
 
 /// Realisations whose fitted models are kept for the figures.
 const KEEP_FITTED: u64 = 32;
+
+/// What a study keeps of each fit besides its estimates.
+#[derive(Debug, Clone, Copy, Default)]
+struct Keep {
+    /// The fitted models of the first [`KEEP_FITTED`] runs (for the figures).
+    fitted: bool,
+    /// Every fit's standard errors (the covariance is computed for every fit).
+    stderr: bool,
+}
 
 fn one_run(
     exp: &Experiment,
@@ -675,14 +688,17 @@ fn one_run(
     n: usize,
     r: u64,
     rng: &mut jitterid::rand::rngs::StdRng,
-    keep: bool,
+    keep: Keep,
 ) -> RunOut {
     let mut go = || -> Result<Fit, String> {
         let text = |e: CliError| e.to_string();
-        let input = fitting::realize_input(exp, rng).map_err(text)?;
-        let signal = fitting::signal_of(&exp.system.kind, input.as_ref()).map_err(text)?;
+        let truth = fitting::realize_input(exp, rng).map_err(text)?;
+        let signal = fitting::signal_of(&exp.system.kind, truth.as_ref()).map_err(text)?;
         let sim = fitting::simulate_record(exp, &signal, rng).map_err(text)?;
-        let s = fitting::structure(exp, signal, method).map_err(text)?;
+        // The model sees the input from t0 on only, as a fit of measured data would.
+        let seen = fitting::seen_input(exp, truth.as_ref()).map_err(text)?;
+        let model = fitting::signal_of(&exp.system.kind, seen.as_ref()).map_err(text)?;
+        let s = fitting::structure(exp, model, method).map_err(text)?;
         let start = fitting::perturb(&s.params(), exp.estimate.perturb, rng);
         let s0 = s.with_params(&start).map_err(|e| e.to_string())?;
         let record = fitting::record(&exp.grid, sim.y).map_err(|e| e.to_string())?;
@@ -692,20 +708,22 @@ fn one_run(
             &record,
             method,
             realization_seed(seed, r) ^ 0x6d73,
-            exp.noise.estimate,
+            exp.noise.estimate || keep.stderr,
         )
     };
     match go() {
         Ok(f) => RunOut {
+            stderr: f.params.iter().map(|p| p.stderr.and_then(finite)).collect(),
             realization: Realization {
                 run: r,
                 converged: f.converged,
                 termination: f.termination.clone(),
                 values: f.params.iter().map(|p| finite(p.estimate)).collect(),
             },
-            fitted: keep.then_some(f.fitted),
+            fitted: keep.fitted.then_some(f.fitted),
         },
         Err(e) => RunOut {
+            stderr: vec![None; n],
             realization: Realization {
                 run: r,
                 converged: false,
@@ -776,14 +794,14 @@ struct StudyRun {
 
 /// Runs `runs` realisations (or shard `shard` of them) of the experiment with its method on
 /// `threads` worker threads (rayon's default if `None`), keeping the fitted models of the first
-/// runs when `keep_fitted`.
+/// runs when `keep.fitted`, and every fit's standard errors when `keep.stderr`.
 fn run_study(
     exp: &Experiment,
     runs: u64,
     seed: u64,
     shard: Option<Shard>,
     threads: Option<usize>,
-    keep_fitted: bool,
+    keep: Keep,
 ) -> CliResult<StudyRun> {
     let method = exp.estimate.method;
     if runs == 0 || runs > MAX_RUNS {
@@ -793,7 +811,8 @@ fn run_study(
     }
     // The names and truths, from realisation 0's setup (they do not depend on the input).
     let mut rng0 = realization_rng(seed, 0);
-    let input0 = fitting::realize_input(exp, &mut rng0)?;
+    let truth0 = fitting::realize_input(exp, &mut rng0)?;
+    let input0 = fitting::seen_input(exp, truth0.as_ref())?;
     let signal0 = fitting::signal_of(&exp.system.kind, input0.as_ref())?;
     let names = fitting::param_names(exp, &signal0, method)?;
     let truth = fitting::truth_values(exp, &signal0, method)?;
@@ -823,7 +842,10 @@ fn run_study(
                 n,
                 r,
                 rng,
-                keep_fitted && r < first + KEEP_FITTED,
+                Keep {
+                    fitted: keep.fitted && r < first + KEEP_FITTED,
+                    stderr: keep.stderr,
+                },
             );
             progress.tick();
             out
@@ -864,6 +886,48 @@ fn run_study(
     })
 }
 
+/// Every realisation of a study, with the reported parameters' names and true values.
+#[derive(Debug, Clone)]
+pub struct Realizations {
+    /// Names of the reported parameters, in order.
+    pub names: Vec<String>,
+    /// Their true values (`None` where a parameter has no single truth, such as the free
+    /// response's coefficients after an input with a history).
+    pub truth: Vec<Option<f64>>,
+    /// Every run, in run order.
+    pub runs: Vec<Realization>,
+    /// The standard errors each run's fit reported (`None` where undefined or for a failed
+    /// run), in the order of `runs` and `names`.
+    pub stderr: Vec<Vec<Option<f64>>>,
+}
+
+/// Every realisation of a study of `runs` runs: the estimates of runs that
+/// [`montecarlo_values`] leaves out of its summary too, such as fits whose residual spectrum
+/// is not flat, for studies of a model's bias.
+pub fn montecarlo_realizations(
+    exp: &Experiment,
+    runs: u64,
+    seed: u64,
+    threads: Option<usize>,
+) -> CliResult<Realizations> {
+    let keep = Keep {
+        fitted: false,
+        stderr: true,
+    };
+    let s = run_study(exp, runs, seed, None, threads, keep)?;
+    let (runs, stderr) = s
+        .outs
+        .into_iter()
+        .map(|o| (o.realization, o.stderr))
+        .unzip();
+    Ok(Realizations {
+        names: s.names,
+        truth: s.truth,
+        runs,
+        stderr,
+    })
+}
+
 /// The result of `jitterid montecarlo --json` (with `--shard` when `shard` is given) for an
 /// experiment already read, as values.
 pub fn montecarlo_values(
@@ -873,7 +937,7 @@ pub fn montecarlo_values(
     shard: Option<Shard>,
     threads: Option<usize>,
 ) -> CliResult<McJson> {
-    run_study(exp, runs, seed, shard, threads, false).map(|s| s.json)
+    run_study(exp, runs, seed, shard, threads, Keep::default()).map(|s| s.json)
 }
 
 /// `jitterid montecarlo`: the text to print (empty if the JSON is written to `--out`), and exit
@@ -885,7 +949,11 @@ pub fn montecarlo(o: &MonteCarloOptions) -> CliResult<Outcome> {
         o.max_iterations,
         o.time_limit,
     )?;
-    let study = run_study(&exp, o.runs, o.seed, o.shard, o.threads, o.plot.is_some())?;
+    let keep = Keep {
+        fitted: o.plot.is_some(),
+        stderr: false,
+    };
+    let study = run_study(&exp, o.runs, o.seed, o.shard, o.threads, keep)?;
     let j = &study.json;
     let mut outputs = OutputSet::new();
     if let Some(dir) = &o.plot {

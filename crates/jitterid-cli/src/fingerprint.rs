@@ -17,6 +17,10 @@ pub fn experiment_fingerprint(exp: &Experiment) -> String {
         "title={:?}\ngrid={:?}\ninput={:?}\nsystem={:?}\njitter={:?}\nnoise={:?}\nestimate={:?}",
         exp.title, exp.grid, exp.input, exp.system, exp.jitter, exp.noise, exp.estimate
     );
+    // Entered only when given, so that an experiment without a history keeps its fingerprint.
+    if exp.history != 0.0 {
+        let _ = write!(h, "\nhistory={:?}", exp.history);
+    }
     format!("{:016x}", h.0.finish())
 }
 
@@ -69,6 +73,9 @@ std = 0.01
             ("poles = [-0.5]", "poles = [-0.25]"),
             ("sigma = 0.1", "sigma = 0.100000001"),
             ("std = 0.01", "std = 0.02"),
+            ("mean_dwell = 8.0", "mean_dwell = 8.0\nhistory = 5.0"),
+            ("poles = [-0.5]", "poles = [-0.5]\ndelay = 0.5"),
+            ("poles = [-0.5]", "poles = [-0.5]\ninitial = \"estimate\""),
             ("[noise]", "[estimate]\nmethod = \"ls\"\n[noise]"),
             ("[sampling]", "title = \"other\"\n[sampling]"),
         ] {

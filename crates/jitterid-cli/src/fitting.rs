@@ -50,17 +50,31 @@ pub fn signal_of(spec: &Spec, input: Option<&Input>) -> CliResult<AnySignal> {
         .map_err(|e| cli_err!("[system]: {e}"))
 }
 
-/// The input of one realisation: a random binary input is drawn from `rng`, others are fixed.
+/// The true input of one realisation: a random binary input is drawn from `rng` (from
+/// `history` seconds before `t0`), others are fixed.
 pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> CliResult<Option<Input>> {
     Ok(match &exp.input {
         InputSpec::None => None,
         InputSpec::Known(i) => Some(i.clone()),
         InputSpec::RandomBinary(rb) => {
             let (a, b) = input_span(&exp.grid);
-            Some(Input::Piecewise(rb.generate(a, b, rng).map_err(|e| {
-                cli_err!("{}: [input] random-binary: {e}", exp.file)
-            })?))
+            Some(Input::Piecewise(
+                rb.generate(a - exp.history, b, rng)
+                    .map_err(|e| cli_err!("{}: [input] random-binary: {e}", exp.file))?,
+            ))
         }
+    })
+}
+
+/// The input as a fit sees it: the true input from the record's first instant `t0` on (what
+/// `simulate` writes beside the record), as a measurement of it would.
+pub fn seen_input(exp: &Experiment, truth: Option<&Input>) -> CliResult<Option<Input>> {
+    Ok(match truth {
+        Some(Input::Piecewise(p)) if exp.history > 0.0 => Some(Input::Piecewise(
+            crate::inputs::from_start(p, exp.grid.start())
+                .map_err(|e| cli_err!("{}: [input] history: {e}", exp.file))?,
+        )),
+        other => other.cloned(),
     })
 }
 
@@ -281,7 +295,16 @@ pub fn truth_values(
     let names = report_names(exp, &s);
     let mut out = Vec::with_capacity(names.len());
     if s.estimate_signal {
-        out.extend(signal_truth.params().into_iter().map(Some));
+        // After an input with a history the free response's coefficients are those of each
+        // realisation's state at t0: no one truth.
+        let names = signal_truth.param_names();
+        out.extend(
+            signal_truth
+                .params()
+                .into_iter()
+                .zip(&names)
+                .map(|(p, n)| (exp.history == 0.0 || !n.starts_with("initial.")).then_some(p)),
+        );
     }
     if s.estimate_jitter {
         let t = &exp.jitter.truth;

@@ -4,7 +4,7 @@
 use crate::csvio;
 use crate::error::CliResult;
 use jitterid::estimate::csv;
-use jitterid::signal::{PiecewiseConstant, SampleGrid};
+use jitterid::signal::{PiecewiseConstant, SampleGrid, SignalError};
 
 /// The span `[t0, t0 + (N+1)T)` on which a random binary input is drawn.
 pub fn input_span(grid: &SampleGrid) -> (f64, f64) {
@@ -35,4 +35,23 @@ pub fn piecewise_from_table(
         value_column,
         grid,
     )?)
+}
+
+/// The part of `u` from `t0` on, as a measurement that starts at `t0` records it: the level
+/// held at `t0`, then `u`'s own switches; zero where `u` has ended. Unchanged when `u` starts
+/// at or after `t0`.
+pub fn from_start(u: &PiecewiseConstant, t0: f64) -> Result<PiecewiseConstant, SignalError> {
+    let edges = u.edges();
+    // Index of the first edge after t0: the interval before it holds t0.
+    let i = edges.partition_point(|&e| e <= t0);
+    if i == 0 {
+        return Ok(u.clone());
+    }
+    if i == edges.len() {
+        // The input ended before t0: the record sees none of it.
+        return PiecewiseConstant::new(vec![t0, t0 + 1.0], vec![0.0]);
+    }
+    let mut e = vec![t0];
+    e.extend_from_slice(&edges[i..]);
+    PiecewiseConstant::new(e, u.levels()[i - 1..].to_vec())
 }

@@ -20,13 +20,14 @@ const S: &str = "input";
 const KINDS: &str = "\"random-binary\", \"sine\", \"multisine\", \"piecewise\" or \"csv\"";
 
 /// The input of `system`: none for a kind without one (a sinusoid), required for a kind the
-/// signal registry drives by an input (a rational system).
+/// signal registry drives by an input (a rational system); with the input's history before
+/// `t0` in seconds (`[input] history`, 0 unless given).
 pub(super) fn parse_input_section(
     cx: &Source,
     r: Option<&RawInput>,
     system: &SystemSpec,
     grid: &SampleGrid,
-) -> CliResult<InputSpec> {
+) -> CliResult<(InputSpec, f64)> {
     let name = system
         .kind
         .get(KIND_KEY)
@@ -37,21 +38,25 @@ pub(super) fn parse_input_section(
         .is_some_and(|k| k.needs_input());
     let why = format!("a {name} system has no input; remove the [input] section");
     match (needs_input, r) {
-        (false, None) => Ok(InputSpec::None),
+        (false, None) => Ok((InputSpec::None, 0.0)),
         (false, Some(r)) => Err(cx.err_at(S, "kind", r.kind.as_ref(), why)),
         (true, None) => Err(cli_err!(
             "{}: missing section [input]; a {name} system needs an input (kind = {KINDS})",
             cx.file,
         )),
-        (true, Some(r)) => parse_input(cx, r, grid),
+        (true, Some(r)) => {
+            let history =
+                cx.opt_checked(S, "history", &r.history, 0.0, |h| range::history(h, grid))?;
+            Ok((parse_input(cx, r, grid, history)?, history))
+        }
     }
 }
 
-fn parse_input(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
+fn parse_input(cx: &Source, r: &RawInput, grid: &SampleGrid, history: f64) -> CliResult<InputSpec> {
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
     let name = kind.get_ref().as_str();
     let allowed: &[&str] = match name {
-        "random-binary" => &["kind", "mean_dwell", "low", "high"],
+        "random-binary" => &["kind", "mean_dwell", "low", "high", "history"],
         "sine" => &["kind", "frequency", "amplitude", "phase"],
         "multisine" => &["kind", "frequencies", "amplitudes", "phases"],
         "piecewise" => &["kind", "times", "values"],
@@ -67,7 +72,7 @@ fn parse_input(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputS
     };
     cx.only(S, &r.present(), "kind", allowed, name)?;
     match name {
-        "random-binary" => random_binary(cx, r, grid),
+        "random-binary" => random_binary(cx, r, grid, history),
         "sine" => sine(cx, r, grid),
         "multisine" => multisine(cx, r, grid),
         "piecewise" => piecewise_levels(cx, r, grid),
@@ -75,7 +80,13 @@ fn parse_input(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputS
     }
 }
 
-fn random_binary(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
+/// A random binary input, drawn on `[t0 − history, t0 + (N+1)T)`.
+fn random_binary(
+    cx: &Source,
+    r: &RawInput,
+    grid: &SampleGrid,
+    history: f64,
+) -> CliResult<InputSpec> {
     let dwell = cx.required(
         S,
         "mean_dwell",
@@ -86,6 +97,7 @@ fn random_binary(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<Inpu
     let low = cx.opt_checked(S, "low", &r.low, 0.0, range::level)?;
     let high = cx.opt_checked(S, "high", &r.high, 1.0, range::level)?;
     let (a, b) = input_span(grid);
+    let a = a - history;
     if (b - a) / mean_dwell > MAX_SWITCHES || mean_dwell < 1e-9 * a.abs().max(b.abs()) {
         return Err(cx.err(
             S,

@@ -33,6 +33,7 @@ use crate::csvio;
 use crate::error::CliResult;
 use diagnostics::{shape_error, toml_error, Source};
 use jitterid::estimate::{AnyNoise, Frequencies};
+use jitterid::signal::Input;
 use raw::RawExperiment;
 use std::path::{Path, PathBuf};
 
@@ -87,7 +88,16 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
     })?;
     let grid = sampling::parse_sampling(&cx, r_sampling)?;
     let system = system::parse_system(&cx, r_system, &grid)?;
-    let input = input::parse_input_section(&cx, raw.input.as_ref(), &system, &grid)?;
+    let (input, history) = input::parse_input_section(&cx, raw.input.as_ref(), &system, &grid)?;
+    if let (Some(d), InputSpec::Known(Input::Tones(_))) = (&r_system.delay, &input) {
+        // A tone's delay is a phase: the delayed response needs an input made of steps.
+        return Err(cx.err(
+            "system",
+            "delay",
+            &d.span(),
+            "needs an input made of steps (random-binary, piecewise or csv); a sine or multisine input's delay is a phase",
+        ));
+    }
     let jitter = match &raw.jitter {
         Some(r) => jitter::parse_jitter(&cx, r, &grid)?,
         None => jitter::no_jitter(),
@@ -133,6 +143,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
         title: raw.title.clone(),
         grid,
         input,
+        history,
         system,
         jitter,
         noise,

@@ -155,3 +155,33 @@ pub(super) fn response<M: RationalModel>(m: &M, grid: &SampleGrid) -> Result<(),
         ))
     }
 }
+
+/// Largest input history, in records: an input that ran longer before `t0` left only its
+/// settled state, which a shorter history reaches as well.
+pub const MAX_HISTORY_RECORDS: f64 = 1e3;
+
+/// An input delay `D` (s): in `[0, (N+1)T]`, so that some of the input reaches the record.
+pub(super) fn delay(d: f64, grid: &SampleGrid) -> Result<f64, String> {
+    let (a, b) = crate::inputs::input_span(grid);
+    let hi = b - a;
+    if (0.0..=hi).contains(&d) {
+        Ok(d)
+    } else {
+        Err(format!(
+            "expected a delay in [0, {hi}] s (at most the input's span (N+1)T), found {d:e}"
+        ))
+    }
+}
+
+/// An input history `H` (s): in `[0, MAX_HISTORY_RECORDS·(N+1)T]`.
+pub(super) fn history(h: f64, grid: &SampleGrid) -> Result<f64, String> {
+    let (a, b) = crate::inputs::input_span(grid);
+    let hi = MAX_HISTORY_RECORDS * (b - a);
+    if (0.0..=hi).contains(&h) {
+        Ok(h)
+    } else {
+        Err(format!(
+            "expected a history in [0, {hi:e}] s (at most {MAX_HISTORY_RECORDS:e} input spans (N+1)T), found {h:e}"
+        ))
+    }
+}

@@ -53,6 +53,7 @@ section!(RawInput, "table [input]" {
     path: String,
     time_column: String,
     value_column: String,
+    history: f64,
 });
 
 section!(RawSystem, "table [system]" {
@@ -66,6 +67,8 @@ section!(RawSystem, "table [system]" {
     frequency: f64,
     phase: f64,
     estimate: bool,
+    initial: String,
+    delay: f64,
 });
 
 section!(RawNoise, "table [noise]" {

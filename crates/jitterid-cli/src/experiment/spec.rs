@@ -264,6 +264,9 @@ pub struct Experiment {
     pub grid: SampleGrid,
     /// The input.
     pub input: InputSpec,
+    /// How long (s) the true input ran before the record's first instant `t0`: a random
+    /// binary input is drawn from `t0 − history`, and a fit sees it from `t0` on only.
+    pub history: f64,
     /// The system.
     pub system: SystemSpec,
     /// The jitter.

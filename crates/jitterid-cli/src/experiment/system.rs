@@ -18,8 +18,10 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
     let name = kind.get_ref().as_str();
     let allowed: &[&str] = match name {
-        "zpk" => &["kind", "gain", "zeros", "poles", "estimate"],
-        "tf" => &["kind", "num", "den", "estimate"],
+        "zpk" => &[
+            "kind", "gain", "zeros", "poles", "estimate", "initial", "delay",
+        ],
+        "tf" => &["kind", "num", "den", "estimate", "initial", "delay"],
         "sinusoid" => &["kind", "amplitude", "frequency", "phase", "estimate"],
         other => {
             return Err(cx.err(
@@ -36,6 +38,7 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
         "tf" => tf(cx, r, grid)?,
         _ => sinusoid(cx, r, grid)?,
     };
+    let kind = response_keys(cx, r, grid, kind)?;
     let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
     Ok(SystemSpec { kind, estimate })
 }
@@ -106,6 +109,47 @@ fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
             ("phase", json!(s.phase())),
         ],
     ))
+}
+
+/// `initial` and `delay` written into a rational system's spec table as the signal registry
+/// reads them: a free response from the record's first instant `t0` (started at rest, one
+/// coefficient per pole) and an input delay. A kind without them refused the keys already.
+fn response_keys(cx: &Source, r: &RawSystem, grid: &SampleGrid, mut kind: Spec) -> CliResult<Spec> {
+    if let Some(d) = &r.delay {
+        let d = cx.checked(S, "delay", d, |d| range::delay(d, grid))?;
+        kind.insert("delay".into(), json!(d));
+    }
+    let Some(mode) = &r.initial else {
+        return Ok(kind);
+    };
+    match mode.get_ref().as_str() {
+        "zero" => Ok(kind),
+        "estimate" => {
+            let order = match kind.get("poles").zip(kind.get("zeros")) {
+                Some(_) => zpk_order(&kind),
+                None => kind
+                    .get("den")
+                    .and_then(Value::as_array)
+                    .map_or(0, |d| d.len().saturating_sub(1)),
+            };
+            kind.insert("initial".into(), json!(vec![0.0; order]));
+            kind.insert("origin".into(), json!(grid.start()));
+            Ok(kind)
+        }
+        other => Err(cx.err(
+            S,
+            "initial",
+            &mode.span(),
+            format!("unknown initial state \"{other}\"; expected \"zero\" or \"estimate\""),
+        )),
+    }
+}
+
+/// The number of poles of a zpk spec table (a pair `[re, im]` counts two).
+fn zpk_order(kind: &Spec) -> usize {
+    kind.get("poles").and_then(Value::as_array).map_or(0, |ps| {
+        ps.iter().map(|p| if p.is_array() { 2 } else { 1 }).sum()
+    })
 }
 
 /// The signal registry's spec table of `kind` with `keys`, as the door checks built them.
