@@ -62,9 +62,12 @@ pub struct ValidateArgs {
     /// Write the frequency response with ±2σ bands as CSV to this file.
     #[arg(long, value_name = "FILE.csv")]
     pub bode: Option<PathBuf>,
-    /// Write the JSON to this file (atomically, with --bode) instead of standard output.
+    /// Write the JSON to this file (atomically, with --bode and --plot) instead of standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Write SVG figures into this directory: time.svg, correlations.svg, bode.svg, step.svg.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -247,6 +250,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             model: a.model,
             bode: a.bode,
             out: a.out,
+            plot: a.plot,
         }),
         Command::Select(a) => crate::select::select(&crate::select::SelectOptions {
             experiment: a.experiment,

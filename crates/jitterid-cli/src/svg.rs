@@ -1,5 +1,5 @@
 //! A small hand-written SVG plotter: panels with linear or logarithmic axes, lines, markers,
-//! bars, vertical rules and a legend.
+//! bars, vertical rules, filled bands and a legend.
 
 use std::fmt::Write as _;
 
@@ -43,6 +43,12 @@ pub enum Style {
     },
     /// Stems from 0 to `y` with a dot at the top (point masses).
     Stems,
+    /// A filled area between the points `(x, lo)` and `(x, upper)` (a confidence band); `upper`
+    /// has one value per point.
+    Band {
+        /// The upper edge, at the points' `x`.
+        upper: Vec<f64>,
+    },
 }
 
 /// One data series.
@@ -95,6 +101,18 @@ impl Series {
             opacity: 0.75,
             style: Style::Markers { radius: 2.2 },
             points,
+        }
+    }
+    /// A filled band between `lo` and `hi` at each `x`, from `(x, lo, hi)` triples.
+    pub fn band(label: &str, color: &'static str, points: &[(f64, f64, f64)]) -> Self {
+        Self {
+            label: label.into(),
+            color,
+            opacity: 0.22,
+            style: Style::Band {
+                upper: points.iter().map(|p| p.2).collect(),
+            },
+            points: points.iter().map(|p| (p.0, p.1)).collect(),
         }
     }
     /// Sets the opacity.
@@ -406,6 +424,7 @@ fn panel(s: &mut String, p: &Panel, ox: f64, oy: f64, id: usize) {
             Style::Bars { width } => bars(s, &f, se, *width),
             Style::VRule { dash } => vrules(s, &f, se, *dash),
             Style::Stems => stems(s, &f, se),
+            Style::Band { upper } => band(s, &f, se, upper),
         }
     }
     s.push_str("</g>\n");
@@ -431,7 +450,13 @@ fn data_ranges(p: &Panel) -> (Span, Span) {
         .series
         .iter()
         .filter(|se| !matches!(se.style, Style::VRule { .. }))
-        .flat_map(|se| se.points.iter().map(|q| q.1).collect::<Vec<_>>());
+        .flat_map(|se| {
+            let mut v: Vec<f64> = se.points.iter().map(|q| q.1).collect();
+            if let Style::Band { upper } = &se.style {
+                v.extend(upper);
+            }
+            v
+        });
     let xr = range(xs, p.xlog).map(|(a, b)| {
         if p.xlog {
             (a, b)
@@ -525,6 +550,36 @@ fn line(s: &mut String, f: &Frame, se: &Series, width: f64, dash: Option<&str>) 
                 f.px(x),
                 f.py(y).clamp(f.oy - 2.0 * f.h, f.oy + 3.0 * f.h)
             ));
+        } else {
+            flush(&mut run, s);
+        }
+    }
+    flush(&mut run, s);
+}
+
+/// A filled band: one closed path per run of points whose both edges can be drawn (along the
+/// lower edge, back along the upper one).
+fn band(s: &mut String, f: &Frame, se: &Series, upper: &[f64]) {
+    let clamp = |y: f64| f.py(y).clamp(f.oy - 2.0 * f.h, f.oy + 3.0 * f.h);
+    let mut run: Vec<(f64, f64, f64)> = Vec::new();
+    let flush = |run: &mut Vec<(f64, f64, f64)>, s: &mut String| {
+        if run.len() >= 2 {
+            let lower = run.iter().map(|(x, lo, _)| format!("{x:.1},{lo:.1}"));
+            let upper = run.iter().rev().map(|(x, _, hi)| format!("{x:.1},{hi:.1}"));
+            let d: Vec<String> = lower.chain(upper).collect();
+            let _ = writeln!(
+                s,
+                r#"<path fill="{}" fill-opacity="{}" stroke="none" d="M{}Z"/>"#,
+                se.color,
+                se.opacity,
+                d.join(" L")
+            );
+        }
+        run.clear();
+    };
+    for (&(x, lo), &hi) in se.points.iter().zip(upper) {
+        if f.ok(x, lo) && f.ok(x, hi) {
+            run.push((f.px(x), clamp(lo), clamp(hi)));
         } else {
             flush(&mut run, s);
         }
@@ -680,7 +735,7 @@ fn legend_symbol(e: &Series, lx: f64, y: f64) -> String {
             y - 4.0,
             e.color
         ),
-        Style::Bars { .. } => format!(
+        Style::Bars { .. } | Style::Band { .. } => format!(
             r#"<rect x="{:.1}" y="{:.1}" width="14" height="9" fill="{}" fill-opacity="{}"/>"#,
             lx + 9.0,
             y - 9.0,
@@ -781,5 +836,38 @@ mod tests {
         assert!((w - 1.5).abs() < 1e-12);
         let (h, _) = histogram(&[0.0, 0.0, 3.0]);
         assert_eq!(h, vec![(0.0, 2.0), (1.0, 0.0), (2.0, 0.0), (3.0, 1.0)]);
+    }
+
+    /// The band is one closed path around both edges, broken where an edge cannot be drawn,
+    /// and its upper edge widens the y range.
+    #[test]
+    fn a_band_is_a_closed_path_per_drawable_run() {
+        let pts = [
+            (1.0, 0.0, 1.0),
+            (2.0, 0.5, 2.0),
+            (3.0, f64::NAN, 2.0),
+            (4.0, 0.0, 1.0),
+            (5.0, 0.0, 10.0),
+        ];
+        let p = Panel {
+            series: vec![Series::band("±2σ", BLUE, &pts)],
+            ..Default::default()
+        };
+        let (_, yr) = data_ranges(&p);
+        assert!(yr.unwrap().1 >= 10.0, "{yr:?}");
+        let s = figure("x", "y", &[p], 1);
+        assert_eq!(s.matches("<path ").count(), 2, "{s}");
+        let first = s.split("<path ").nth(1).unwrap();
+        // Four corners: two along the lower edge, two back along the upper one.
+        let d = first
+            .split(" d=\"M")
+            .nth(1)
+            .unwrap()
+            .split('Z')
+            .next()
+            .unwrap();
+        assert_eq!(d.split(" L").count(), 4, "{d}");
+        // The legend shows a filled swatch.
+        assert!(s.contains("±2σ"));
     }
 }

@@ -1,5 +1,6 @@
 //! `jitterid validate`: fit percent, residual whiteness and input cross-correlation, flatness,
-//! and the frequency-response CSV of a fitted model (given as `fit --json` or fitted here).
+//! the frequency-response CSV of a fitted model (given as `fit --json` or fitted here), and
+//! its figures.
 
 use crate::cli_err;
 use crate::commands::{self, input_side_file, read_data};
@@ -11,8 +12,9 @@ use crate::export;
 use crate::fitting::{self, Structure};
 use crate::inputs;
 use crate::output::OutputSet;
+use crate::plots::{self, RecordPlot, ValidatePlots};
 use jitterid::estimate::residual_flatness;
-use jitterid::estimate::validation::{self, CorrelationTest};
+use jitterid::estimate::validation::{self, BodePoint, CorrelationTest, StepPoint};
 use jitterid::signal::{Input, SampleGrid};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use serde::Serialize;
@@ -36,6 +38,8 @@ pub struct ValidateOptions {
     pub bode: Option<PathBuf>,
     /// Write the JSON here instead of standard output.
     pub out: Option<PathBuf>,
+    /// Write the SVG figures into this directory.
+    pub plot: Option<PathBuf>,
 }
 
 /// The checks of one record.
@@ -162,7 +166,7 @@ fn signal_block(c: Option<&[Vec<Option<f64>>]>, ns: usize) -> Option<Vec<Vec<f64
         .flatten()
 }
 
-/// The validation checks of `y` on `grid` under `s`.
+/// The validation checks of `y` on `grid` under `s`, and the expected samples `m_k`.
 fn check_record(
     s: &Structure,
     grid: &SampleGrid,
@@ -170,7 +174,7 @@ fn check_record(
     noise_std: f64,
     input: Option<&Input>,
     name: &str,
-) -> CliResult<RecordReport> {
+) -> CliResult<(RecordReport, Vec<f64>)> {
     let e = |e: jitterid::estimate::EstimateError| cli_err!("{name}: validation: {e}");
     let cmp = validation::compare(s, grid, y).map_err(e)?;
     let r = validation::standardized_residuals(s, grid, y, noise_std).map_err(e)?;
@@ -187,14 +191,15 @@ fn check_record(
     let flatness = transform(grid, &DirichletWindow, &raw, &FrequencySet::dft(grid))
         .ok()
         .and_then(|v| residual_flatness(&v.iter().flat_map(|z| [z.re, z.im]).collect::<Vec<_>>()));
-    Ok(RecordReport {
+    let report = RecordReport {
         record: name.to_string(),
         samples: y.len(),
         fit_percent: cmp.fit_percent,
         whiteness,
         cross_correlation: cross,
         flatness,
-    })
+    };
+    Ok((report, cmp.expected))
 }
 
 /// A validation record: its grid (the experiment's `T`, its own length and start) and samples.
@@ -225,13 +230,49 @@ fn read_validation(exp: &Experiment, path: &Path) -> CliResult<(SampleGrid, Vec<
     Ok((grid, y, name))
 }
 
-/// The frequency-response CSV: log-spaced from `1/(NT)` to the Nyquist frequency `1/(2T)`.
-fn bode_csv(s: &Structure, grid: &SampleGrid, cov: Option<&[Vec<f64>]>) -> CliResult<String> {
+/// The frequency response on 200 frequencies log-spaced from `1/(NT)` to the Nyquist
+/// frequency `1/(2T)`; `None` for a system that is not rational. `flag` names the option.
+fn frequency_response(
+    s: &Structure,
+    grid: &SampleGrid,
+    cov: Option<&[Vec<f64>]>,
+    flag: &str,
+) -> CliResult<Option<Vec<BodePoint>>> {
     let freqs = validation::log_spaced(1.0 / grid.duration(), 0.5 / grid.interval(), 200)
-        .map_err(|e| cli_err!("--bode: {e}"))?;
-    let points = export::bode_of(&s.signal, &freqs, cov)
-        .ok_or_else(|| cli_err!("--bode: the system is not a rational transfer function"))?
-        .map_err(|e| cli_err!("--bode: {e}"))?;
+        .map_err(|e| cli_err!("{flag}: {e}"))?;
+    export::bode_of(&s.signal, &freqs, cov)
+        .transpose()
+        .map_err(|e| cli_err!("{flag}: {e}"))
+}
+
+/// The unit-step response on 200 times from the step to 8 time constants of the slowest pole
+/// (where its mode has decayed to e⁻⁸), at most the record's duration; `None` for a system that
+/// is not rational.
+fn step(
+    s: &Structure,
+    grid: &SampleGrid,
+    cov: Option<&[Vec<f64>]>,
+) -> CliResult<Option<Vec<StepPoint>>> {
+    let slowest = export::tf_of(&s.signal)
+        .and_then(|tf| tf.to_zpk().ok())
+        .map(|z| {
+            z.poles()
+                .iter()
+                .map(|p| -p.re)
+                .fold(f64::INFINITY, f64::min)
+        });
+    let horizon = match slowest {
+        Some(r) if r > 0.0 && r.is_finite() => (8.0 / r).min(grid.duration()),
+        _ => grid.duration(),
+    };
+    let times: Vec<f64> = (0..200).map(|i| horizon * i as f64 / 199.0).collect();
+    export::step_of(&s.signal, &times, cov)
+        .transpose()
+        .map_err(|e| cli_err!("--plot: step response: {e}"))
+}
+
+/// The frequency-response CSV of `points`.
+fn bode_csv(points: &[BodePoint]) -> String {
     let o = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     let mut out = String::from(
         "f_hz,omega_rad_s,magnitude_db,phase_deg,magnitude_db_lo,magnitude_db_hi,phase_deg_lo,phase_deg_hi\n",
@@ -249,10 +290,58 @@ fn bode_csv(s: &Structure, grid: &SampleGrid, cov: Option<&[Vec<f64>]>) -> CliRe
             o(p.phase_deg_hi)
         ));
     }
-    Ok(out)
+    out
 }
 
-/// `jitterid validate`: the JSON, printed or written to `--out` with the CSV, atomically.
+/// What the figures draw of one record.
+fn record_plot<'a>(
+    role: &'a str,
+    r: &'a RecordReport,
+    grid: &'a SampleGrid,
+    y: &'a [f64],
+    expected: &'a [f64],
+) -> RecordPlot<'a> {
+    RecordPlot {
+        role,
+        name: &r.record,
+        grid,
+        y,
+        expected,
+        fit_percent: r.fit_percent,
+        whiteness: &r.whiteness,
+        cross: r.cross_correlation.as_ref(),
+    }
+}
+
+/// Adds the figures of `--plot DIR` to the outputs (the Bode diagram on the `--bode` CSV's
+/// frequencies; it and the step response only for a rational system).
+fn stage_figures(
+    dir: &Path,
+    outputs: &mut OutputSet,
+    exp: &Experiment,
+    fitted: &Structure,
+    cov: Option<&[Vec<f64>]>,
+    estimation: RecordPlot<'_>,
+    validation: Option<RecordPlot<'_>>,
+) -> CliResult<()> {
+    let bode = frequency_response(fitted, &exp.grid, cov, "--plot")?;
+    let step = step(fitted, &exp.grid, cov)?;
+    let figs = plots::validate_figures(&ValidatePlots {
+        title: exp.title.clone().unwrap_or_else(|| exp.file.clone()),
+        estimation,
+        validation,
+        bode: bode.as_deref(),
+        step: step.as_deref(),
+    });
+    outputs.dir(dir);
+    for (name, svg) in figs {
+        outputs.file(&dir.join(name), svg);
+    }
+    Ok(())
+}
+
+/// `jitterid validate`: the JSON, printed or written to `--out` with the CSV and the figures,
+/// all at once.
 pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
     let exp = experiment::read(&o.experiment, Purpose::Estimate(None))?;
     let table = read_data(&exp, &o.data)?;
@@ -271,7 +360,7 @@ pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
             (f.fitted, f.noise_std, cov)
         }
     };
-    let estimation = check_record(
+    let (estimation, expected) = check_record(
         &fitted,
         &exp.grid,
         &y,
@@ -290,14 +379,33 @@ pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
                     .with_input(u)
                     .map_err(|e| cli_err!("{name}: the validation input: {e}"))?;
             }
-            Some(check_record(&s, &grid, &yv, noise_std, u.as_ref(), &name)?)
+            let (report, expected) = check_record(&s, &grid, &yv, noise_std, u.as_ref(), &name)?;
+            Some((report, expected, grid, yv))
         }
         None => None,
     };
     let mut outputs = OutputSet::new();
     if let Some(path) = &o.bode {
-        outputs.file(path, bode_csv(&fitted, &exp.grid, cov.as_deref())?);
+        let points = frequency_response(&fitted, &exp.grid, cov.as_deref(), "--bode")?
+            .ok_or_else(|| cli_err!("--bode: the system is not a rational transfer function"))?;
+        outputs.file(path, bode_csv(&points));
     }
+    if let Some(dir) = &o.plot {
+        let validation = validation
+            .as_ref()
+            .map(|(r, e, g, yv)| record_plot("validation", r, g, yv, e));
+        let estimation = record_plot("estimation", &estimation, &exp.grid, &y, &expected);
+        stage_figures(
+            dir,
+            &mut outputs,
+            &exp,
+            &fitted,
+            cov.as_deref(),
+            estimation,
+            validation,
+        )?;
+    }
+    let validation = validation.map(|v| v.0);
     let j = ValidateJson {
         fit_percent: FitPercent {
             estimation: estimation.fit_percent,
