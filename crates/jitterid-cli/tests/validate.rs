@@ -1,9 +1,9 @@
-//! `jitterid validate` through the real binary: the JSON verdicts and the frequency-response
-//! CSV of a fitted model, and bad input named with exit status 2.
+//! `jitterid validate` through the real binary: the JSON verdicts, the frequency-response CSV
+//! and the figures of a fitted model, and bad input named with exit status 2.
 
 mod common;
 
-use common::{example, run, s, scratch, stderr, stdout};
+use common::{example, files_in, run, s, scratch, stderr, stdout};
 use serde_json::Value;
 
 #[test]
@@ -87,4 +87,143 @@ fn validate_reports_verdicts_and_refuses_bad_input() {
         .collect();
     std::fs::write(&short, format!("t,y\n{rows}")).unwrap();
     refused(validate(&fit, Some(&short)), "interval");
+}
+
+/// Checks that `svg` is one `<svg>` element whose tags all close in order (the text is escaped,
+/// so every `<` opens a tag).
+fn assert_well_formed(name: &str, svg: &str) {
+    assert!(
+        svg.starts_with("<svg ") && svg.ends_with("</svg>\n"),
+        "{name}"
+    );
+    let mut open: Vec<&str> = Vec::new();
+    let mut rest = svg;
+    while let Some(i) = rest.find('<') {
+        let end = rest[i..]
+            .find('>')
+            .unwrap_or_else(|| panic!("{name}: unclosed tag"));
+        let tag = &rest[i + 1..i + end];
+        rest = &rest[i + end + 1..];
+        if let Some(closing) = tag.strip_prefix('/') {
+            assert_eq!(
+                open.pop(),
+                Some(closing.trim()),
+                "{name}: </{closing}> closes another tag"
+            );
+        } else if !tag.ends_with('/') {
+            open.push(tag.split_whitespace().next().unwrap());
+        }
+    }
+    assert!(open.is_empty(), "{name}: unclosed {open:?}");
+}
+
+/// The number of points of each polyline drawn in `color` (without a dash pattern).
+fn solid_lines(svg: &str, color: &str) -> Vec<usize> {
+    svg.lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains(&format!("stroke=\"{color}\"")))
+        .filter(|l| !l.contains("stroke-dasharray"))
+        .map(|l| {
+            l.split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split_whitespace()
+                .count()
+        })
+        .collect()
+}
+
+const BLUE: &str = "#1f77b4";
+const RED: &str = "#d62728";
+
+#[test]
+fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
+    let dir = scratch("validate-plot");
+    let (data, other) = (dir.join("d.csv"), dir.join("v.csv"));
+    let exp = example("table2.toml");
+    assert!(run(&["simulate", &exp, "--out", s(&data)]).status.success());
+    assert!(run(&["simulate", &exp, "--run", "1", "--out", s(&other)])
+        .status
+        .success());
+    let (figs, bode, out) = (dir.join("figs"), dir.join("b.csv"), dir.join("r.json"));
+    let validate = |extra: &[&str], out: &std::path::Path, figs: &std::path::Path| {
+        let mut args = vec!["validate", exp.as_str(), "--data", s(&data)];
+        args.extend(extra);
+        args.extend(["--bode", s(&bode), "--out", s(out), "--plot", s(figs)]);
+        run(&args)
+    };
+    let o = validate(&["--validation", s(&other)], &out, &figs);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        files_in(&figs),
+        ["bode.svg", "correlations.svg", "step.svg", "time.svg"]
+    );
+    let read = |f: &str| {
+        let t = std::fs::read_to_string(figs.join(f)).unwrap();
+        assert_well_formed(f, &t);
+        t
+    };
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+
+    // Model vs data: one m_k line per record (200 samples each) over its 200 data points, the
+    // fit percent in the legend.
+    let time = read("time.svg");
+    assert_eq!(solid_lines(&time, BLUE), [200, 200]);
+    assert!(time.matches("<circle").count() >= 400);
+    for record in ["estimation", "validation"] {
+        let fit = j["fit_percent"][record].as_f64().unwrap();
+        assert!(time.contains(&format!("fit {fit:.1} %")), "{record}");
+    }
+
+    // Correlations: autocorrelation (lags 1..=25) and cross-correlation (0..=25) of both
+    // records, each with its two dashed 99 % bounds at ±bound.
+    let corr = read("correlations.svg");
+    let bounds = corr
+        .lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains(RED) && l.contains("dasharray"))
+        .count();
+    assert_eq!(bounds, 8);
+    let stems = corr.matches(r#"stroke-width="2"/><circle"#).count();
+    assert_eq!(stems, 2 * (25 + 26));
+    let bound = j["whiteness"]["bound"].as_f64().unwrap();
+    assert!(corr.contains(&format!("99 % bounds ±{bound:.3}")));
+
+    // Bode: magnitude and phase lines on the CSV's 200 frequencies, each with its band.
+    let b = read("bode.svg");
+    let rows = std::fs::read_to_string(&bode).unwrap().lines().count() - 1;
+    assert_eq!(solid_lines(&b, BLUE), [rows, rows]);
+    assert_eq!(b.matches("<path ").count(), 2);
+    // Step response with its band.
+    let st = read("step.svg");
+    assert_eq!(solid_lines(&st, BLUE), [200]);
+    assert_eq!(st.matches("<path ").count(), 1);
+
+    // Without a validation record: one panel per figure row, the estimation record's.
+    let one = dir.join("one");
+    let o = validate(&[], &out, &one);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = std::fs::read_to_string(one.join("time.svg")).unwrap();
+    assert_eq!(solid_lines(&t, BLUE), [200]);
+    assert!(!t.contains("validation record"));
+
+    // An --out that cannot be written (a directory): nothing is written, no figure directory.
+    let (late, blocked) = (dir.join("late"), dir.join("blocked"));
+    std::fs::create_dir(&blocked).unwrap();
+    let before = std::fs::read(&bode).unwrap();
+    std::fs::remove_file(&bode).unwrap();
+    let o = validate(&[], &blocked, &late);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("blocked"), "{}", stderr(&o));
+    assert!(!late.exists() && !bode.exists());
+    std::fs::write(&bode, before).unwrap();
+
+    // A --plot target that is a regular file: refused by name, nothing written.
+    let file = dir.join("not-a-dir");
+    std::fs::write(&file, "x").unwrap();
+    std::fs::remove_file(&out).unwrap();
+    let o = validate(&[], &out, &file);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not-a-dir"), "{}", stderr(&o));
+    assert!(!out.exists());
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
