@@ -767,7 +767,7 @@ fn correlation_figure(records: &[&RecordPlot<'_>], title: &str) -> String {
         }
     }
     figure(
-        "Residual correlations of the standardised residuals ε_k, with 99 % bounds",
+        "Correlations of the standardised residuals ε_k (99 % bounds)",
         title,
         &panels,
         if with_input { 2 } else { 1 },

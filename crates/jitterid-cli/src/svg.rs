@@ -558,7 +558,7 @@ fn line(s: &mut String, f: &Frame, se: &Series, width: f64, dash: Option<&str>) 
 }
 
 /// A filled band: one closed path per run of points whose both edges can be drawn (along the
-/// lower edge, back along the upper one).
+/// lower edge, back along the upper one), outlined so that a narrow band stays visible.
 fn band(s: &mut String, f: &Frame, se: &Series, upper: &[f64]) {
     let clamp = |y: f64| f.py(y).clamp(f.oy - 2.0 * f.h, f.oy + 3.0 * f.h);
     let mut run: Vec<(f64, f64, f64)> = Vec::new();
@@ -569,9 +569,10 @@ fn band(s: &mut String, f: &Frame, se: &Series, upper: &[f64]) {
             let d: Vec<String> = lower.chain(upper).collect();
             let _ = writeln!(
                 s,
-                r#"<path fill="{}" fill-opacity="{}" stroke="none" d="M{}Z"/>"#,
+                r#"<path fill="{0}" fill-opacity="{1}" stroke="{0}" stroke-opacity="{2}" stroke-width="0.7" d="M{3}Z"/>"#,
                 se.color,
                 se.opacity,
+                (2.5 * se.opacity).min(1.0),
                 d.join(" L")
             );
         }

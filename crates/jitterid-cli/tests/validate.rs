@@ -206,6 +206,22 @@ fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
     assert_eq!(solid_lines(&t, BLUE), [200]);
     assert!(!t.contains("validation record"));
 
+    // A model without a covariance: the same curves, no bands, and a note that says so.
+    let (fit, bare) = (dir.join("fit.json"), dir.join("bare"));
+    let o = run(&["fit", &exp, "--data", s(&data), "--json"]);
+    let mut m: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!(m.as_object_mut().unwrap().remove("covariance").is_some());
+    std::fs::write(&fit, m.to_string()).unwrap();
+    let o = validate(&["--model", s(&fit)], &out, &bare);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["bode.svg", "step.svg"] {
+        let t = std::fs::read_to_string(bare.join(f)).unwrap();
+        assert_well_formed(f, &t);
+        assert_eq!(t.matches("<path ").count(), 0, "{f}");
+        assert!(t.contains("no covariance, so no bands"), "{f}");
+        assert!(!solid_lines(&t, BLUE).is_empty(), "{f}");
+    }
+
     // An --out that cannot be written (a directory): nothing is written, no figure directory.
     let (late, blocked) = (dir.join("late"), dir.join("blocked"));
     std::fs::create_dir(&blocked).unwrap();
