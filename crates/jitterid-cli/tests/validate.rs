@@ -243,3 +243,87 @@ fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
     assert!(!out.exists());
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
+
+/// A system fitted with the free response from an unknown initial state: its Bode band comes
+/// from the block of the system's own parameters (gain, zero, poles; `G` does not depend on
+/// `initial.*`), checked against `G(s) = k (s − z)/((s − p)(s − p̄))` and its log-derivatives
+/// written out here. A system with an input delay has no rational Bode diagram: `--bode` is
+/// refused by name, and `--plot` draws the time and correlation figures only.
+#[test]
+fn validate_bode_band_of_a_system_with_a_free_initial_response() {
+    use jitterid::num_complex::Complex64;
+    let dir = scratch("validate-initial");
+    let (data, fit, bode) = (dir.join("d.csv"), dir.join("fit.json"), dir.join("b.csv"));
+    let exp = example("initial-state.toml");
+    assert!(run(&["simulate", &exp, "--out", s(&data)]).status.success());
+    let o = run(&["fit", &exp, "--data", s(&data), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::write(&fit, stdout(&o)).unwrap();
+    let m: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let names: Vec<&str> = (0..4)
+        .map(|i| m["parameters"][i]["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["gain", "zero0", "pole0.re", "pole0.im"]);
+    let th: Vec<f64> = (0..4)
+        .map(|i| m["parameters"][i]["estimate"].as_f64().unwrap())
+        .collect();
+    let c = |i: usize, j: usize| m["covariance"][i][j].as_f64().unwrap();
+    let figs = dir.join("figs");
+    let args = ["--model", s(&fit), "--bode", s(&bode), "--plot", s(&figs)];
+    let o = run(&[&["validate", exp.as_str(), "--data", s(&data)], &args[..]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(files_in(&figs).len(), 4);
+    let csv = std::fs::read_to_string(&bode).unwrap();
+    for row in csv.lines().skip(1).step_by(40) {
+        let v: Vec<f64> = row.split(',').map(|x| x.parse().unwrap()).collect();
+        let s_ = Complex64::new(0.0, v[1]);
+        let (z, p) = (th[1], Complex64::new(th[2], th[3]));
+        let g = th[0] * (s_ - z) / ((s_ - p) * (s_ - p.conj()));
+        // ∂ ln G / ∂θ for θ = (k, z, Re p, Im p).
+        let i = Complex64::i();
+        let d = [
+            Complex64::new(1.0 / th[0], 0.0),
+            -1.0 / (s_ - z),
+            1.0 / (s_ - p) + 1.0 / (s_ - p.conj()),
+            i / (s_ - p) - i / (s_ - p.conj()),
+        ];
+        let grad: Vec<f64> = d
+            .iter()
+            .map(|x| 20.0 / std::f64::consts::LN_10 * x.re)
+            .collect();
+        let var: f64 = (0..4)
+            .flat_map(|a| (0..4).map(move |b| (a, b)))
+            .map(|(a, b)| grad[a] * c(a, b) * grad[b])
+            .sum();
+        let db = 20.0 * g.norm().log10();
+        // Both routes are closed forms in double precision.
+        assert!((v[2] - db).abs() < 1e-9, "{row}: {db}");
+        assert!(
+            (v[5] - v[2] - 2.0 * var.sqrt()).abs() < 1e-9 * (1.0 + var.sqrt()),
+            "{row}"
+        );
+    }
+
+    let exp = example("dead-time.toml");
+    assert!(run(&["simulate", &exp, "--out", s(&data)]).status.success());
+    let figs = dir.join("delayed");
+    let o = run(&[
+        "validate",
+        &exp,
+        "--data",
+        s(&data),
+        "--plot",
+        s(&figs),
+        "--out",
+        s(&fit),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(files_in(&figs), ["correlations.svg", "time.svg"]);
+    let o = run(&["validate", &exp, "--data", s(&data), "--bode", s(&bode)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--bode") && stderr(&o).contains("delay"),
+        "{}",
+        stderr(&o)
+    );
+}
