@@ -665,7 +665,17 @@ fn time_figure(records: &[&RecordPlot<'_>], title: &str) -> String {
             let t: Vec<f64> = r.grid.times().collect();
             let pts = |v: &[f64]| t.iter().copied().zip(v.iter().copied()).collect();
             let dense = r.y.len() > 400;
+            // Room above the data for the legend, which would hide samples in any corner.
+            let (lo, hi) =
+                r.y.iter()
+                    .chain(r.expected)
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                        (a.min(v), b.max(v))
+                    });
+            let span = if hi > lo { hi - lo } else { 1.0 };
             Panel {
+                yrange: (lo <= hi).then_some((lo - 0.04 * span, hi + 0.3 * span)),
                 title: format!("{} record {}: fit {:.1} %", r.role, r.name, r.fit_percent),
                 xlabel: "time (s)".into(),
                 ylabel: "y".into(),
