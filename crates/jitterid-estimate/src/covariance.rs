@@ -156,6 +156,20 @@ where
                 .iter()
                 .map(|&f| measurement_shape(&model.noise, f, t))
                 .collect();
+            // The signal's fit takes `p` of the `M` real residuals' power (REML's `M − p`,
+            // as in the Box–Jenkins criterion).
+            let residuals = 2 * power.len();
+            let p = if model.estimate_signal {
+                model.signal.num_params()
+            } else {
+                0
+            };
+            let power: Vec<f64> = if p < residuals {
+                let scale = residuals as f64 / (residuals - p) as f64;
+                power.iter().map(|q| q * scale).collect()
+            } else {
+                power
+            };
             coloured_noise_variance(&power, &shape, mean_jitter_var)
         }
     };
