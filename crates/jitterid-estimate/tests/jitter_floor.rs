@@ -1,5 +1,6 @@
 //! The Box–Jenkins noise model with the jitter's white floor: on Table 2 records with AR(1)
-//! measurement noise, the noise parameters are unbiased with the floor and biased without it.
+//! measurement noise, the noise level is unbiased with the floor and the AR coefficient's bias
+//! towards white noise is much smaller than without it.
 
 use jitterid_estimate::{
     estimate, mean_jitter_variance, ArmaNoise, BoxJenkins, EstimateOptions, ModelStructure,
