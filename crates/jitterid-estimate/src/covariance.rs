@@ -144,17 +144,77 @@ where
             (mse - mean_jitter_var).max(0.0)
         }
         None => {
-            // σ_e² from |D|² ≈ N (σ_e²|H|² + mean λ^J), averaged over the set.
             let mu = data.transform_moment(&m);
-            let mut acc = 0.0;
-            for ((y, mu), &f) in data.dtft().iter().zip(&mu).zip(freqs.frequencies()) {
-                let d2 = (y - mu).norm_sqr() / n as f64;
-                acc += (d2 - mean_jitter_var).max(0.0) / measurement_shape(&model.noise, f, t);
-            }
-            acc / freqs.len() as f64
+            let power: Vec<f64> = data
+                .dtft()
+                .iter()
+                .zip(&mu)
+                .map(|(y, mu)| (y - mu).norm_sqr() / n as f64)
+                .collect();
+            let shape: Vec<f64> = freqs
+                .frequencies()
+                .iter()
+                .map(|&f| measurement_shape(&model.noise, f, t))
+                .collect();
+            // The signal's fit takes `p` of the `M` real residuals' power (REML's `M − p`,
+            // as in the Box–Jenkins criterion).
+            let residuals = 2 * power.len();
+            let p = if model.estimate_signal {
+                model.signal.num_params()
+            } else {
+                0
+            };
+            let power: Vec<f64> = if p < residuals {
+                let scale = residuals as f64 / (residuals - p) as f64;
+                power.iter().map(|q| q * scale).collect()
+            } else {
+                power
+            };
+            coloured_noise_variance(&power, &shape, mean_jitter_var)
         }
     };
     (jitter_var, noise_var)
+}
+
+/// Rounds of [`coloured_noise_variance`]'s reweighting: each multiplies the distance to the
+/// root by about `λ̄ / (σ²|H|² + λ̄)` at worst, so a few suffice; the loop stops earlier once
+/// the estimate settles.
+const NOISE_VARIANCE_ROUNDS: usize = 50;
+
+/// `σ_e²` from the residual powers `P_f = |D(f)|²/N`, whose expectation is `σ_e²|H_f|² + λ̄`
+/// (`λ̄` the jitter's mean sample variance, a flat floor): the root of the Whittle score
+/// `Σ_f (P_f − Φ_f) |H_f|² / Φ_f² = 0`, `Φ_f = σ_e²|H_f|² + λ̄`, by iterated weighted least
+/// squares. Every term has expectation zero at the truth, so the estimate is consistent; a
+/// per-frequency `max(P_f − λ̄, 0)` would not be (it is biased up wherever the floor dominates).
+/// Without a floor the root is `mean_f P_f / |H_f|²`. Clamped at 0 (residuals with less power
+/// than the floor alone).
+fn coloured_noise_variance(power: &[f64], shape: &[f64], floor: f64) -> f64 {
+    let bins = power.len().max(1) as f64;
+    let plain = power.iter().zip(shape).map(|(p, h)| p / h).sum::<f64>() / bins;
+    if !(floor.is_finite() && floor > 0.0) {
+        return plain;
+    }
+    // Start where the floor's expected share is taken out of every bin.
+    let mut var = (plain - floor * shape.iter().map(|h| 1.0 / h).sum::<f64>() / bins).max(0.0);
+    for _ in 0..NOISE_VARIANCE_ROUNDS {
+        let (mut num, mut den) = (0.0, 0.0);
+        for (&p, &h) in power.iter().zip(shape) {
+            let phi = var * h + floor;
+            let w = h / (phi * phi);
+            num += w * (p - floor);
+            den += w * h;
+        }
+        let next = (num / den).max(0.0);
+        if !next.is_finite() {
+            break;
+        }
+        let settled = (next - var).abs() <= 1e-12 * next.max(f64::MIN_POSITIVE);
+        var = next;
+        if settled {
+            break;
+        }
+    }
+    var
 }
 
 /// The measurement noise's own shape `|H(f)|²`: a jitter floor in the noise model is already in

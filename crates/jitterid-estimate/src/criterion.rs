@@ -99,6 +99,7 @@ pub(crate) trait ModelView: Sync {
     fn noise_shape(&self, f: f64, interval: f64) -> f64;
     fn jitter_variances(&self, grid: &SampleGrid) -> Vec<f64>;
     fn noise_std(&self) -> Option<f64>;
+    fn estimated_signal_gradient(&self, grid: &SampleGrid) -> Vec<Vec<f64>>;
 }
 
 impl<S: Signal, J: JitterModel, N: NoiseModel> ModelView for ModelStructure<S, J, N> {
@@ -119,6 +120,13 @@ impl<S: Signal, J: JitterModel, N: NoiseModel> ModelView for ModelStructure<S, J
     fn noise_std(&self) -> Option<f64> {
         self.noise_std
     }
+    fn estimated_signal_gradient(&self, grid: &SampleGrid) -> Vec<Vec<f64>> {
+        if self.estimate_signal {
+            self.signal.expected_values_gradient(grid, &self.jitter)
+        } else {
+            Vec::new()
+        }
+    }
 }
 
 /// What a criterion's weights may depend on: the frequency set, the data's DTFT `Y(f)`, and the
@@ -130,6 +138,7 @@ pub struct WeightContext<'a> {
     pub(crate) model_dtft: Option<&'a [Complex64]>,
     pub(crate) lazy_model_dtft: OnceLock<Vec<Complex64>>,
     pub(crate) first_moment: &'a (dyn Fn() -> Vec<Complex64> + 'a),
+    pub(crate) transform: &'a (dyn Fn(&[f64]) -> Vec<Complex64> + 'a),
     pub(crate) model: &'a dyn ModelView,
 }
 
@@ -177,6 +186,17 @@ impl WeightContext<'_> {
         let t = self.freqs.interval();
         let f = self.freqs.frequencies();
         f.iter().map(|&f| self.model.noise_shape(f, t)).collect()
+    }
+
+    /// `∂μ_Y/∂θ` at the frequency set for each estimated parameter of the signal (with the
+    /// structure's jitter; none when the signal is not estimated). Costs the signal's moment
+    /// gradient.
+    pub fn signal_sensitivities(&self) -> Vec<Vec<Complex64>> {
+        self.model
+            .estimated_signal_gradient(self.grid)
+            .iter()
+            .map(|c| (self.transform)(c))
+            .collect()
     }
 
     /// The structure's known measurement-noise standard deviation, if any.
@@ -283,11 +303,27 @@ impl Criterion for WeightedBcls {
 }
 
 /// The Box–Jenkins frequency-domain criterion: the Gaussian log-likelihood of the residual DTFT
-/// with noise spectrum `σ²|H(f)|²`,
-/// `Σ_f [ |Y − μ|² / (σ² |H_f|²) + log(σ² |H_f|²) ]`, with `σ²` concentrated out. The
-/// minimiser over `σ²` turns it into the sum of squares `Σ_f |Y − μ|² / |H̃_f|²` with
-/// `H̃ = H / exp(mean_f log|H_f|)`, which keeps the `log|H|²` term (so the noise shape is
-/// identifiable) while staying a least-squares problem.
+/// with noise spectrum `σ²|H(f)|²`, restricted to the residuals (REML), with `σ²` concentrated
+/// out:
+///
+/// ```text
+/// Σ_f [ |Y − μ|² / (σ² |H_f|²) + log(σ² |H_f|²) ] + log det(Xᵀ Φ⁻¹ X)
+/// ```
+///
+/// `X` the sensitivities `∂μ/∂θ` of the `p` estimated signal parameters (real and imaginary
+/// parts) and `Φ = σ²|H|²`. The minimiser over `σ²` is `Σ|Y − μ|²/|H|² / (M − p)` (`M` real
+/// residuals), which turns the criterion into the sum of squares `Σ_f G |Y − μ|² / |H_f|²` with
+/// the scalar `G = exp[(Σ log|H_f|² + log det(Xᵀ|H|⁻²X)) / (M − p)]` (both sums over the real
+/// residuals): the `log|H|²` term keeps the noise shape identifiable while the problem stays a
+/// least-squares one.
+///
+/// The determinant accounts for the residual power the signal's fit takes out: without it the
+/// plain likelihood's score for the noise shape has expectation `−½ Σ h_i ∂log Φ_i` at the truth
+/// (`h_i` the fit's leverages, concentrated where the input has power), which biases the shape
+/// towards a flat spectrum by `O(p/N)` (on Table 2 with AR(1) noise, `N = 200`, about 6 standard
+/// errors of a 128-record mean). Its derivative in the noise shape is exactly `−Σ h_i ∂log Φ_i`,
+/// so the REML score has expectation zero. Without estimated signal parameters `G` is the
+/// geometric mean of `|H|²` and the criterion the plain concentrated likelihood.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BoxJenkins;
 
@@ -304,10 +340,66 @@ impl Criterion for BoxJenkins {
     fn uses_noise_model(&self) -> bool {
         true
     }
+    fn model_dependent_weights(&self) -> bool {
+        // G depends on the signal's sensitivities.
+        true
+    }
     fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
         let shape = context.noise_shape();
-        let mean_log = shape.iter().map(|s| s.ln()).sum::<f64>() / shape.len() as f64;
-        let g = mean_log.exp();
+        let sum_log = 2.0 * shape.iter().map(|s| s.ln()).sum::<f64>();
+        let residuals = 2 * shape.len();
+        let sens = context.signal_sensitivities();
+        let log_g = match restricted_log_det(&sens, &shape) {
+            Some(log_det) if sens.len() < residuals => {
+                (sum_log + log_det) / (residuals - sens.len()) as f64
+            }
+            _ => sum_log / residuals as f64,
+        };
+        let g = log_g.exp();
         shape.iter().map(|s| g / s).collect()
     }
+}
+
+/// `log det(Xᵀ|H|⁻²X)` for the sensitivities `X` (one column of `∂μ/∂θ` per parameter, real and
+/// imaginary parts as rows) and the noise shape `|H|²`, by Cholesky; `None` without columns or
+/// when the matrix is not numerically positive definite (the plain likelihood then).
+fn restricted_log_det(sens: &[Vec<Complex64>], shape: &[f64]) -> Option<f64> {
+    let p = sens.len();
+    if p == 0 {
+        return None;
+    }
+    let mut a = vec![0.0; p * p];
+    for i in 0..p {
+        for j in 0..=i {
+            let v: f64 = sens[i]
+                .iter()
+                .zip(&sens[j])
+                .zip(shape)
+                .map(|((x, y), s)| (x.re * y.re + x.im * y.im) / s)
+                .sum();
+            a[i * p + j] = v;
+        }
+    }
+    // In-place Cholesky of the lower triangle.
+    let mut log_det = 0.0;
+    for j in 0..p {
+        let mut d = a[j * p + j];
+        for k in 0..j {
+            d -= a[j * p + k] * a[j * p + k];
+        }
+        if !(d.is_finite() && d > 0.0) {
+            return None;
+        }
+        let l = d.sqrt();
+        a[j * p + j] = l;
+        log_det += 2.0 * l.ln();
+        for i in j + 1..p {
+            let mut v = a[i * p + j];
+            for k in 0..j {
+                v -= a[i * p + k] * a[j * p + k];
+            }
+            a[i * p + j] = v / l;
+        }
+    }
+    Some(log_det)
 }

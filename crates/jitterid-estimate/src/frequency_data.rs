@@ -125,6 +125,7 @@ impl<W: Window> FrequencyData<W> {
             model_dtft: mu,
             lazy_model_dtft: OnceLock::new(),
             first_moment: &|| self.transform_moment(self.first_moment(criterion, model)),
+            transform: &|m| self.transform_moment(m),
             model,
         })
     }

@@ -1,5 +1,6 @@
 //! The Box–Jenkins noise model with the jitter's white floor: on Table 2 records with AR(1)
-//! measurement noise, the noise coefficient is unbiased with the floor and biased without it.
+//! measurement noise, the noise level is unbiased with the floor and the AR coefficient's bias
+//! towards white noise is much smaller than without it.
 
 use jitterid_estimate::{
     estimate, mean_jitter_variance, ArmaNoise, BoxJenkins, EstimateOptions, ModelStructure,
@@ -12,11 +13,22 @@ use rand::SeedableRng;
 
 /// The AR coefficient of the noise filter `1 / (1 + d q⁻¹)`.
 const D1: f64 = -0.6;
-/// Records per case: enough that the unfloored bias (about 30 standard errors of the mean at
-/// 128 records) stands far outside the tolerance.
-const RUNS: u64 = 40;
-/// Margin, in Monte Carlo standard errors (`sd/√RUNS`), by which a difference of means must
-/// exceed zero to count: a false positive has probability below 0.0001 (normal tails).
+/// The white noise's standard deviation.
+const SIGMA_E: f64 = 0.01;
+/// Records fitted with the floor: the Monte Carlo standard error of the mean of `noise.d1` is
+/// then about 0.0085 (its spread over records is about 0.095), that of the noise level about
+/// 0.0001.
+const RUNS: u64 = 128;
+/// Records fitted without the floor: the bias there (about 0.23) is about 16 standard errors
+/// of a 24-record mean.
+const RUNS_WITHOUT: u64 = 24;
+/// A mean further than this many Monte Carlo standard errors (`sd/√runs`) from the truth counts
+/// as biased: for an unbiased estimator the mean over the records is normal to a good
+/// approximation (central limit theorem), so a correct implementation fails with probability
+/// 0.0027 per parameter at 3, and with fixed seeds the outcome is reproducible.
+const UNBIASED_SE: f64 = 3.0;
+/// Margin, in Monte Carlo standard errors of a difference of means, by which the floor must
+/// reduce the bias (a false positive has probability below 0.0001).
 const TOLERANCE_SE: f64 = 4.0;
 
 /// `v = e / (1 + d₁ q⁻¹)`, at rest before the record.
@@ -30,18 +42,19 @@ fn ar1(e: &[f64], d1: f64) -> Vec<f64> {
     v
 }
 
-/// The estimates of `noise.d1` over `RUNS` seeded records, with or without the floor.
-fn d1_estimates(with_floor: bool) -> Vec<f64> {
+/// The estimates of `noise.d1` and of `σ_e` over `runs` seeded records, with or without the
+/// floor.
+fn noise_estimates(with_floor: bool, runs: u64) -> (Vec<f64>, Vec<f64>) {
     let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
-    let mut out = Vec::new();
-    for seed in 0..RUNS {
+    let (mut d1, mut std) = (Vec::new(), Vec::new());
+    for seed in 0..runs {
         let mut rng = rand::rngs::StdRng::seed_from_u64(1000 + seed);
         let u = RandomBinary::paper()
             .generate(0.0, 201.0, &mut rng)
             .unwrap();
         let truth = LtiResponse::new(eq17(0.2, 0.5, -0.25, 0.3).unwrap(), u.clone());
-        let sim = simulate(&truth, &jitter, &grid, 0.01, &mut rng).unwrap();
+        let sim = simulate(&truth, &jitter, &grid, SIGMA_E, &mut rng).unwrap();
         let v = ar1(&sim.noise, D1);
         let y = sim
             .y
@@ -56,7 +69,7 @@ fn d1_estimates(with_floor: bool) -> Vec<f64> {
         let options = EstimateOptions::default();
         let fit = if with_floor {
             let (fit, fitted) = s
-                .fit_with_jitter_floor(&grid, Some(0.01), |floored| {
+                .fit_with_jitter_floor(&grid, Some(SIGMA_E), |floored| {
                     estimate(floored, &record, &BoxJenkins, &options)
                 })
                 .unwrap();
@@ -66,9 +79,10 @@ fn d1_estimates(with_floor: bool) -> Vec<f64> {
             estimate(&s, &record, &BoxJenkins, &options).unwrap()
         };
         let i = fit.names.iter().position(|n| n == "noise.d1").unwrap();
-        out.push(fit.params[i]);
+        d1.push(fit.params[i]);
+        std.push(fit.noise_std);
     }
-    out
+    (d1, std)
 }
 
 fn mean_and_se(x: &[f64]) -> (f64, f64) {
@@ -79,20 +93,29 @@ fn mean_and_se(x: &[f64]) -> (f64, f64) {
 }
 
 #[test]
-fn the_floor_reduces_the_noise_models_bias() {
-    let (with, se_with) = mean_and_se(&d1_estimates(true));
-    let (without, se_without) = mean_and_se(&d1_estimates(false));
+fn the_floor_makes_the_noise_level_unbiased_and_cuts_the_coefficients_bias() {
+    let (d1, std) = noise_estimates(true, RUNS);
+    let (d1_with, se_with) = mean_and_se(&d1);
+    let (std_mean, std_se) = mean_and_se(&std);
+    // The AR coefficient keeps a small-sample bias of about 3 standard errors here (0.025
+    // towards 0; see the Box–Jenkins section of docs/reproduction.md), so only the level is
+    // held to the unbiased tolerance and the coefficient to the floor's reduction below.
+    assert!(
+        (std_mean - SIGMA_E).abs() <= UNBIASED_SE * std_se,
+        "with the floor: mean noise std {std_mean} vs {SIGMA_E}, se {std_se}"
+    );
     // Without the floor the ARMA shape absorbs the jitter's white noise and d1 is pulled
     // towards 0 (white); with it, the pull is smaller by several standard errors of the
     // difference of the two means.
+    let (without, se_without) = mean_and_se(&noise_estimates(false, RUNS_WITHOUT).0);
     let se = (se_with * se_with + se_without * se_without).sqrt();
     assert!(
         without - D1 > TOLERANCE_SE * se_without,
         "without the floor the bias should show: mean d1 {without} vs {D1}, se {se_without}"
     );
     assert!(
-        (without - D1) - (with - D1).abs() > TOLERANCE_SE * se,
-        "with the floor: mean d1 {with} (se {se_with}); without: {without} (se {se_without})"
+        (without - D1) - (d1_with - D1).abs() > TOLERANCE_SE * se,
+        "with the floor: mean d1 {d1_with} (se {se_with}); without: {without} (se {se_without})"
     );
 }
 
