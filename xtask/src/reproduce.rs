@@ -113,14 +113,15 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "table1-ml" => crate::reproduce_ml::table1_ml(o),
         "sine" => crate::reproduce_ml::sine(o),
         "starts" => crate::reproduce_starts::starts(o),
+        "select" => crate::reproduce_select::select_case(o),
         "all" => {
-            for c in ["table2", "ls-bias", "alias", "table1", "table1-ml", "sine", "starts"] {
+            for c in ["table2", "ls-bias", "alias", "table1", "table1-ml", "sine", "starts", "select"] {
                 run(c, &Options { json: None, ..o.clone() })?;
             }
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, select or all)"
         )),
     }
 }
