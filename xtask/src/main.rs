@@ -6,6 +6,7 @@ mod paper;
 mod reproduce;
 mod reproduce_initial;
 mod reproduce_ml;
+mod reproduce_select;
 mod reproduce_starts;
 mod scale;
 
@@ -19,7 +20,7 @@ const USAGE: &str = "usage:
   cargo xtask speedup
       the Table 2 study on 1 and 2 threads: wall time and identical results
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
-      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, all";
+      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, all";
 
 /// Options of `reproduce`.
 #[derive(Debug, Clone)]

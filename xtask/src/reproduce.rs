@@ -114,6 +114,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "sine" => crate::reproduce_ml::sine(o),
         "starts" => crate::reproduce_starts::starts(o),
         "initial" => crate::reproduce_initial::initial(o),
+        "select" => crate::reproduce_select::select_case(o),
         "all" => {
             for c in [
                 "table2",
@@ -124,13 +125,14 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
                 "sine",
                 "starts",
                 "initial",
+                "select",
             ] {
                 run(c, &Options { json: None, ..o.clone() })?;
             }
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select or all)"
         )),
     }
 }

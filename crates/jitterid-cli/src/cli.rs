@@ -132,6 +132,10 @@ pub struct FitArgs {
     /// Write SVG figures into this directory.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// The start: `experiment` (the experiment's values) or `auto` (the system from the
+    /// data-driven initializer, as `select` starts each candidate).
+    #[arg(long, value_name = "START", default_value = "experiment", value_parser = crate::select::InitChoice::parse)]
+    pub init: crate::select::InitChoice,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub budget: BudgetArgs,
@@ -225,6 +229,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             method: a.method,
             json: a.json,
             plot: a.plot,
+            init: a.init,
             accept_unconverged: a.budget.accept_unconverged,
             max_iterations: a.budget.max_iterations,
             time_limit: a.budget.time_limit,

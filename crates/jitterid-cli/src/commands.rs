@@ -172,6 +172,8 @@ pub struct FitOptions {
     pub json: bool,
     /// Plot directory.
     pub plot: Option<PathBuf>,
+    /// The start: the experiment's values or the data-driven initializer's.
+    pub init: crate::select::InitChoice,
     /// Exit 0 even when the fit did not converge.
     pub accept_unconverged: bool,
     /// Iteration limit (overrides `[estimate] max_iterations`).
@@ -341,7 +343,10 @@ pub fn fit(o: &FitOptions) -> CliResult<Outcome> {
     let table = read_data(&exp, &o.data)?;
     let y = table.column("y")?.to_vec();
     let input = read_input(&exp, &o.data, o.input.as_deref())?;
-    let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+    let mut signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+    if o.init == crate::select::InitChoice::Auto {
+        signal = crate::select::auto_start(&exp, &signal, input.as_ref(), &y, &table.name)?;
+    }
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let f = fit_values(&exp, signal.clone(), y.clone(), &table.name)?;
     drop(ticker);

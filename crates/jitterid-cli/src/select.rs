@@ -8,12 +8,16 @@ use crate::cli_err;
 use crate::commands::{read_data, read_experiment, read_input};
 use crate::error::CliResult;
 use crate::exit::{Outcome, Status};
+use crate::experiment::Experiment;
 use crate::experiment::Purpose;
 use crate::fitting;
 use crate::output::OutputSet;
 use jitterid::estimate::selection::{select as run_select, Candidate, SelectionOptions};
+use jitterid::estimate::{initial_model, InitError, InitOptions};
 use jitterid::jitter::registry::JitterRegistry;
-use jitterid::signal::Input;
+use jitterid::jitter::JitterModel;
+use jitterid::signal::registry::{SignalRegistry, Spec};
+use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -144,4 +148,123 @@ pub fn select(o: &SelectOptions) -> CliResult<Outcome> {
         );
     }
     Ok(Outcome { text: out, status })
+}
+
+/// Where `jitterid fit` starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InitChoice {
+    /// The experiment's values.
+    #[default]
+    Experiment,
+    /// The data-driven initializer's model (as `select` starts each candidate), with the
+    /// experiment's jitter, noise and the system's other keys (delay, initial state).
+    Auto,
+}
+
+impl InitChoice {
+    /// Parses `experiment` or `auto`.
+    ///
+    /// # Errors
+    ///
+    /// A message naming the accepted values.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        match s {
+            "experiment" => Ok(Self::Experiment),
+            "auto" => Ok(Self::Auto),
+            other => Err(format!("expected experiment or auto, found `{other}`")),
+        }
+    }
+}
+
+fn roots_of(spec: &Spec, key: &str) -> Option<Vec<Root>> {
+    let Some(v) = spec.get(key) else {
+        return Some(Vec::new());
+    };
+    v.as_array()?
+        .iter()
+        .map(|r| match r {
+            Value::Array(p) => match p.as_slice() {
+                [re, im] => Some(Root::Pair {
+                    re: re.as_f64()?,
+                    im: im.as_f64()?,
+                }),
+                _ => None,
+            },
+            x => x.as_f64().map(Root::Real),
+        })
+        .collect()
+}
+
+fn roots_json(roots: &[Root]) -> Value {
+    roots
+        .iter()
+        .map(|r| match *r {
+            Root::Real(x) => json!(x),
+            Root::Pair { re, im } => json!([re, im]),
+        })
+        .collect()
+}
+
+fn f64s(spec: &Spec, key: &str) -> Option<Vec<f64>> {
+    spec.get(key)?
+        .as_array()?
+        .iter()
+        .map(Value::as_f64)
+        .collect()
+}
+
+/// The experiment's system with its rational model replaced by the data-driven initializer's
+/// ([`initial_model`], the jitter's damping compensated with the experiment's jitter): the
+/// start of `fit --init auto`. Only the model's own keys change; a delay or an initial state
+/// keeps the experiment's value.
+pub fn auto_start(
+    exp: &Experiment,
+    signal: &AnySignal,
+    input: Option<&Input>,
+    y: &[f64],
+    data: &str,
+) -> CliResult<AnySignal> {
+    let input = input.ok_or_else(|| {
+        cli_err!(
+            "{}: --init auto fits the system's frequency response to the input's, but the experiment has no [input]",
+            exp.file
+        )
+    })?;
+    let record = fitting::record(&exp.grid, y.to_vec()).map_err(|e| cli_err!("{data}: {e}"))?;
+    let jitter: &dyn JitterModel = &exp.jitter.model;
+    let opts = InitOptions::default();
+    let init_err = |e: InitError| cli_err!("{data}: --init auto: the initializer failed: {e}");
+    let mut spec = signal.spec();
+    match signal.kind() {
+        "tf" => {
+            let (num, den) = f64s(&spec, "num")
+                .zip(f64s(&spec, "den"))
+                .ok_or_else(|| cli_err!("{}: [system] num, den: not numbers", exp.file))?;
+            let tf = TransferFunction::new(&num, &den)
+                .map_err(|e| cli_err!("{}: [system]: {e}", exp.file))?;
+            let g = initial_model(&tf, &record, input, Some(jitter), &opts).map_err(init_err)?;
+            spec.insert("num".into(), json!(g.num()));
+            spec.insert("den".into(), json!(g.den()));
+        }
+        "zpk" => {
+            let (zeros, poles) = roots_of(&spec, "zeros")
+                .zip(roots_of(&spec, "poles"))
+                .ok_or_else(|| cli_err!("{}: [system] zeros, poles: not roots", exp.file))?;
+            let zpk =
+                Zpk::new(1.0, zeros, poles).map_err(|e| cli_err!("{}: [system]: {e}", exp.file))?;
+            let g = initial_model(&zpk, &record, input, Some(jitter), &opts).map_err(init_err)?;
+            spec.insert("gain".into(), json!(g.gain()));
+            spec.insert("zeros".into(), roots_json(g.zeros()));
+            spec.insert("poles".into(), roots_json(g.poles()));
+        }
+        other => {
+            return Err(cli_err!(
+                "{}: --init auto: the initializer fits rational systems (kind tf or zpk), not `{other}`",
+                exp.file
+            ))
+        }
+    }
+    SignalRegistry::builtin()
+        .build(&spec, Some(input))
+        .map_err(|e| cli_err!("{data}: --init auto: the initializer's model: {e}"))
 }

@@ -3,8 +3,12 @@
 //! [`select`] fits every candidate of a [`SelectionGrid`] — a number of zeros and poles (a
 //! transfer function `N(s)/A(s)`, `A` monic) and a jitter family taken from a
 //! [`JitterRegistry`] by name, `"none"` included — with BCLS, each started by the data-driven
-//! initializer ([`crate::initial_model`]) and the jitter at a standard deviation of
-//! [`SelectionOptions::jitter_fraction`] `· T` through [`JitterRegistry::from_std_dev`].
+//! initializer ([`crate::initial_model`]) with the jitter at a standard deviation of
+//! `f · T` through [`JitterRegistry::from_std_dev`], once for every fraction `f` of
+//! [`SelectionOptions::jitter_fractions`], keeping the lowest-cost converged fit. Several jitter
+//! starts because the BCLS cost is not convex in the jitter's scale for families whose `γ(f)`
+//! oscillates (periodic: `J₀`, two-point: `cos`): from one start the fit of the true family can
+//! end in a local minimum with the scale far off, and a wrong family would then win.
 //!
 //! Candidates are ranked by the BIC of a Gaussian quasi-likelihood of the frequency-domain
 //! residuals: with independent samples the residual `D(f) = Y(f) − μ_Y(f)` has the same
@@ -36,14 +40,15 @@ pub struct SelectionGrid {
 /// Settings of [`select`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct SelectionOptions {
-    /// Starting jitter standard deviation as a fraction of the sampling interval `T`.
-    pub jitter_fraction: f64,
+    /// Starting jitter standard deviations as fractions of the sampling interval `T`: every
+    /// jittered candidate is fitted from each, and the lowest-cost converged fit is kept.
+    pub jitter_fractions: Vec<f64>,
 }
 
 impl Default for SelectionOptions {
     fn default() -> Self {
         Self {
-            jitter_fraction: 0.2,
+            jitter_fractions: vec![0.1, 0.25, 0.4],
         }
     }
 }
@@ -178,6 +183,40 @@ fn template(zeros: usize, poles: usize) -> Result<TransferFunction, String> {
     TransferFunction::new(&vec![1.0; zeros + 1], &den).map_err(|e| e.to_string())
 }
 
+type Structure = ModelStructure<LtiResponse<TransferFunction>, AnyJitter, crate::WhiteNoise>;
+
+/// One BCLS fit of a candidate from the initializer's model with the jitter at `fraction · T`.
+fn fit_from(
+    record: &Record,
+    input: &Input,
+    registry: &JitterRegistry,
+    family: &str,
+    poles: usize,
+    zeros: usize,
+    fraction: f64,
+) -> Result<(Structure, crate::Fit), String> {
+    let sigma = fraction * record.grid().interval();
+    let jitter = registry
+        .from_std_dev(family, sigma, &serde_json::Map::new())
+        .map_err(|e| format!("jitter start: {e}"))?;
+    let model = template(zeros, poles).map_err(|e| format!("template: {e}"))?;
+    let signal = LtiResponse::new(model, input.clone());
+    let structure = if family == "none" {
+        ModelStructure::oe(signal, jitter)
+    } else {
+        ModelStructure::joe(signal, jitter)
+    };
+    let structure = initialize(&structure, record, &InitOptions::default())
+        .map_err(|e| format!("initializer: {e}"))?;
+    // The ranking needs the cost only; the sandwich covariance would dominate the time.
+    let options = EstimateOptions {
+        covariance: false,
+        ..EstimateOptions::default()
+    };
+    let fit = estimate(&structure, record, &Bcls, &options).map_err(|e| format!("fit: {e}"))?;
+    Ok((structure, fit))
+}
+
 fn fit_candidate(
     record: &Record,
     input: &Input,
@@ -195,28 +234,30 @@ fn fit_candidate(
         failure: Some(reason),
         fitted: None,
     };
-    let sigma = options.jitter_fraction * record.grid().interval();
-    let jitter = match registry.from_std_dev(&family, sigma, &serde_json::Map::new()) {
-        Ok(j) => j,
-        Err(e) => return failed(format!("jitter start: {e}")),
-    };
-    let model = match template(zeros, poles) {
-        Ok(m) => m,
-        Err(e) => return failed(format!("template: {e}")),
-    };
-    let signal = LtiResponse::new(model, input.clone());
-    let structure = if family == "none" {
-        ModelStructure::oe(signal, jitter)
+    // "none" has no scale: one start is enough.
+    let fractions: &[f64] = if family == "none" {
+        &options.jitter_fractions[..1]
     } else {
-        ModelStructure::joe(signal, jitter)
+        &options.jitter_fractions
     };
-    let structure = match initialize(&structure, record, &InitOptions::default()) {
-        Ok(s) => s,
-        Err(e) => return failed(format!("initializer: {e}")),
-    };
-    let fit = match estimate(&structure, record, &Bcls, &EstimateOptions::default()) {
-        Ok(f) => f,
-        Err(e) => return failed(format!("fit: {e}")),
+    let mut best: Option<(Structure, crate::Fit)> = None;
+    let mut last_error = String::new();
+    for &fraction in fractions {
+        match fit_from(record, input, registry, &family, poles, zeros, fraction) {
+            Ok((s, fit)) => {
+                let better = match &best {
+                    None => true,
+                    Some((_, b)) => (fit.converged, -fit.cost) > (b.converged, -b.cost),
+                };
+                if better {
+                    best = Some((s, fit));
+                }
+            }
+            Err(e) => last_error = e,
+        }
+    }
+    let Some((structure, fit)) = best else {
+        return failed(last_error);
     };
     let n = record.y().len() as f64;
     let k = fit.params.len() as f64;
@@ -259,10 +300,11 @@ pub fn select(
     registry: &JitterRegistry,
     options: &SelectionOptions,
 ) -> Result<Vec<Candidate>, SelectionError> {
-    if !(options.jitter_fraction.is_finite() && options.jitter_fraction > 0.0) {
+    let fractions = &options.jitter_fractions;
+    if fractions.is_empty() || !fractions.iter().all(|f| f.is_finite() && *f > 0.0) {
         return Err(invalid(
-            "jitter_fraction",
-            format!("{} must be positive and finite", options.jitter_fraction),
+            "jitter_fractions",
+            format!("{fractions:?} must be a non-empty list of positive finite numbers"),
         ));
     }
     let list = grid.candidates(registry, record.y().len())?;
