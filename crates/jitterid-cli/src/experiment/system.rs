@@ -85,14 +85,16 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
         "zpk" => zpk(cx, r, grid)?,
         "tf" => tf(cx, r, grid)?,
         "sinusoid" => sinusoid(cx, r, grid)?,
-        other => return Err(cx.err(
-            S,
-            "kind",
-            &kind.span(),
-            format!(
+        other => {
+            return Err(cx.err(
+                S,
+                "kind",
+                &kind.span(),
+                format!(
                 "the command line has no reader for the signal kind \"{other}\"; expected {kinds}"
             ),
-        )),
+            ))
+        }
     };
     let kind = response_keys(cx, r, grid, kind)?;
     let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
