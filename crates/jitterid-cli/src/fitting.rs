@@ -5,9 +5,7 @@ use crate::error::CliResult;
 use crate::experiment::{name_table, Experiment, InputSpec, Method};
 use crate::export::{reported_covariance, CovarianceSource};
 use crate::inputs::input_span;
-use jitterid::estimate::solver::{
-    AnySolver, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead, SolverRegistry,
-};
+use jitterid::estimate::solver::{AnySolver, SolverRegistry};
 use jitterid::estimate::{
     AnyCriterion, AnyNoise, EstimateError, Fit as Estimate, FitOptions, ModelStructure, NoiseModel,
     Record,
@@ -164,52 +162,42 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
     }
 }
 
-/// The solver of the experiment; `seed` seeds multistart perturbations.
-pub fn solver(exp: &Experiment, seed: u64) -> AnySolver {
+/// The solver of the experiment, built through the solver registry; `seed` seeds multistart
+/// perturbations. The command line's iteration and wall-clock budgets go to the entry's
+/// `max_iters` and `max_seconds` keys where it takes them (a solver without a wall-clock
+/// budget runs to its iteration limit), and the progress bar, when one is shown, to the
+/// solver itself.
+pub fn solver(exp: &Experiment, seed: u64) -> CliResult<AnySolver> {
     let e = &exp.estimate;
-    let base = match e.solver.as_str() {
-        "lm" => {
-            let mut s = LevenbergMarquardt::default();
-            if let Some(n) = e.max_iterations {
-                s = s.with_max_iters(n);
-            }
-            if let Some(t) = e.max_seconds {
-                s = s.with_max_seconds(t);
-            }
-            if let Some(hook) = crate::progress::active_fit_hook() {
-                s = s.with_progress(hook);
-            }
-            AnySolver::new(s)
-        }
-        "gauss-newton" => {
-            let mut s = GaussNewtonLineSearch::default();
-            if let Some(n) = e.max_iterations {
-                s.max_iters = n;
-            }
-            AnySolver::new(s)
-        }
-        "nelder-mead" => {
-            let mut s = NelderMead::default();
-            if let Some(n) = e.max_iterations {
-                s.max_iters = n;
-            }
-            AnySolver::new(s)
-        }
-        // A name validated at the door that takes no budget: the registry's defaults.
-        other => SolverRegistry::builtin()
-            .build(&name_table(SolverRegistry::builtin().key(), other))
-            .unwrap_or_default(),
+    let registry = SolverRegistry::builtin();
+    let mut table = name_table(registry.key(), e.solver.as_str());
+    let takes = |key: &str| {
+        registry
+            .entry(e.solver.as_str())
+            .is_some_and(|entry| entry.params.iter().any(|p| p.key == key))
     };
-    if e.multistart > 0 {
-        AnySolver::new(MultiStart::new(
-            base,
-            e.multistart,
-            e.multistart_radius,
-            seed,
-        ))
-    } else {
-        base
+    if let Some(n) = e.max_iterations.filter(|_| takes("max_iters")) {
+        table.insert("max_iters".into(), n.into());
     }
+    if let Some(t) = e.max_seconds.filter(|_| takes("max_seconds")) {
+        table.insert("max_seconds".into(), t.into());
+    }
+    if e.multistart > 0 {
+        table.insert("starts".into(), e.multistart.into());
+        table.insert("radius".into(), e.multistart_radius.into());
+        table.insert("seed".into(), seed.into());
+    }
+    let solver = registry.build(&table).map_err(|err| {
+        cli_err!(
+            "{}: [estimate] solver \"{}\": {err}",
+            exp.file,
+            e.solver.as_str()
+        )
+    })?;
+    Ok(match crate::progress::active_fit_hook() {
+        Some(hook) => solver.with_progress(hook),
+        None => solver,
+    })
 }
 
 /// One reported parameter of a fit.
@@ -337,13 +325,13 @@ pub fn truth_values(
     Ok(out)
 }
 
-fn options(exp: &Experiment, seed: u64, covariance: bool) -> FitOptions {
-    FitOptions {
+fn options(exp: &Experiment, seed: u64, covariance: bool) -> CliResult<FitOptions> {
+    Ok(FitOptions {
         frequencies: exp.estimate.frequencies.clone(),
-        solver: Some(solver(exp, seed)),
+        solver: Some(solver(exp, seed)?),
         covariance,
         noise_std_start: None,
-    }
+    })
 }
 
 /// `j`, a uniform sum, with its whole number `n` replaced (rebuilt through the registry).
@@ -417,7 +405,7 @@ pub fn fit(
     seed: u64,
     covariance: bool,
 ) -> Result<Fit, String> {
-    let opts = options(exp, seed, covariance);
+    let opts = options(exp, seed, covariance).map_err(|e| e.to_string())?;
     let raw =
         |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
             let (e, fitted, n) = r.map_err(|e| e.to_string())?;

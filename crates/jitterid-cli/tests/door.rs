@@ -179,3 +179,33 @@ fn a_term_time_scale_outside_the_range_is_named_at_its_line() {
         ],
     );
 }
+
+#[test]
+fn an_unknown_system_kind_lists_the_registry_kinds_a_file_can_describe() {
+    refused(
+        "unknown-kind",
+        &table2_with("kind = \"zpk\"", "kind = \"zpq\""),
+        &[
+            "e.toml:23:",
+            "[system] kind",
+            "unknown system kind \"zpq\"",
+            "expected \"zpk\", \"tf\" or \"sinusoid\"",
+        ],
+    );
+}
+
+#[test]
+fn a_registry_kind_whose_keys_a_file_cannot_hold_is_refused_with_those_keys() {
+    // `pulse-response` is a signal registry kind; [system] has no keys for its coefficients
+    // and pulse spacing, so the door names them (from the registry) instead of failing later.
+    refused(
+        "pulse-response",
+        &table2_with("kind = \"zpk\"", "kind = \"pulse-response\""),
+        &[
+            "e.toml:23:",
+            "[system] kind",
+            "\"pulse-response\"",
+            "takes coefficients, interval",
+        ],
+    );
+}

@@ -84,7 +84,10 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
         cli_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
     })?;
     let r_system = raw.system.as_ref().ok_or_else(|| {
-        cli_err!("{file}: missing section [system]; expected kind = \"zpk\", \"tf\" or \"sinusoid\" and its keys")
+        cli_err!(
+            "{file}: missing section [system]; expected kind = {} and its keys",
+            system::kinds()
+        )
     })?;
     let grid = sampling::parse_sampling(&cx, r_sampling)?;
     let system = system::parse_system(&cx, r_system, &grid)?;

@@ -3,11 +3,14 @@
 use super::diagnostics::Source;
 use super::range;
 use super::raw::RawNoise;
-use super::spec::NoiseSpec;
+use super::spec::{quoted_list, NoiseSpec};
 use crate::error::CliResult;
-use jitterid::estimate::{AnyNoise, ArmaNoise, WhiteNoise};
+use jitterid::estimate::{AnyNoise, ArmaNoise, NoiseRegistry, WhiteNoise};
 
 const S: &str = "noise";
+
+/// Keys of `[noise]` the command line reads itself, whatever the model.
+const OWN_KEYS: &[&str] = &["std", "model", "estimate"];
 
 pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
     let present = r.present();
@@ -28,9 +31,25 @@ pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
     };
     let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
     let model = r.model.as_ref().map_or("white", |m| m.get_ref().as_str());
+    let registry = NoiseRegistry::builtin();
+    let names: Vec<&str> = registry.entries().iter().map(|e| e.name).collect();
+    let model_span = || r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
+    let Some(entry) = registry.entry(model) else {
+        return Err(cx.err(
+            S,
+            "model",
+            &model_span(),
+            format!(
+                "unknown noise model \"{model}\"; expected {}",
+                quoted_list(&names)
+            ),
+        ));
+    };
+    let mut keys = OWN_KEYS.to_vec();
+    keys.extend(entry.params.iter().map(|p| p.key.as_str()));
     let shape = match model {
         "white" => {
-            cx.only(S, &present, "model", &["std", "model", "estimate"], "white")?;
+            cx.only(S, &present, "model", &keys, "white")?;
             AnyNoise::new(WhiteNoise)
         }
         "arma" => {
@@ -48,12 +67,11 @@ pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
             })?)
         }
         other => {
-            let span = r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
             return Err(cx.err(
                 S,
                 "model",
-                &span,
-                format!("unknown noise model \"{other}\"; expected \"white\" or \"arma\""),
+                &model_span(),
+                format!("the command line has no reader for the noise model \"{other}\""),
             ));
         }
     };

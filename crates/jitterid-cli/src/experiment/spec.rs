@@ -206,7 +206,7 @@ pub fn name_table(key: &str, name: &str) -> SpecTable {
 }
 
 /// `"a", "b" or "c"`.
-fn quoted_list(names: &[&str]) -> String {
+pub(crate) fn quoted_list(names: &[&str]) -> String {
     let quoted: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
     match quoted.split_last() {
         Some((last, [])) => last.clone(),

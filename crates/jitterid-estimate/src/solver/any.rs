@@ -2,7 +2,7 @@
 
 use super::{
     Bfgs, Brent, BrentOrBfgs, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
-    Solver, SolverError, SolverReport,
+    ProgressHook, Solver, SolverError, SolverReport,
 };
 use crate::objective::Objective;
 use crate::solver::LeastSquares;
@@ -28,6 +28,13 @@ pub trait DynSolver: fmt::Debug + Send + Sync {
         problem: &dyn Objective,
         start: &[f64],
     ) -> Result<SolverReport, SolverError>;
+
+    /// A copy of this solver that reports to `hook` after the start and after every
+    /// iteration, or `None` for a solver that has no progress reports (the default).
+    fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
+        let _ = hook;
+        None
+    }
 }
 
 /// A solver chosen at run time (from the [`SolverRegistry`](super::SolverRegistry) or any
@@ -44,6 +51,33 @@ impl AnySolver {
     /// The solver's name.
     pub fn name(&self) -> &'static str {
         self.0.name()
+    }
+
+    /// Whether the solver reports its progress ([`DynSolver::with_progress_dyn`]).
+    pub fn reports_progress(&self) -> bool {
+        self.0
+            .with_progress_dyn(ProgressHook::new(|_| {}))
+            .is_some()
+    }
+
+    /// This solver reporting to `hook` after the start and after every iteration; a solver
+    /// without progress reports is returned as it is. A [`MultiStart`] passes the hook to
+    /// the solver it runs.
+    ///
+    /// ```
+    /// use jitterid_estimate::solver::{ProgressHook, SolverRegistry};
+    ///
+    /// let table = serde_json::json!({ "solver": "lm", "starts": 3 });
+    /// let solver = SolverRegistry::builtin().build(table.as_object().unwrap())?;
+    /// let solver = solver.with_progress(ProgressHook::new(|p| eprintln!("{}", p.cost)));
+    /// assert!(solver.reports_progress());
+    /// # Ok::<(), jitterid_estimate::RegistryError>(())
+    /// ```
+    #[must_use]
+    pub fn with_progress(&self, hook: ProgressHook) -> AnySolver {
+        self.0
+            .with_progress_dyn(hook)
+            .unwrap_or_else(|| self.clone())
     }
 }
 
@@ -74,6 +108,9 @@ impl DynSolver for AnySolver {
         start: &[f64],
     ) -> Result<SolverReport, SolverError> {
         self.0.minimize_dyn(problem, start)
+    }
+    fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
+        self.0.with_progress_dyn(hook)
     }
 }
 
@@ -115,6 +152,9 @@ impl DynSolver for LevenbergMarquardt {
     fn minimize_dyn(&self, p: &dyn Objective, start: &[f64]) -> Result<SolverReport, SolverError> {
         Solver::minimize(self, residual_form(p, "lm")?, start)
     }
+    fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
+        Some(AnySolver::new(self.clone().with_progress(hook)))
+    }
 }
 
 impl DynSolver for GaussNewtonLineSearch {
@@ -128,6 +168,9 @@ impl DynSolver for GaussNewtonLineSearch {
 
 macro_rules! objective_solver {
     ($ty:ty, $name:literal) => {
+        objective_solver!($ty, $name, |_s: &$ty, _h: ProgressHook| None);
+    };
+    ($ty:ty, $name:literal, $hooked:expr) => {
         impl DynSolver for $ty {
             fn name(&self) -> &'static str {
                 $name
@@ -139,12 +182,42 @@ macro_rules! objective_solver {
             ) -> Result<SolverReport, SolverError> {
                 Solver::minimize(self, p, start)
             }
+            fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
+                ($hooked)(self, hook)
+            }
         }
     };
 }
 
 objective_solver!(NelderMead, "nelder-mead");
-objective_solver!(Bfgs, "bfgs");
-objective_solver!(Brent, "brent");
-objective_solver!(BrentOrBfgs, "brent-or-bfgs");
-objective_solver!(MultiStart<AnySolver>, "multistart");
+objective_solver!(Bfgs, "bfgs", |s: &Bfgs, hook| Some(AnySolver::new(Bfgs {
+    progress: Some(hook),
+    ..s.clone()
+})));
+objective_solver!(Brent, "brent", |s: &Brent, hook| Some(AnySolver::new(
+    Brent {
+        progress: Some(hook),
+        ..s.clone()
+    }
+)));
+objective_solver!(
+    BrentOrBfgs,
+    "brent-or-bfgs",
+    |s: &BrentOrBfgs, hook: ProgressHook| {
+        let mut s = s.clone();
+        s.brent.progress = Some(hook.clone());
+        s.bfgs.progress = Some(hook);
+        Some(AnySolver::new(s))
+    }
+);
+// The wrapper reports the runs of the solver it wraps.
+objective_solver!(
+    MultiStart<AnySolver>,
+    "multistart",
+    |s: &MultiStart<AnySolver>, hook| s.solver.with_progress_dyn(hook).map(|inner| {
+        AnySolver::new(MultiStart {
+            solver: inner,
+            ..s.clone()
+        })
+    })
+);

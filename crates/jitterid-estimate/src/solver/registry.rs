@@ -41,9 +41,21 @@ pub type SolverEntry = Entry<AnySolver>;
 pub type SolverRegistry = Registry<AnySolver>;
 
 const MAX_ITERS: &str = "max_iters";
+const MAX_SECONDS: &str = "max_seconds";
 
 fn max_iters(default: f64) -> ParamSpec {
     whole(MAX_ITERS, "iteration limit", ">= 1", Some(default))
+}
+
+/// The wall-clock budget of a solver that checks one between iterations.
+fn max_seconds(default: f64) -> ParamSpec {
+    real(
+        MAX_SECONDS,
+        "wall-clock budget, checked between iterations",
+        "s",
+        ">= 0, finite",
+        Some(default),
+    )
 }
 
 fn positive(key: &'static str, meaning: &'static str, default: f64) -> ParamSpec {
@@ -64,7 +76,11 @@ fn multistart(table: &SpecTable, solver: AnySolver) -> Result<AnySolver, Registr
             format!("must be finite and >= 0, got {radius}"),
         ));
     }
-    let seed = count(table, &seed, solver.name())?;
+    // A seed above 2^53 has no exact `f64`: read it as the whole number it is.
+    let seed = match table.get(&seed.key).and_then(serde_json::Value::as_u64) {
+        Some(s) => s,
+        None => count(table, &seed, solver.name())?,
+    };
     Ok(AnySolver::new(MultiStart::new(
         solver,
         starts as usize,
@@ -73,7 +89,9 @@ fn multistart(table: &SpecTable, solver: AnySolver) -> Result<AnySolver, Registr
     )))
 }
 
-/// Reads the entry's keys in order as numbers; an iteration limit must be at least 1.
+/// Reads the entry's keys in order as numbers; an iteration limit must be at least 1, a
+/// wall-clock budget finite and at least 0 (no time: stop after the start), other reals
+/// finite and positive.
 fn read(table: &SpecTable, entry: &str, specs: &[ParamSpec]) -> Result<Vec<f64>, RegistryError> {
     specs
         .iter()
@@ -81,6 +99,16 @@ fn read(table: &SpecTable, entry: &str, specs: &[ParamSpec]) -> Result<Vec<f64>,
             let v = number(table, s, entry)?;
             if s.key == MAX_ITERS && !(v >= 1.0) {
                 return Err(RegistryError::bad(MAX_ITERS, "must be at least 1"));
+            }
+            if s.key == MAX_SECONDS {
+                return if v.is_finite() && v >= 0.0 {
+                    Ok(v)
+                } else {
+                    Err(RegistryError::bad(
+                        MAX_SECONDS,
+                        format!("must be finite and >= 0, got {v}"),
+                    ))
+                };
             }
             let positive = v.is_finite() && v > 0.0;
             if !s.integer && !positive {
@@ -122,6 +150,7 @@ impl Registry<AnySolver> {
             positive("xtol", "relative step tolerance", lm.xtol),
             positive("ftol", "relative cost-reduction tolerance", lm.ftol),
             positive("gtol", "gradient tolerance", lm.gtol),
+            max_seconds(lm.max_seconds),
         ];
         let keys = lm_keys.clone();
         r.insert(Entry::new(
@@ -134,7 +163,8 @@ impl Registry<AnySolver> {
                     .with_max_iters(v[0] as u64)
                     .with_xtol(v[1])
                     .with_ftol(v[2])
-                    .with_gtol(v[3]);
+                    .with_gtol(v[3])
+                    .with_max_seconds(v[4]);
                 lm.options().validate().map_err(|e| match e {
                     SolverError::InvalidOption { option, .. } => RegistryError::bad(option, &e),
                     other => RegistryError::bad(SOLVER_KEY, other),
@@ -185,7 +215,10 @@ impl Registry<AnySolver> {
             },
         ));
         let bfgs = Bfgs::default();
-        let bfgs_keys = vec![max_iters(bfgs.max_iters as f64)];
+        let bfgs_keys = vec![
+            max_iters(bfgs.max_iters as f64),
+            max_seconds(bfgs.max_seconds),
+        ];
         let keys = bfgs_keys.clone();
         r.insert(Entry::new(
             "bfgs",
@@ -195,6 +228,7 @@ impl Registry<AnySolver> {
                 let v = read(t, "bfgs", &keys)?;
                 Ok(AnySolver::new(Bfgs {
                     max_iters: v[0] as u64,
+                    max_seconds: v[1],
                     ..Bfgs::default()
                 }))
             },

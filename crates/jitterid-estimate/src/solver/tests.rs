@@ -197,3 +197,90 @@ fn termination_reasons_classify() {
         assert!(!t.to_string().is_empty());
     }
 }
+
+fn registry_solver(table: serde_json::Value) -> AnySolver {
+    SolverRegistry::builtin()
+        .build(table.as_object().expect("a table"))
+        .expect("a valid solver table")
+}
+
+#[test]
+fn solver_registry_budget_keys_reach_the_solver() {
+    // The registry's defaults are the types' defaults: the same run, to the bit.
+    let by_name = registry_solver(serde_json::json!({ "solver": "lm" }));
+    let by_hand = LevenbergMarquardt::default();
+    let start = [-1.2, 1.0];
+    assert_eq!(
+        Solver::minimize(&by_name, &Rosenbrock, &start).unwrap(),
+        Solver::minimize(&by_hand, &Rosenbrock, &start).unwrap()
+    );
+    // An iteration limit of 3 stops Levenberg–Marquardt on Rosenbrock (it needs about 20).
+    let short = registry_solver(serde_json::json!({ "solver": "lm", "max_iters": 3 }));
+    let report = Solver::minimize(&short, &Rosenbrock, &start).unwrap();
+    assert_eq!(report.termination, Termination::MaxIterations);
+    assert_eq!(report.iterations, 3);
+    // No time at all: the first iteration boundary ends the run.
+    for name in ["lm", "bfgs"] {
+        let none = registry_solver(serde_json::json!({ "solver": name, "max_seconds": 0.0 }));
+        let report = Solver::minimize(&none, &Rosenbrock, &start).unwrap();
+        assert_eq!(report.termination, Termination::TimeLimit, "{name}");
+    }
+    for bad in [-1.0, f64::MAX * 2.0] {
+        let table = serde_json::json!({ "solver": "lm", "max_seconds": bad });
+        let err = SolverRegistry::builtin()
+            .build(table.as_object().unwrap())
+            .unwrap_err();
+        assert_eq!(err.key(), Some("max_seconds"), "{bad}");
+    }
+}
+
+#[test]
+fn solver_registry_reads_a_multistart_seed_above_2_pow_53_exactly() {
+    let seed = u64::MAX - 1;
+    let by_name = registry_solver(
+        serde_json::json!({ "solver": "lm", "starts": 4, "radius": 0.5, "seed": seed }),
+    );
+    let start = [-1.2, 1.0];
+    let exact = MultiStart::new(LevenbergMarquardt::default(), 4, 0.5, seed);
+    assert_eq!(
+        Solver::minimize(&by_name, &Rosenbrock, &start).unwrap(),
+        Solver::minimize(&exact, &Rosenbrock, &start).unwrap()
+    );
+}
+
+#[test]
+fn solver_progress_hook_goes_through_the_trait_and_the_multistart_wrapper() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::Arc;
+    let start = [-1.2, 1.0];
+    for table in [
+        serde_json::json!({ "solver": "lm" }),
+        serde_json::json!({ "solver": "lm", "starts": 2 }),
+        serde_json::json!({ "solver": "bfgs" }),
+    ] {
+        let calls = Arc::new(AtomicU64::new(0));
+        let seen = Arc::clone(&calls);
+        let hook = ProgressHook::new(move |_| {
+            seen.fetch_add(1, Ordering::Relaxed);
+        });
+        let plain = registry_solver(table.clone());
+        assert!(plain.reports_progress(), "{table}");
+        let hooked = plain.with_progress(hook);
+        let report = Solver::minimize(&hooked, &Rosenbrock, &start).unwrap();
+        // One report after the start's evaluation and one per iteration, for every run.
+        assert!(calls.load(Ordering::Relaxed) > report.iterations, "{table}");
+        // The hook only watches: the run is the one without it.
+        assert_eq!(
+            report,
+            Solver::minimize(&plain, &Rosenbrock, &start).unwrap(),
+            "{table}"
+        );
+    }
+    // A solver without progress reports is returned unchanged.
+    let gn = registry_solver(serde_json::json!({ "solver": "gauss-newton" }));
+    assert!(!gn.reports_progress());
+    assert_eq!(
+        gn.with_progress(ProgressHook::new(|_| {})).name(),
+        "gauss-newton"
+    );
+}
