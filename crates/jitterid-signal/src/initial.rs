@@ -252,16 +252,17 @@ fn free_of(modes: &[Mode], delta: f64) -> f64 {
 }
 
 /// `M_τ(p) = E[e^{pτ}]` (the moment-generating function, or the jitter's rule where it
-/// diverges) and `E[τ e^{pτ}]` (the rule).
+/// diverges) and `E[τ e^{pτ}]` (the rule), from one complex exponential per node.
 fn jitter_factors(jitter: &dyn JitterModel, p: Complex64) -> (Complex64, Complex64) {
     let rule = jitter.rule(&[], p.norm());
-    let expect = |h: &dyn Fn(f64) -> Complex64| {
-        Complex64::new(rule.expect(|tau| h(tau).re), rule.expect(|tau| h(tau).im))
-    };
-    let m0 = jitter
-        .mgf(p)
-        .unwrap_or_else(|| expect(&|tau| (p * tau).exp()));
-    (m0, expect(&|tau| tau * (p * tau).exp()))
+    // Σ w_i h(τ_i) in the rule's order, as `QuadratureRule::expect` sums it.
+    let (mut m0, mut m1) = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+    for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+        let e = (p * tau).exp();
+        m0 += w * e;
+        m1 += w * (tau * e);
+    }
+    (jitter.mgf(p).unwrap_or(m0), m1)
 }
 
 impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
@@ -351,6 +352,8 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
         let modes = self.modes();
         let breaks = self.inner.breakpoints();
         let (lo, hi) = jitter.reach();
+        let mut smooth = None;
+        let mut cut;
         for (k, t) in grid.times().enumerate() {
             // |f| ≤ bound on the sample's reach (every mode decays), so by Cauchy–Schwarz
             // |E[2sf + f²]| ≤ 2·bound·√E[s²] + bound²: below rounding of E[s²], skip it.
@@ -362,7 +365,14 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
             if extra_bound <= 1e-17 * sq[k] || bound == 0.0 {
                 continue;
             }
-            let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), 2.0 * self.rate());
+            let local = local_breaks(&breaks, t, lo, hi);
+            // Most samples have no breakpoint in reach: their rule is the same one, built once.
+            let rule = if local.is_empty() {
+                &*smooth.get_or_insert_with(|| jitter.rule(&[], 2.0 * self.rate()))
+            } else {
+                cut = jitter.rule(&local, 2.0 * self.rate());
+                &cut
+            };
             sq[k] += rule.expect(|tau| {
                 let f = free_of(&modes, t + tau - self.origin);
                 f * (2.0 * self.inner.value(t + tau) + f)
