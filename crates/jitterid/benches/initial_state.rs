@@ -48,7 +48,7 @@ fn benches(c: &mut Criterion) {
     let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
     let y = simulate(&truth, &jitter, &grid, 0.01, &mut rng).unwrap().y;
-    let record = Record::new(grid.clone(), y).unwrap();
+    let record = Record::new(grid, y).unwrap();
     let start = LtiResponse::new(eq17(0.21, 0.45, -0.27, 0.33), seen);
     let options = EstimateOptions {
         covariance: false,
@@ -67,7 +67,7 @@ fn benches(c: &mut Criterion) {
     let fresh_y = simulate(&fresh_truth, &jitter, &grid, 0.01, &mut rng)
         .unwrap()
         .y;
-    let fresh_record = Record::new(grid.clone(), fresh_y).unwrap();
+    let fresh_record = Record::new(grid, fresh_y).unwrap();
     let fresh_start = LtiResponse::new(eq17(0.21, 0.45, -0.27, 0.33), fresh);
     let fresh_rest = ModelStructure::oe(fresh_start.clone(), jitter);
     let fresh_free =
