@@ -7,8 +7,10 @@
 //! Chebyshev extrema; a segment whose error exceeds the tolerance is halved, so the table does
 //! not rely on the model's declared rate being right.
 
+#[cfg(doc)]
+use jitterid_jitter::kernels::chebyshev::to_monomial;
 use jitterid_jitter::kernels::chebyshev::{
-    clenshaw, to_monomial, ChebyshevBasis, CheckPoints, PiecewiseChebyshev,
+    clenshaw, ChebyshevBasis, CheckPoints, PiecewiseChebyshev,
 };
 use std::sync::OnceLock;
 
@@ -21,11 +23,63 @@ pub(crate) fn basis() -> &'static ChebyshevBasis {
     B.get_or_init(|| ChebyshevBasis::new(CHEB_POINTS))
 }
 
-/// Chebyshev coefficients of the values at the 16 nodes.
+/// The basis' transform from node values to coefficients as a fixed-size matrix,
+/// `dct[j][i]`, each entry computed by the formula of [`ChebyshevBasis::new`] (so the same to
+/// the bit; a test checks the coefficients against the basis').
+fn dct() -> &'static [[f64; CHEB_POINTS]; CHEB_POINTS] {
+    static D: OnceLock<[[f64; CHEB_POINTS]; CHEB_POINTS]> = OnceLock::new();
+    D.get_or_init(|| {
+        let nf = CHEB_POINTS as f64;
+        std::array::from_fn(|j| {
+            let s = if j == 0 { 1.0 / nf } else { 2.0 / nf };
+            std::array::from_fn(|i| {
+                s * (std::f64::consts::PI * j as f64 * (i as f64 + 0.5) / nf).cos()
+            })
+        })
+    })
+}
+
+/// Chebyshev coefficients of the values at the 16 nodes: the sums of
+/// [`ChebyshevBasis::coefficients_into`] in the same order, on fixed-size arrays (this runs
+/// for every sample of every likelihood evaluation, where the slice version's loops over a
+/// run-time length cost about five times as much).
+#[inline]
 pub(crate) fn coefficients(values: &[f64; CHEB_POINTS]) -> [f64; CHEB_POINTS] {
-    let mut c = [0.0; CHEB_POINTS];
-    basis().coefficients_into(values, &mut c);
-    c
+    let d = dct();
+    std::array::from_fn(|j| {
+        let row = &d[j];
+        let mut acc = 0.0;
+        for i in 0..CHEB_POINTS {
+            acc += values[i] * row[i];
+        }
+        acc
+    })
+}
+
+/// Monomial coefficients `a_k` with `Σ c_j T_j(x) = Σ a_k x^k`: [`to_monomial`]'s operations
+/// in its order, on fixed-size arrays (no allocation per recurrence step).
+fn to_monomial16(c: &[f64]) -> [f64; CHEB_POINTS] {
+    const N: usize = CHEB_POINTS;
+    let mut out = [0.0; N];
+    let mut t_prev = [0.0; N];
+    let mut t_cur = [0.0; N];
+    t_prev[0] = 1.0;
+    t_cur[1] = 1.0;
+    out[0] += c[0];
+    out[1] += c[1];
+    for &cj in &c[2..N] {
+        let mut next = [0.0; N];
+        for k in 0..N - 1 {
+            next[k + 1] += 2.0 * t_cur[k];
+        }
+        for k in 0..N {
+            next[k] -= t_prev[k];
+            out[k] += cj * next[k];
+        }
+        t_prev = t_cur;
+        t_cur = next;
+    }
+    out
 }
 
 /// A piecewise Chebyshev interpolant of `channels` real functions on sorted, non-overlapping
@@ -61,11 +115,9 @@ impl PiecewiseCheb {
         );
         let mono0 = (0..table.len())
             .map(|seg| {
-                let mut m = [0.0; CHEB_POINTS];
-                if let Some(c) = table.coefficients(seg, 0) {
-                    m.copy_from_slice(&to_monomial(c));
-                }
-                m
+                table
+                    .coefficients(seg, 0)
+                    .map_or([0.0; CHEB_POINTS], to_monomial16)
             })
             .collect();
         PiecewiseCheb { table, mono0 }
@@ -103,7 +155,10 @@ impl PiecewiseCheb {
     }
 
     /// Channel 0 at the points `ts[lanes]` of one segment `seg`, into `out[lanes]` (Horner in
-    /// the monomial basis, one lane per point; only the lanes asked for are computed).
+    /// the monomial basis, one lane per point). All 16 lanes are computed on fixed-size arrays,
+    /// which the compiler turns into vector instructions, and only `lanes` are kept: a loop
+    /// over a run-time range of lanes stays scalar and costs about twice as much. Each lane's
+    /// operations do not depend on the others, so the kept values are the same either way.
     #[inline]
     fn eval0_lanes(
         &self,
@@ -115,18 +170,17 @@ impl PiecewiseCheb {
         let (a, b) = (self.table.starts()[seg], self.table.ends()[seg]);
         let (mid, scale) = (0.5 * (a + b), 2.0 / (b - a));
         let m = &self.mono0[seg];
-        let ts = &ts[lanes.clone()];
-        let acc = &mut out[lanes];
         let mut x = [0.0; 16];
-        for ((xi, &t), ai) in x.iter_mut().zip(ts).zip(acc.iter_mut()) {
-            *xi = ((t - mid) * scale).clamp(-1.0, 1.0);
-            *ai = m[CHEB_POINTS - 1];
+        for i in 0..16 {
+            x[i] = ((ts[i] - mid) * scale).clamp(-1.0, 1.0);
         }
+        let mut acc = [m[CHEB_POINTS - 1]; 16];
         for &mk in m[..CHEB_POINTS - 1].iter().rev() {
-            for (ai, &xi) in acc.iter_mut().zip(&x) {
-                *ai = *ai * xi + mk;
+            for i in 0..16 {
+                acc[i] = acc[i] * x[i] + mk;
             }
         }
+        out[lanes.clone()].copy_from_slice(&acc[lanes]);
     }
 
     /// Channel 0 at 16 increasing points, which may span several segments: each run of points
@@ -284,6 +338,85 @@ mod tests {
                 let direct = clenshaw(&table.table.coefficient_data()[s..s + CHEB_POINTS], x);
                 assert_eq!(v.to_bits(), direct.to_bits(), "t = {t}, channel {c}");
             }
+        }
+    }
+
+    /// Deterministic values spanning signs and magnitudes (a fixed linear congruential
+    /// sequence).
+    fn test_values(seed: u64) -> [f64; CHEB_POINTS] {
+        let mut state = seed;
+        std::array::from_fn(|_| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+            (u - 0.5) * 10f64.powi((state % 7) as i32 - 3)
+        })
+    }
+
+    #[test]
+    fn fixed_size_coefficients_equal_the_basis_to_the_bit() {
+        for seed in 0..200 {
+            let v = test_values(seed);
+            let mut reference = [0.0; CHEB_POINTS];
+            basis().coefficients_into(&v, &mut reference);
+            let fast = coefficients(&v);
+            for j in 0..CHEB_POINTS {
+                assert_eq!(
+                    fast[j].to_bits(),
+                    reference[j].to_bits(),
+                    "seed {seed}, c_{j}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn fixed_size_monomials_equal_the_kernel_to_the_bit() {
+        for seed in 0..200 {
+            let c = test_values(seed);
+            let reference = jitterid_jitter::kernels::chebyshev::to_monomial(&c);
+            let fast = to_monomial16(&c);
+            for k in 0..CHEB_POINTS {
+                assert_eq!(
+                    fast[k].to_bits(),
+                    reference[k].to_bits(),
+                    "seed {seed}, a_{k}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn lanes_of_a_segment_equal_single_lane_horner_to_the_bit() {
+        let f = |t: f64, out: &mut [f64]| out[0] = (-1.5 * t).exp() * (5.0 * t).sin() + 0.25;
+        let table = PiecewiseCheb::build(&[(0.0, 3.0)], 1, 1e-14, f);
+        assert!(table.len() > 1);
+        // Points spanning several segments, so that runs start and end inside the 16 lanes.
+        let ts: [f64; 16] = std::array::from_fn(|i| 0.1 + 0.17 * i as f64);
+        let mut out = [f64::NAN; 16];
+        let mut hint = 0;
+        let ok = table.eval0_sorted16(&ts, &mut out, &mut hint);
+        for i in 0..16 {
+            assert!(ok[i]);
+            // Horner on lane i alone, the operations of one lane of `eval0_lanes`.
+            let seg = table.segment(ts[i]).unwrap();
+            let alone = (i == 0 || table.segment(ts[i - 1]) != Some(seg))
+                && (i == 15 || table.segment(ts[i + 1]) != Some(seg));
+            if alone {
+                // A run of one point uses Clenshaw (`eval0`).
+                assert_eq!(out[i].to_bits(), table.eval0(seg, ts[i]).to_bits(), "{i}");
+                continue;
+            }
+            let (a, b) = (table.table.starts()[seg], table.table.ends()[seg]);
+            let (mid, scale) = (0.5 * (a + b), 2.0 / (b - a));
+            let x = ((ts[i] - mid) * scale).clamp(-1.0, 1.0);
+            let m = &table.mono0[seg];
+            let mut acc = m[CHEB_POINTS - 1];
+            for &mk in m[..CHEB_POINTS - 1].iter().rev() {
+                acc = acc * x + mk;
+            }
+            assert_eq!(out[i].to_bits(), acc.to_bits(), "{i}");
         }
     }
 
