@@ -391,8 +391,14 @@ fn transform_weighted<V: AsRef<[f64]>>(
         .collect()
 }
 
-/// The bins `indices` of a spectrum (NaN for a bin past its end).
+/// The bins `indices` of a spectrum (NaN for a bin past its end); the first bins in order (the
+/// half DFT grid) as one copy of that prefix.
 fn select_bins(spectrum: &[Complex64], indices: &[usize]) -> Vec<Complex64> {
+    let prefix =
+        indices.len() <= spectrum.len() && indices.iter().enumerate().all(|(i, &j)| i == j);
+    if prefix {
+        return spectrum[..indices.len()].to_vec();
+    }
     indices
         .iter()
         .map(|&j| {
