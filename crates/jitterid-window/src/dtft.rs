@@ -25,6 +25,7 @@ use crate::WindowError;
 use jitterid_signal::SampleGrid;
 use num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
+use std::cell::RefCell;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Re-anchoring period of the rotation recurrence.
@@ -199,9 +200,67 @@ fn complex_buffer(values: &[f64]) -> Vec<Complex64> {
 /// `X_j = Σ_k x_k e^{-i2πjk/N}`, with the plan of that length shared with [`transform`] and
 /// [`fft_grid`] (a long record's plan is held once).
 pub fn fft_in_place(buffer: &mut [Complex64]) {
-    if !buffer.is_empty() {
-        plan(buffer.len()).process(buffer);
+    if buffer.is_empty() {
+        return;
     }
+    let fft = plan(buffer.len());
+    if buffer.len() < WORKSPACE_MAX_LEN {
+        let done = WORKSPACE.with(|w| match w.try_borrow_mut() {
+            Ok(mut w) => {
+                let scratch = scratch_of(&mut w.scratch, fft.get_inplace_scratch_len());
+                fft.process_with_scratch(buffer, scratch);
+                true
+            }
+            Err(_) => false,
+        });
+        if done {
+            return;
+        }
+    }
+    fft.process(buffer);
+}
+
+/// Records shorter than this are transformed in a buffer and scratch kept per thread
+/// ([`Workspace`]), at most a few MiB; longer ones allocate both per transform and free them
+/// at once, so that a long record's peak memory does not carry them between transforms.
+const WORKSPACE_MAX_LEN: usize = 1 << 16;
+
+/// The FFT buffer and scratch of the last transform on this thread, reused by the next.
+///
+/// A fit transforms records of the same length many times per step. Allocating and freeing
+/// the two length-`N` buffers each time makes the allocator return the top of its heap to
+/// the system and fault it back in on the next transform (for `N` in the tens of thousands,
+/// above its initial threshold), which costs more than the FFT itself on a loaded machine.
+#[derive(Default)]
+struct Workspace {
+    buffer: Vec<Complex64>,
+    scratch: Vec<Complex64>,
+}
+
+/// `scratch`'s first `len` entries, grown to that length if shorter.
+fn scratch_of(scratch: &mut Vec<Complex64>, len: usize) -> &mut [Complex64] {
+    if scratch.len() < len {
+        scratch.resize(len, Complex64::new(0.0, 0.0));
+    }
+    &mut scratch[..len]
+}
+
+thread_local! {
+    static WORKSPACE: RefCell<Workspace> = RefCell::new(Workspace::default());
+}
+
+/// `f` of the FFT of `values` (length `< WORKSPACE_MAX_LEN`, non-empty), computed in this
+/// thread's [`Workspace`]; `None` if the workspace is in use (a transform inside `f`).
+fn with_workspace_fft<T>(values: &[f64], f: impl FnOnce(&[Complex64]) -> T) -> Option<T> {
+    WORKSPACE.with(|w| {
+        let mut w = w.try_borrow_mut().ok()?;
+        let fft = plan(values.len());
+        let Workspace { buffer, scratch } = &mut *w;
+        buffer.clear();
+        buffer.extend(values.iter().map(|&v| Complex64::new(v, 0.0)));
+        fft.process_with_scratch(buffer, scratch_of(scratch, fft.get_inplace_scratch_len()));
+        Some(f(buffer))
+    })
 }
 
 /// FFT of `values` (any length ≥ 1), unchecked.
@@ -295,6 +354,13 @@ fn transform_weighted<V: AsRef<[f64]>>(
     let n = values.as_ref().len();
     if let Some(indices) = freqs.dft_indices() {
         if freqs.fits(grid) && fft_pays(freqs.len(), n) {
+            if n < WORKSPACE_MAX_LEN {
+                let kept =
+                    with_workspace_fft(values.as_ref(), |spectrum| select_bins(spectrum, indices));
+                if let Some(kept) = kept {
+                    return kept;
+                }
+            }
             let mut spectrum = complex_buffer(values.as_ref());
             // An owned input is no longer needed once copied: free it before the FFT's scratch.
             drop(values);
@@ -322,6 +388,25 @@ fn transform_weighted<V: AsRef<[f64]>>(
         .frequencies()
         .iter()
         .map(|&f| dtft_at(values.as_ref(), Cycles::new(f, t)))
+        .collect()
+}
+
+/// The bins `indices` of a spectrum (NaN for a bin past its end); the first bins in order (the
+/// half DFT grid) as one copy of that prefix.
+fn select_bins(spectrum: &[Complex64], indices: &[usize]) -> Vec<Complex64> {
+    let prefix =
+        indices.len() <= spectrum.len() && indices.iter().enumerate().all(|(i, &j)| i == j);
+    if prefix {
+        return spectrum[..indices.len()].to_vec();
+    }
+    indices
+        .iter()
+        .map(|&j| {
+            spectrum
+                .get(j)
+                .copied()
+                .unwrap_or(Complex64::new(f64::NAN, f64::NAN))
+        })
         .collect()
 }
 
@@ -373,6 +458,25 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    #[test]
+    fn workspace_transform_equals_an_allocating_fft() {
+        // The per-thread buffers are reused across lengths (longer, then shorter, then longer
+        // again) and must give bit for bit the FFT of freshly allocated ones (lengths where the
+        // half grid is taken by FFT, not by direct sums).
+        for n in [1000, 20_000, 999, 64, 20_000] {
+            let g = SampleGrid::new(0.0, 1.0, n).unwrap();
+            let x: Vec<f64> = (0..n).map(|k| ((k * k) % 97) as f64 - 48.0).collect();
+            let mut want = complex_buffer(&x);
+            plan(n).process(&mut want);
+            let half = transform(&g, &DirichletWindow, &x, &FrequencySet::dft(&g)).unwrap();
+            assert_eq!(half.len(), n / 2 + 1);
+            assert!(half.iter().zip(&want).all(|(a, b)| a == b), "N = {n}");
+            let mut got = complex_buffer(&x);
+            fft_in_place(&mut got);
+            assert_eq!(got, want, "N = {n}");
+        }
     }
 
     #[test]
