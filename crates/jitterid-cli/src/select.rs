@@ -16,7 +16,7 @@ use jitterid::estimate::selection::{select as run_select, Candidate, SelectionOp
 use jitterid::estimate::{initial_model, InitError, InitOptions};
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::JitterModel;
-use jitterid::signal::registry::{SignalRegistry, Spec};
+use jitterid::signal::registry::{roots_json, SignalRegistry, Spec};
 use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
@@ -191,16 +191,6 @@ fn roots_of(spec: &Spec, key: &str) -> Option<Vec<Root>> {
                 _ => None,
             },
             x => x.as_f64().map(Root::Real),
-        })
-        .collect()
-}
-
-fn roots_json(roots: &[Root]) -> Value {
-    roots
-        .iter()
-        .map(|r| match *r {
-            Root::Real(x) => json!(x),
-            Root::Pair { re, im } => json!([re, im]),
         })
         .collect()
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{example_with, jitterid, scratch_in};
+use common::{example_with, simulate_text};
 use std::path::PathBuf;
 use std::process::Output;
 
@@ -16,20 +16,7 @@ fn table2_with(from: &str, to: &str) -> String {
 /// Runs `simulate` on the experiment `text`, written to a fresh directory `name`; returns the
 /// process output and the data file it was asked to write.
 fn simulate(name: &str, text: &str) -> (Output, PathBuf) {
-    let d = scratch_in("jitterid-door", name);
-    let exp = d.join("e.toml");
-    std::fs::write(&exp, text).unwrap();
-    let out = d.join("d.csv");
-    let o = jitterid()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    (o, out)
+    simulate_text("jitterid-door", name, text)
 }
 
 /// Runs `simulate` on `text`; asserts exit status 2, no output file, and a one-line error

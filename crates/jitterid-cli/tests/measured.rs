@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{example, example_with, jitterid, scratch_in};
+use common::{example, example_with, jitterid, scratch_in, simulate_text};
 use jitterid_cli::commands::{montecarlo_realizations, DEFAULT_SEED};
 use jitterid_cli::experiment::{self, Purpose};
 use std::path::Path;
@@ -14,19 +14,7 @@ use std::path::Path;
 /// Runs `simulate` on the experiment `text` (in a fresh directory `name`); asserts exit status
 /// 2, nothing written, and a one-line error holding every one of `expect`.
 fn refused(name: &str, text: &str, expect: &[&str]) {
-    let d = scratch_in("jitterid-measured", name);
-    let exp = d.join("e.toml");
-    std::fs::write(&exp, text).unwrap();
-    let out = d.join("d.csv");
-    let o = jitterid()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let (o, out) = simulate_text("jitterid-measured", name, text);
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(2), "{name}: expected exit 2: {err}");
     assert!(!out.exists(), "{name}: a refused experiment wrote data");

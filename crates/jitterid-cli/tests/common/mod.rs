@@ -85,3 +85,17 @@ pub fn example_with(name: &str, from: &str, to: &str) -> String {
         .unwrap_or_else(|| panic!("{name} has no line starting with {from:?}"));
     text.replacen(line, to, 1)
 }
+
+/// Runs `jitterid simulate` on the experiment `text`, written to a fresh scratch directory of
+/// `group`: the process output and the data file it was asked to write.
+pub fn simulate_text(group: &str, name: &str, text: &str) -> (Output, PathBuf) {
+    let d = scratch_in(group, name);
+    let exp = d.join("e.toml");
+    std::fs::write(&exp, text).unwrap();
+    let out = d.join("d.csv");
+    let o = jitterid()
+        .args(["simulate", s(&exp), "--out", s(&out)])
+        .output()
+        .unwrap();
+    (o, out)
+}
