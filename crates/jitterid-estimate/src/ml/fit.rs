@@ -291,7 +291,8 @@ fn brent_hook<V: Any>(solver: &V) -> Option<ProgressHook> {
 ///
 /// With the default solver and a single free parameter (the jitter's), every value is first
 /// fitted to a loose tolerance and only those within [`PROFILE_MARGIN`] of the best are
-/// refined.
+/// refined; both stages run Brent's iterations from their brackets' known values
+/// ([`Brent::from_bracket`]).
 ///
 /// # Errors
 ///
@@ -339,6 +340,7 @@ where
         ..options.with_solver(Brent {
             tolerance: 3e-3,
             progress: brent_hook(&options.solver),
+            from_bracket: true,
             ..Brent::default()
         })
     };
@@ -370,6 +372,7 @@ where
         let fine = options.with_solver(Brent {
             bracket_step: 0.01,
             progress: brent_hook(&options.solver),
+            from_bracket: true,
             ..Brent::default()
         });
         let fine = MlOptions {
@@ -472,5 +475,64 @@ mod tests {
         let with = ml_estimate_with(&restart, &record, Some(&data), known, &criterion, &fine);
         let without = ml_estimate_with(&restart, &record, Some(&data), None, &criterion, &fine);
         assert_eq!(with.unwrap(), without.unwrap());
+    }
+
+    /// Brent's iterations started from the bracket's known values (the staged profile's
+    /// solvers) reach the minimum that argmin's start reaches, to the tolerance, in fewer
+    /// evaluations: the coarse fit of every `n`, then the refinement from its minimum.
+    #[test]
+    fn bracket_started_brent_reaches_the_same_minimum_in_fewer_evaluations() {
+        let grid = SampleGrid::new(0.0, 1.0, 120).unwrap();
+        let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap();
+        let mut rng = StdRng::seed_from_u64(9);
+        let u = RandomBinary::paper()
+            .generate(0.0, 121.0, &mut rng)
+            .unwrap();
+        let signal = LtiResponse::new(g, u);
+        let truth = UniformSum::new(0, 0.5).unwrap();
+        let y = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap().y;
+        let record = Record::new(grid, y).unwrap();
+        let criterion = ExactMl::default();
+        let (mut new_evals, mut old_evals) = (0, 0);
+        for n in [0, 3] {
+            let structure = ModelStructure::oe(signal.clone(), UniformSum::new(n, 0.45).unwrap())
+                .with_estimated(false, true, false)
+                .with_noise_std(0.01)
+                .unwrap();
+            let data = criterion.prepare(&structure, &record);
+            for (tolerance, bracket_step) in [(3e-3, 0.1), (1e-8, 0.01)] {
+                let fit = |from_bracket| {
+                    let o = MlOptions::default().with_solver(Brent {
+                        tolerance,
+                        bracket_step,
+                        from_bracket,
+                        ..Brent::default()
+                    });
+                    ml_estimate_with(&structure, &record, Some(&data), None, &criterion, &o)
+                        .unwrap()
+                };
+                let (new, old) = (fit(true), fit(false));
+                assert!(new.converged && old.converged);
+                // Brent's stopping test leaves each minimiser within 2 tol of the minimum of
+                // ln a (tol = √ε |ln a| + tolerance), so they are within 4 tol of each other
+                // (8 tol allowed; 1e-7 more for the flat bottom, where −log L changes by about
+                // 1e-12 over 1e-8 in ln a), and their costs within ½ C (4 tol)², C ≤ 2500 the
+                // curvature of −log L in ln a (see `PROFILE_MARGIN`).
+                let tol = f64::EPSILON.sqrt() * old.params[0].ln().abs() + tolerance;
+                let d = (new.params[0].ln() - old.params[0].ln()).abs();
+                assert!(
+                    d <= 8.0 * tol + 1e-7,
+                    "n = {n}, tol {tolerance}: Δ ln a = {d}"
+                );
+                let dc = (new.cost - old.cost).abs();
+                assert!(
+                    dc <= 1250.0 * (4.0 * tol).powi(2) + 1e-9,
+                    "n = {n}: Δ cost {dc}"
+                );
+                new_evals += new.iterations;
+                old_evals += old.iterations;
+            }
+        }
+        assert!(new_evals < old_evals, "{new_evals} vs {old_evals}");
     }
 }

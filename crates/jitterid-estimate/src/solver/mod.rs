@@ -64,6 +64,7 @@ use std::fmt;
 mod any;
 mod bfgs;
 mod brent;
+mod brent_bracket;
 mod error;
 mod gauss_newton;
 pub mod lm;
