@@ -10,13 +10,15 @@
 //! itself: a bounded arcsine law and a Gaussian of the same variance give samples spread
 //! differently wherever the signal moves, which is at every input switch.
 //!
-//! Only the finalists are refitted because one exact fit costs about as much as the whole
-//! BCLS screen of a candidate; the screen picks the order within a family reliably.
+//! Only the finalists are refitted because an exact fit costs several BCLS fits; the screen
+//! picks the order within a family reliably.
 
 use super::{Candidate, Structure};
 use crate::ml::{ml_estimate, ExactMl, MlOptions};
 use crate::{ModelStructure, Record};
-use jitterid_signal::{Input, LtiResponse, Signal};
+use jitterid_jitter::registry::JitterRegistry;
+use jitterid_jitter::{AnyJitter, JitterModel};
+use jitterid_signal::{Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 
 /// Index of the best screened candidate of every family, in the order the families first
@@ -55,18 +57,15 @@ pub(super) fn finalists(candidates: &[Candidate]) -> Vec<usize> {
 fn exact_fit(
     record: &Record,
     input: &Input,
-    candidate: &Candidate,
-) -> Result<(crate::Fit, Structure, f64), String> {
-    let (model, jitter) = candidate
-        .fitted
-        .clone()
-        .ok_or_else(|| "no screened fit".to_string())?;
+    family: &str,
+    (model, jitter): (TransferFunction, AnyJitter),
+) -> ExactFit {
     let signal = LtiResponse::new(model, input.clone());
     let m = signal.expected_values(record.grid(), &jitter);
     let y = record.y();
     let n = y.len() as f64;
     let rms = (y.iter().zip(&m).map(|(y, m)| (y - m).powi(2)).sum::<f64>() / n).sqrt();
-    let structure: Structure = if candidate.family == "none" {
+    let structure: Structure = if family == "none" {
         ModelStructure::oe(signal, jitter)
     } else {
         ModelStructure::joe(signal, jitter)
@@ -89,16 +88,83 @@ fn exact_fit(
     Ok((fit, at, bic))
 }
 
+/// The likelihood fits to run: every [`finalists`] entry from its own BCLS estimate, and, for
+/// every other jittered family, its candidate at the screen winner's order from the winner's
+/// system with the family's jitter at the winner's standard deviation. Families of equal
+/// spread have nearly the same first moment, so that is a start near the family's best fit
+/// even where the family's own BCLS fits ended in a wrong local minimum of the jitter's scale
+/// (periodic `J₀` makes the BCLS cost oscillate in the scale).
+pub(super) fn starts(
+    candidates: &[Candidate],
+    registry: &JitterRegistry,
+) -> Vec<(usize, (TransferFunction, AnyJitter))> {
+    let chosen = finalists(candidates);
+    let mut out: Vec<_> = chosen
+        .iter()
+        .filter_map(|&i| candidates[i].fitted.clone().map(|f| (i, f)))
+        .collect();
+    let winner = chosen.iter().copied().min_by(|&a, &b| {
+        let (ca, cb) = (&candidates[a], &candidates[b]);
+        (!ca.bcls_converged)
+            .cmp(&!cb.bcls_converged)
+            .then(ca.bcls_criterion.total_cmp(&cb.bcls_criterion))
+    });
+    let Some(w) = winner else { return out };
+    let Some((model, jitter)) = candidates[w].fitted.clone() else {
+        return out;
+    };
+    let std = jitter.std_dev();
+    if !(std.is_finite() && std > 0.0) {
+        return out;
+    }
+    for (i, c) in candidates.iter().enumerate() {
+        let same_order = (c.poles, c.zeros) == (candidates[w].poles, candidates[w].zeros);
+        if !same_order || c.family == candidates[w].family || c.family == "none" {
+            continue;
+        }
+        if let Ok(j) = registry.from_std_dev(&c.family, std, &serde_json::Map::new()) {
+            out.push((i, (model.clone(), j)));
+        }
+    }
+    out
+}
+
+/// An exact fit, the structure at its estimate and its BIC, or why it failed.
+type ExactFit = Result<(crate::Fit, Structure, f64), String>;
+
 /// Refits the [`finalists`] of `candidates` by exact maximum likelihood (in parallel) and
 /// records the outcome on each: a converged fit makes the candidate ranked by the likelihood's
 /// BIC, with the likelihood's estimates; otherwise it keeps its screen's rank and says why.
-pub(super) fn refine_finalists(record: &Record, input: &Input, candidates: &mut [Candidate]) {
-    let chosen = finalists(candidates);
-    let fits: Vec<_> = chosen
+/// A candidate fitted from two [`starts`] keeps the converged fit of higher likelihood.
+pub(super) fn refine_finalists(
+    record: &Record,
+    input: &Input,
+    registry: &JitterRegistry,
+    candidates: &mut [Candidate],
+) {
+    let jobs = starts(candidates, registry);
+    let fits: Vec<_> = jobs
         .par_iter()
-        .map(|&i| exact_fit(record, input, &candidates[i]))
+        .map(|(i, start)| exact_fit(record, input, &candidates[*i].family, start.clone()))
         .collect();
-    for (i, result) in chosen.into_iter().zip(fits) {
+    // Converged before not converged before failed, then the lower BIC.
+    let key = |r: &ExactFit| match r {
+        Ok((fit, _, bic)) => (u8::from(!fit.converged), *bic),
+        Err(_) => (2, f64::INFINITY),
+    };
+    let mut best: Vec<(usize, ExactFit)> = Vec::new();
+    for ((i, _), result) in jobs.into_iter().zip(fits) {
+        match best.iter_mut().find(|(j, _)| *j == i) {
+            None => best.push((i, result)),
+            Some((_, kept)) => {
+                let (a, b) = (key(&result), key(kept));
+                if a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).is_lt() {
+                    *kept = result;
+                }
+            }
+        }
+    }
+    for (i, result) in best {
         let c = &mut candidates[i];
         match result {
             Ok((fit, structure, bic)) => {

@@ -24,7 +24,11 @@
 //! 2. **Exact-likelihood final** ([`SelectionOptions::refine_by_likelihood`]). Within each
 //!    family the candidate the screen ranks first is refitted by exact maximum likelihood
 //!    ([`ExactMl`](crate::ml::ExactMl), the noise level estimated), started at its BCLS
-//!    estimate, and these finalists are ranked by Schwarz's BIC `−2 log L̂ + k ln N` of the
+//!    estimate; so is every jittered family's candidate at the screen winner's order, started
+//!    at the winner's system with the family's jitter at the winner's standard deviation
+//!    (families of equal spread have nearly the same first moment, so this start does not
+//!    depend on the family's own BCLS fits, which can end in a wrong local minimum of the
+//!    jitter's scale). These finalists are ranked by Schwarz's BIC `−2 log L̂ + k ln N` of the
 //!    exact likelihood of independent samples (`k` now counts `σ_v` too). That likelihood
 //!    sees the jitter's whole law through the spread of `s(t_k + τ)`, not only `γ(f)`.
 //!
@@ -358,7 +362,7 @@ pub fn select(
         .map(|c| fit_candidate(record, input, registry, options, c))
         .collect();
     if options.refine_by_likelihood {
-        likelihood::refine_finalists(record, input, &mut out);
+        likelihood::refine_finalists(record, input, registry, &mut out);
     }
     // A stable sort keeps grid order among equal keys: deterministic for any thread count.
     let group = |c: &Candidate| match (c.ranked_by_likelihood, c.converged) {

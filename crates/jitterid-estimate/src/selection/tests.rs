@@ -213,13 +213,15 @@ fn picks_the_true_order_and_family_of_jittered_records() {
                 .map(|c| (c.poles, &c.family, c.criterion, c.ranked_by_likelihood))
                 .collect::<Vec<_>>()
         );
-        // One finalist per family, each refitted (the likelihood's BIC is reported even if
-        // that fit did not converge); the margin is taken among the converged ones only.
-        let finalists: Vec<&Candidate> = ranked
-            .iter()
-            .filter(|c| c.likelihood_criterion.is_some() || c.likelihood_failure.is_some())
-            .collect();
-        assert_eq!(finalists.len(), 3, "{family}, seed {seed}");
+        // At least one finalist per family, each refitted (the likelihood's BIC is reported
+        // even if that fit did not converge); the margin is taken among the converged ones.
+        for f in ["none", "gaussian", "periodic"] {
+            assert!(
+                ranked.iter().any(|c| c.family == f
+                    && (c.likelihood_criterion.is_some() || c.likelihood_failure.is_some())),
+                "{family}, seed {seed}: no {f} finalist"
+            );
+        }
         let runner_up = ranked[1..]
             .iter()
             .filter(|c| c.ranked_by_likelihood)
