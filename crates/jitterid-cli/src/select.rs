@@ -1,8 +1,10 @@
 //! `jitterid select`: fit the `[select]` grid of model orders × jitter families and rank them.
 //!
-//! Candidates are ranked by the information criterion (BIC of the BCLS fit, see
-//! `docs/method.md`); with a validation record each candidate's fit percent on it is reported
-//! beside the criterion, and `best_validation` names the candidate that fits it best.
+//! Candidates are ranked by an information criterion (see `docs/method.md`): the best of each
+//! family by the BIC of its exact maximum-likelihood refit, the others by the BIC of their BCLS
+//! fit (each candidate's `ranked_by` says which). With a validation record each candidate's fit
+//! percent on it is reported beside the criterion, and `best_validation` names the candidate
+//! that fits it best.
 
 use crate::cli_err;
 use crate::commands::{read_data, read_experiment, read_input};
@@ -37,6 +39,15 @@ pub struct SelectOptions {
     pub out: Option<PathBuf>,
 }
 
+/// Which criterion ranks `c`.
+fn ranked_by(c: &Candidate) -> &'static str {
+    if c.ranked_by_likelihood {
+        "exact-ml-bic"
+    } else {
+        "bcls-bic"
+    }
+}
+
 fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
     let estimates: serde_json::Map<String, Value> = c
         .parameters
@@ -48,7 +59,12 @@ fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
         "zeros": c.zeros,
         "family": c.family,
         "criterion": c.criterion.is_finite().then_some(c.criterion),
+        "ranked_by": ranked_by(c),
         "converged": c.converged,
+        "bcls_criterion": c.bcls_criterion.is_finite().then_some(c.bcls_criterion),
+        "bcls_converged": c.bcls_converged,
+        "likelihood_criterion": c.likelihood_criterion.filter(|v| v.is_finite()),
+        "likelihood_failure": c.likelihood_failure,
         "estimates": estimates,
         "validation_fit_percent": validation,
         "failure": c.failure,
@@ -132,17 +148,19 @@ pub fn select(o: &SelectOptions) -> CliResult<Outcome> {
     let mut out = format!("selection on {} ({})\n", table.name, exp.file);
     let _ = writeln!(
         out,
-        "{:>5}  {:>5}  {:<14}  {:>14}  {:>9}  {:>14}",
-        "poles", "zeros", "family", "BIC", "converged", "validation fit"
+        "{:>5}  {:>5}  {:<14}  {:>14}  {:<12}  {:>14}  {:>9}  {:>14}",
+        "poles", "zeros", "family", "BIC", "ranked by", "BCLS BIC", "converged", "validation fit"
     );
     for (c, f) in ranked.iter().zip(&fits) {
         let _ = writeln!(
             out,
-            "{:>5}  {:>5}  {:<14}  {:>14.4}  {:>9}  {:>14}",
+            "{:>5}  {:>5}  {:<14}  {:>14.4}  {:<12}  {:>14.4}  {:>9}  {:>14}",
             c.poles,
             c.zeros,
             c.family,
             c.criterion,
+            ranked_by(c),
+            c.bcls_criterion,
             if c.converged { "yes" } else { "no" },
             f.map_or("–".into(), |v| format!("{v:.2} %"))
         );

@@ -10,14 +10,31 @@
 //! oscillates (periodic: `J₀`, two-point: `cos`): from one start the fit of the true family can
 //! end in a local minimum with the scale far off, and a wrong family would then win.
 //!
-//! Candidates are ranked by the BIC of a Gaussian quasi-likelihood of the frequency-domain
-//! residuals: with independent samples the residual `D(f) = Y(f) − μ_Y(f)` has the same
-//! variance `Σ_k λ_k` at every frequency, even though the jittered samples are
-//! heteroscedastic in time, so one common variance is the right nuisance parameter and
-//! `N ln(cost) + k ln N` (with `k` the number of estimated parameters: gain, numerator and
-//! denominator coefficients, the jitter's free parameters) is, up to a constant shared by all
-//! candidates, `−2 log L + k ln N`. Candidates that fail are kept with their reason and ranked
-//! last.
+//! Two stages rank the candidates.
+//!
+//! 1. **BCLS screen.** Every candidate gets the BIC of a Gaussian quasi-likelihood of the
+//!    frequency-domain residuals: with independent samples the residual `D(f) = Y(f) − μ_Y(f)`
+//!    has the same variance `Σ_k λ_k` at every frequency, even though the jittered samples are
+//!    heteroscedastic in time, so one common variance is the right nuisance parameter and
+//!    `N ln(cost) + k ln N` (with `k` the number of estimated parameters: gain, numerator and
+//!    denominator coefficients, the jitter's free parameters) is, up to a constant shared by
+//!    all candidates, `−2 log L + k ln N`. It picks the order well (the order shapes the first
+//!    moment) but not always the family: families whose `γ(f)` differ only where the signal
+//!    has little power give nearly the same first moment.
+//! 2. **Exact-likelihood final** ([`SelectionOptions::refine_by_likelihood`]). Within each
+//!    family the candidate the screen ranks first is refitted by exact maximum likelihood
+//!    ([`ExactMl`](crate::ml::ExactMl), the noise level estimated), started at its BCLS
+//!    estimate; so is every jittered family's candidate at the screen winner's order, started
+//!    at the winner's system with the family's jitter at the winner's standard deviation
+//!    (families of equal spread have nearly the same first moment, so this start does not
+//!    depend on the family's own BCLS fits, which can end in a wrong local minimum of the
+//!    jitter's scale). These finalists are ranked by Schwarz's BIC `−2 log L̂ + k ln N` of the
+//!    exact likelihood of independent samples (`k` now counts `σ_v` too). That likelihood
+//!    sees the jitter's whole law through the spread of `s(t_k + τ)`, not only `γ(f)`.
+//!
+//! The ranking: finalists whose likelihood fit converged, by that BIC; then the other
+//! converged candidates by the screen's BIC; then the failed ones, with their reason.
+//! The two BICs are never compared with each other.
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
 use jitterid_signal::{Input, LtiResponse, Signal, TransferFunction};
@@ -25,6 +42,8 @@ use rayon::prelude::*;
 
 use crate::validation::fit_percent;
 use crate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
+
+mod likelihood;
 
 /// A rectangular grid of candidate model orders and jitter families.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,12 +62,17 @@ pub struct SelectionOptions {
     /// Starting jitter standard deviations as fractions of the sampling interval `T`: every
     /// jittered candidate is fitted from each, and the lowest-cost converged fit is kept.
     pub jitter_fractions: Vec<f64>,
+    /// Whether the best candidate of each family is refitted by exact maximum likelihood and
+    /// the finalists ranked by the likelihood's BIC (default true); false ranks by the BCLS
+    /// screen alone.
+    pub refine_by_likelihood: bool,
 }
 
 impl Default for SelectionOptions {
     fn default() -> Self {
         Self {
             jitter_fractions: vec![0.1, 0.25, 0.4],
+            refine_by_likelihood: true,
         }
     }
 }
@@ -62,10 +86,24 @@ pub struct Candidate {
     pub zeros: usize,
     /// Jitter family name.
     pub family: String,
-    /// The information criterion (BIC); `+∞` for a failed candidate.
+    /// The information criterion the candidate is ranked by: the exact likelihood's BIC if
+    /// [`ranked_by_likelihood`](Self::ranked_by_likelihood), else the BCLS BIC; `+∞` for a
+    /// failed candidate.
     pub criterion: f64,
-    /// Whether the fit converged.
+    /// Whether the fit that gives [`criterion`](Self::criterion) converged.
     pub converged: bool,
+    /// Whether the candidate is a finalist whose exact maximum-likelihood fit converged: then
+    /// [`criterion`](Self::criterion), [`parameters`](Self::parameters) and
+    /// [`fitted`](Self::fitted) are those of the likelihood fit.
+    pub ranked_by_likelihood: bool,
+    /// The BIC of the BCLS screen (`+∞` for a candidate whose BCLS fit failed).
+    pub bcls_criterion: f64,
+    /// Whether the BCLS fit converged.
+    pub bcls_converged: bool,
+    /// The exact likelihood's BIC `−2 log L̂ + k ln N` of a finalist, converged or not.
+    pub likelihood_criterion: Option<f64>,
+    /// Why a finalist's likelihood fit failed or did not converge, if it did.
+    pub likelihood_failure: Option<String>,
     /// The estimated parameters by name (empty for a failed candidate).
     pub parameters: Vec<(String, f64)>,
     /// Why the candidate failed, if it did.
@@ -230,6 +268,11 @@ fn fit_candidate(
         family: family.clone(),
         criterion: f64::INFINITY,
         converged: false,
+        ranked_by_likelihood: false,
+        bcls_criterion: f64::INFINITY,
+        bcls_converged: false,
+        likelihood_criterion: None,
+        likelihood_failure: None,
         parameters: Vec::new(),
         failure: Some(reason),
         fitted: None,
@@ -272,6 +315,11 @@ fn fit_candidate(
         family,
         criterion,
         converged: fit.converged,
+        ranked_by_likelihood: false,
+        bcls_criterion: criterion,
+        bcls_converged: fit.converged,
+        likelihood_criterion: None,
+        likelihood_failure: None,
         parameters: fit
             .names
             .iter()
@@ -286,8 +334,9 @@ fn fit_candidate(
     }
 }
 
-/// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first:
-/// converged candidates by increasing criterion, then the failed ones. Candidates are fitted in
+/// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first
+/// (see the [module docs](self)): the finalists ranked by the exact likelihood's BIC, then the
+/// other converged candidates by the BCLS BIC, then the failed ones. Candidates are fitted in
 /// parallel; the order is deterministic (ties broken by grid order).
 ///
 /// # Errors
@@ -312,10 +361,18 @@ pub fn select(
         .into_par_iter()
         .map(|c| fit_candidate(record, input, registry, options, c))
         .collect();
+    if options.refine_by_likelihood {
+        likelihood::refine_finalists(record, input, registry, &mut out);
+    }
     // A stable sort keeps grid order among equal keys: deterministic for any thread count.
+    let group = |c: &Candidate| match (c.ranked_by_likelihood, c.converged) {
+        (true, _) => 0,
+        (false, true) => 1,
+        (false, false) => 2,
+    };
     out.sort_by(|a, b| {
-        (!a.converged)
-            .cmp(&!b.converged)
+        group(a)
+            .cmp(&group(b))
             .then(a.criterion.total_cmp(&b.criterion))
     });
     Ok(out)
