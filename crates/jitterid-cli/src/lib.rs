@@ -22,5 +22,6 @@ pub mod progress;
 pub mod select;
 pub mod svg;
 pub mod validate;
+pub mod whiten;
 
 pub use cli::run;

@@ -19,7 +19,7 @@ use jitterid::estimate::{initial_model, InitError, InitOptions};
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::JitterModel;
 use jitterid::signal::registry::{roots_json, SignalRegistry, Spec};
-use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
+use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -221,10 +221,25 @@ fn f64s(spec: &Spec, key: &str) -> Option<Vec<f64>> {
         .collect()
 }
 
+/// `input` delayed by `delay` seconds: what drives the rational part of a system with an input
+/// delay. The initializer fits the frequency response from this input to the output, so that
+/// the rational model it returns does not carry the delay's phase a second time.
+fn delayed_input(input: &Input, delay: Option<f64>) -> Result<Input, String> {
+    match (input, delay) {
+        (Input::Piecewise(p), Some(d)) if d > 0.0 => {
+            let edges = p.edges().iter().map(|e| e + d).collect();
+            PiecewiseConstant::new(edges, p.levels().to_vec())
+                .map(Input::Piecewise)
+                .map_err(|e| e.to_string())
+        }
+        _ => Ok(input.clone()),
+    }
+}
+
 /// The experiment's system with its rational model replaced by the data-driven initializer's
 /// ([`initial_model`], the jitter's damping compensated with the experiment's jitter): the
 /// start of `fit --init auto`. Only the model's own keys change; a delay or an initial state
-/// keeps the experiment's value.
+/// keeps the experiment's value, and the initializer sees the input delayed by that delay.
 pub fn auto_start(
     exp: &Experiment,
     signal: &AnySignal,
@@ -243,6 +258,8 @@ pub fn auto_start(
     let opts = InitOptions::default();
     let init_err = |e: InitError| cli_err!("{data}: --init auto: the initializer failed: {e}");
     let mut spec = signal.spec();
+    let driven = delayed_input(input, spec.get("delay").and_then(Value::as_f64))
+        .map_err(|e| cli_err!("{}: [system] delay: {e}", exp.file))?;
     match signal.kind() {
         "tf" => {
             let (num, den) = f64s(&spec, "num")
@@ -250,7 +267,7 @@ pub fn auto_start(
                 .ok_or_else(|| cli_err!("{}: [system] num, den: not numbers", exp.file))?;
             let tf = TransferFunction::new(&num, &den)
                 .map_err(|e| cli_err!("{}: [system]: {e}", exp.file))?;
-            let g = initial_model(&tf, &record, input, Some(jitter), &opts).map_err(init_err)?;
+            let g = initial_model(&tf, &record, &driven, Some(jitter), &opts).map_err(init_err)?;
             spec.insert("num".into(), json!(g.num()));
             spec.insert("den".into(), json!(g.den()));
         }
@@ -260,7 +277,7 @@ pub fn auto_start(
                 .ok_or_else(|| cli_err!("{}: [system] zeros, poles: not roots", exp.file))?;
             let zpk =
                 Zpk::new(1.0, zeros, poles).map_err(|e| cli_err!("{}: [system]: {e}", exp.file))?;
-            let g = initial_model(&zpk, &record, input, Some(jitter), &opts).map_err(init_err)?;
+            let g = initial_model(&zpk, &record, &driven, Some(jitter), &opts).map_err(init_err)?;
             spec.insert("gain".into(), json!(g.gain()));
             spec.insert("zeros".into(), roots_json(g.zeros()));
             spec.insert("poles".into(), roots_json(g.poles()));

@@ -13,8 +13,9 @@ use crate::fitting::{self, Structure};
 use crate::inputs;
 use crate::output::OutputSet;
 use crate::plots::{self, RecordPlot, ValidatePlots};
-use jitterid::estimate::residual_flatness;
+use crate::whiten;
 use jitterid::estimate::validation::{self, BodePoint, CorrelationTest, StepPoint};
+use jitterid::estimate::{residual_flatness, NoiseModel};
 use jitterid::signal::{Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use serde::Serialize;
@@ -178,16 +179,17 @@ fn check_record(
     let e = |e: jitterid::estimate::EstimateError| cli_err!("{name}: validation: {e}");
     let cmp = validation::compare(s, grid, y).map_err(e)?;
     let r = validation::standardized_residuals(s, grid, y, noise_std).map_err(e)?;
+    let raw: Vec<f64> = y.iter().zip(&cmp.expected).map(|(y, m)| y - m).collect();
+    let tested = tested_residuals(s, grid, noise_std, &raw, r.standardized, name)?;
     let m = validation::default_max_lag(y.len());
-    let whiteness = validation::whiteness(&r.standardized, m).map_err(e)?;
+    let whiteness = validation::whiteness(&tested, m).map_err(e)?;
     let cross = match input {
         Some(input) => {
             let u: Vec<f64> = grid.times().map(|t| input.value(t)).collect();
-            validation::cross_correlation(&r.standardized, &u, m).ok()
+            validation::cross_correlation(&tested, &u, m).ok()
         }
         None => None,
     };
-    let raw: Vec<f64> = y.iter().zip(&cmp.expected).map(|(y, m)| y - m).collect();
     let flatness = transform(grid, &DirichletWindow, &raw, &FrequencySet::dft(grid))
         .ok()
         .and_then(|v| residual_flatness(&v.iter().flat_map(|z| [z.re, z.im]).collect::<Vec<_>>()));
@@ -200,6 +202,31 @@ fn check_record(
         flatness,
     };
     Ok((report, cmp.expected))
+}
+
+/// The residuals the correlation tests see: the standardised residuals for white noise; for a
+/// coloured noise model the raw residuals whitened by the fitted residual spectrum, the noise
+/// model's shape plus the jitter's floor `ρ = λ̄/σ_e²` at this record's model
+/// ([`whiten::whitened`]).
+fn tested_residuals(
+    s: &Structure,
+    grid: &SampleGrid,
+    noise_std: f64,
+    raw: &[f64],
+    standardized: Vec<f64>,
+    name: &str,
+) -> CliResult<Vec<f64>> {
+    if s.noise.is_white() {
+        return Ok(standardized);
+    }
+    // `None` when the shape has its floor already, or the jitter adds no variance.
+    let floor = s.jitter_floor_start(grid, Some(noise_std)).unwrap_or(0.0);
+    whiten::whitened(raw, grid.interval(), |f| {
+        s.noise.shape(f, grid.interval()) + floor
+    })
+    .ok_or_else(|| {
+        cli_err!("{name}: validation: the noise model's spectrum is not positive and finite")
+    })
 }
 
 /// A validation record: its grid (the experiment's `T`, its own length and start) and samples.
