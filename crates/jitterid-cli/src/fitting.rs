@@ -369,7 +369,7 @@ fn run_criterion(
         .is_some_and(|c| c.uses_noise_model());
     if sees_noise {
         let guess = (exp.noise.std > 0.0).then_some(exp.noise.std);
-        let (e, fitted) = s.fit_with_jitter_floor(record.grid(), guess, |floored| {
+        let (e, fitted) = s.fit_with_jitter_floor(record, guess, |floored| {
             criterion.fit(floored, record, opts)
         })?;
         return Ok((e, fitted, None));

@@ -11,11 +11,16 @@
 //! floor is not searched for: a free `ρ` is poorly determined by one record (on Table 2 with
 //! AR(1) noise its logarithm spreads over ±7 and the AR coefficient stays 6 standard errors
 //! off). [`ModelStructure::fit_with_jitter_floor`] fits with the floor known, sets
-//! `ρ = λ̄(θ̂) / σ̂_e²` from the estimate, and refits from there, a few rounds.
+//! `ρ = λ̄(θ̂) / σ̂_e²` from the estimate, and refits from there, a few rounds; the noise
+//! parameters it reports then come from the exact restricted likelihood in time
+//! ([`restricted_noise_fit`]), which sees the jitter's variance sample by sample.
 
 use crate::any_noise::AnyNoise;
+use crate::data::Record;
 use crate::noise::{NoiseModel, WithFloor};
+use crate::restricted_noise::{restricted_noise_fit, NoiseEstimate, RESTRICTED_NOISE_MAX_SAMPLES};
 use crate::result::Fit;
+use crate::solver::Termination;
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use jitterid_jitter::JitterModel;
@@ -124,21 +129,31 @@ where
     /// with a structure whose parameters are this one's) runs first with the floor's start
     /// (`noise_std` as the level guess, or the known level), then [`JITTER_FLOOR_ROUNDS`]` − 1`
     /// times more with `ρ = λ̄(θ̂) / σ̂_e²` from the previous estimate and its noise level, each
-    /// started at that estimate. Returns the last fit and the fitted structure (with its floor).
-    /// Without a floor to add, one fit.
+    /// started at that estimate. Without a floor to add, one fit.
+    ///
+    /// When the noise shape is estimated and the record has at most
+    /// [`RESTRICTED_NOISE_MAX_SAMPLES`] samples, the noise shape and level of the last fit are
+    /// then replaced by those of [`restricted_noise_fit`] (the exact restricted likelihood in
+    /// time, with the jitter's variances `λ_k` sample by sample), which removes the
+    /// frequency-domain criterion's `O(1/N)` bias of the noise parameters; their rows of the
+    /// covariance become that likelihood's (uncorrelated with the others, as the Box–Jenkins
+    /// information is asymptotically), and the fit counts as converged only if that minimiser
+    /// converged too (its error, if any, is the termination). Returns the fit and the fitted
+    /// structure (with its floor `ρ = λ̄(θ̂) / σ̂_e²`).
     ///
     /// # Errors
     ///
     /// Those of `fit` and of the structures' parameters.
     pub fn fit_with_jitter_floor<F>(
         &self,
-        grid: &SampleGrid,
+        record: &Record,
         noise_std: Option<f64>,
         mut fit: F,
     ) -> Result<(Fit, ModelStructure<S, J, AnyNoise>), EstimateError>
     where
         F: FnMut(&ModelStructure<S, J, AnyNoise>) -> Result<Fit, EstimateError>,
     {
+        let grid = record.grid();
         let guess = self.noise_std.or(noise_std);
         let mut structure = self.clone().with_jitter_floor(grid, guess)?;
         let mut estimate = fit(&structure)?;
@@ -156,7 +171,62 @@ where
                 estimate = fit(&structure)?;
             }
         }
-        let fitted = structure.with_params(&estimate.params)?;
+        let mut fitted = structure.with_params(&estimate.params)?;
+        let (ns, nj, nn) = fitted.blocks();
+        if nn > 0 && grid.len() <= RESTRICTED_NOISE_MAX_SAMPLES {
+            match restricted_noise_fit(&fitted, grid, record.y(), estimate.noise_std) {
+                Ok(noise) => {
+                    replace_noise_block(&mut estimate, ns + nj, &noise);
+                    fitted = structure.with_params(&estimate.params)?;
+                    let plain = self.with_params(&estimate.params)?;
+                    if fitted.noise.floor() > 0.0 {
+                        if let Some(rho) = plain.jitter_floor_start(grid, Some(noise.noise_std)) {
+                            fitted = plain.with_floor(Some(rho))?;
+                        }
+                    }
+                }
+                Err(e) => {
+                    estimate.converged = false;
+                    estimate.termination =
+                        Termination::Other(format!("restricted noise likelihood: {e}"));
+                }
+            }
+        }
         Ok((estimate, fitted))
+    }
+}
+
+/// Puts the noise shape and level of `noise` into `estimate`, whose noise block starts at
+/// `first`: the parameters, the level, and the block's covariance (zero against the others).
+fn replace_noise_block(estimate: &mut Fit, first: usize, noise: &NoiseEstimate) {
+    let nn = noise.params.len();
+    estimate.params[first..first + nn].copy_from_slice(&noise.params);
+    estimate.noise_std = noise.noise_std;
+    estimate.converged &= noise.converged;
+    if !noise.converged {
+        estimate.termination = Termination::Other(
+            "the restricted likelihood of the noise parameters did not converge".into(),
+        );
+    }
+    let Some(cov) = estimate.covariance.as_mut() else {
+        return;
+    };
+    for (i, row) in cov.iter_mut().enumerate() {
+        for (j, c) in row.iter_mut().enumerate() {
+            let (a, b) = (i.wrapping_sub(first), j.wrapping_sub(first));
+            let (in_a, in_b) = (a < nn, b < nn);
+            if in_a || in_b {
+                *c = match (&noise.covariance, in_a && in_b) {
+                    (Some(block), true) => block[a][b],
+                    (None, true) => f64::NAN,
+                    _ => 0.0,
+                };
+            }
+        }
+    }
+    if let Some(se) = estimate.std_errors.as_mut() {
+        for (i, s) in se.iter_mut().enumerate().skip(first).take(nn) {
+            *s = cov[i][i].sqrt();
+        }
     }
 }
