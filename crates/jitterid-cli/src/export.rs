@@ -1,12 +1,17 @@
 //! The fitted model taken out of the command line: transfer-function coefficients, zeros,
-//! poles and gain, and a state-space realisation (`fit --json`'s `model`), and the covariance
-//! of the reported parameters.
+//! poles and gain, and a state-space realisation (`fit --json`'s `model`), with the input
+//! delay `D` of a delayed system (the model is `G(s) e^{−sD}`), and the covariance of the
+//! reported parameters.
 
+use jitterid::estimate::validation::{BodePoint, StepPoint, BAND_SIGMAS};
 use jitterid::estimate::{validation, EstimateError};
+use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
 use jitterid::signal::registry::{SignalRegistry, SpecReader};
+use jitterid::signal::RationalModel;
 use jitterid::signal::{AnySignal, SignalError, TransferFunction, Zpk};
 use serde::Serialize;
+use std::f64::consts::LN_10;
 
 /// The model in the three export forms.
 #[derive(Debug, Clone, Serialize)]
@@ -17,6 +22,18 @@ pub struct ModelForms {
     pub tf: TfForm,
     /// The controllable canonical realisation.
     pub ss: StateSpace,
+    /// The input delay `D` (s) of a delayed system: the model is `G(s) e^{−sD}` with `G` the
+    /// three forms above (absent without a delay).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delay: Option<f64>,
+}
+
+/// The input delay `D` (s) of a signal's system, `None` when it has none.
+pub fn delay_of(signal: &AnySignal) -> Option<f64> {
+    signal
+        .spec()
+        .get("delay")
+        .and_then(serde_json::Value::as_f64)
 }
 
 /// The coefficients of a rational system (rebuilt from the signal's spec table), `None` for
@@ -49,6 +66,7 @@ pub fn model_forms(signal: &AnySignal) -> Option<ModelForms> {
         zpk: tf.to_zpk().ok()?,
         ss: tf.to_state_space(),
         tf,
+        delay: delay_of(signal),
     })
 }
 
@@ -103,27 +121,312 @@ fn transfer_function_of(signal: &AnySignal) -> Option<TransferFunction> {
 }
 
 /// The Bode diagram of a rational signal's system at `freqs` with delta-method bands from the
-/// covariance of its parameters; `None` for other signal kinds.
+/// covariance of its parameters; `None` for other signal kinds. For a delayed system the
+/// response is `G(i2πf) e^{−i2πfD}` and `covariance` covers the system's parameters then the
+/// delay (the order of the signal's parameters).
 pub fn bode_of(
     signal: &AnySignal,
     freqs: &[f64],
     covariance: Option<&[Vec<f64>]>,
-) -> Option<Result<Vec<validation::BodePoint>, EstimateError>> {
+) -> Option<Result<Vec<BodePoint>, EstimateError>> {
+    let delay = delay_of(signal);
     if let Some(z) = zpk_of(signal) {
-        return Some(validation::bode(&z, freqs, covariance));
+        return Some(delayed_bode(&z, delay, freqs, covariance));
     }
-    transfer_function_of(signal).map(|t| validation::bode(&t, freqs, covariance))
+    transfer_function_of(signal).map(|t| delayed_bode(&t, delay, freqs, covariance))
+}
+
+/// `Σ_ij g_i C_ij g_j`, the delta-method variance.
+fn quadratic(covariance: &[Vec<f64>], g: &[f64]) -> f64 {
+    g.iter()
+        .zip(covariance)
+        .map(|(gi, row)| gi * row.iter().zip(g).map(|(c, gj)| c * gj).sum::<f64>())
+        .sum()
+}
+
+/// The covariance without its delay row and column (`p + 1` rows for a delayed model of `p`
+/// parameters), checked to be square with that many rows.
+fn split_covariance(
+    covariance: Option<&[Vec<f64>]>,
+    p: usize,
+    delayed: bool,
+) -> Result<Option<Vec<Vec<f64>>>, EstimateError> {
+    let Some(c) = covariance else { return Ok(None) };
+    let n = p + usize::from(delayed);
+    if c.len() != n || c.iter().any(|row| row.len() != n) {
+        return Err(EstimateError::WrongParamCount {
+            expected: n,
+            got: c.iter().map(Vec::len).find(|&l| l != n).unwrap_or(c.len()),
+        });
+    }
+    Ok(Some(c[..p].iter().map(|r| r[..p].to_vec()).collect()))
+}
+
+/// [`validation::bode`] of `G`, then the delay's phase `−360 f D` degrees and its share of the
+/// phase band: `∂ arg/∂D = −2πf`, with the delay's variance and its covariance with `G`'s
+/// parameters (the magnitude does not depend on `D`).
+fn delayed_bode<M: RationalModel>(
+    model: &M,
+    delay: Option<f64>,
+    freqs: &[f64],
+    covariance: Option<&[Vec<f64>]>,
+) -> Result<Vec<BodePoint>, EstimateError> {
+    let Some(d) = delay else {
+        return validation::bode(model, freqs, covariance);
+    };
+    let p = model.params().len();
+    let own = split_covariance(covariance, p, true)?;
+    let mut points = validation::bode(model, freqs, own.as_deref())?;
+    for point in &mut points {
+        let f = point.f_hz;
+        point.phase_deg -= 360.0 * f * d;
+        let Some(c) = covariance else { continue };
+        let (_, dlog) = validation::log_response_gradient(model, f);
+        let to_deg = 180.0 / std::f64::consts::PI;
+        let mut phase: Vec<f64> = dlog.iter().map(|g| to_deg * g.im).collect();
+        phase.push(-360.0 * f);
+        let mut magnitude: Vec<f64> = dlog.iter().map(|g| 20.0 / LN_10 * g.re).collect();
+        magnitude.push(0.0);
+        let dm = BAND_SIGMAS * quadratic(c, &magnitude).max(0.0).sqrt();
+        let dp = BAND_SIGMAS * quadratic(c, &phase).max(0.0).sqrt();
+        point.magnitude_db_lo = Some(point.magnitude_db - dm);
+        point.magnitude_db_hi = Some(point.magnitude_db + dm);
+        point.phase_deg_lo = Some(point.phase_deg - dp);
+        point.phase_deg_hi = Some(point.phase_deg + dp);
+    }
+    Ok(points)
 }
 
 /// The unit-step response of a rational signal's system with delta-method bands; `None` for
-/// other signal kinds.
+/// other signal kinds. A delayed system's response is `G`'s shifted by `D` (zero before), and
+/// `covariance` covers the system's parameters then the delay.
 pub fn step_of(
     signal: &AnySignal,
     times: &[f64],
     covariance: Option<&[Vec<f64>]>,
-) -> Option<Result<Vec<validation::StepPoint>, EstimateError>> {
+) -> Option<Result<Vec<StepPoint>, EstimateError>> {
+    let delay = delay_of(signal);
     if let Some(z) = zpk_of(signal) {
-        return Some(validation::step_response(&z, times, covariance));
+        return Some(delayed_step(&z, delay, times, covariance));
     }
-    transfer_function_of(signal).map(|t| validation::step_response(&t, times, covariance))
+    transfer_function_of(signal).map(|t| delayed_step(&t, delay, times, covariance))
+}
+
+/// The step response `y_G(t − D)` with the band of `(∇_θ y_G(t − D), −h(t − D))`, `h = y_G'`
+/// the impulse response `Σ r_i e^{p_i t}` for `t > 0` (modal form).
+fn delayed_step<M: RationalModel>(
+    model: &M,
+    delay: Option<f64>,
+    times: &[f64],
+    covariance: Option<&[Vec<f64>]>,
+) -> Result<Vec<StepPoint>, EstimateError> {
+    let Some(d) = delay else {
+        return validation::step_response(model, times, covariance);
+    };
+    let p = model.params().len();
+    split_covariance(covariance, p, true)?;
+    if let Some(c) = covariance {
+        if let Some(v) = c.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(EstimateError::BadArgument {
+                name: "covariance",
+                value: *v,
+                reason: "every entry must be finite",
+            });
+        }
+    }
+    let modal = model.modal();
+    times
+        .iter()
+        .map(|&t| {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(EstimateError::BadArgument {
+                    name: "time",
+                    value: t,
+                    reason: "must be finite and >= 0",
+                });
+            }
+            let shifted = t - d;
+            let (value, mut grad) = if shifted >= 0.0 {
+                let (v, g) = validation::step_value_and_gradient(model, shifted);
+                (v, g)
+            } else {
+                (0.0, vec![0.0; p])
+            };
+            let impulse: f64 = if shifted > 0.0 {
+                modal
+                    .poles
+                    .iter()
+                    .zip(&modal.residues)
+                    .map(|(&pole, &r)| r * (pole * shifted).exp())
+                    .sum::<Complex64>()
+                    .re
+            } else {
+                0.0
+            };
+            grad.push(-impulse);
+            let band = covariance.map(|c| BAND_SIGMAS * quadratic(c, &grad).max(0.0).sqrt());
+            Ok(StepPoint {
+                t,
+                value,
+                lo: band.map(|b| value - b),
+                hi: band.map(|b| value + b),
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use jitterid::signal::{Input, PiecewiseConstant};
+    use serde_json::json;
+
+    /// `2 (s − z) / ((s − a)² + b²)` with input delay `d` (none when `d` is `None`), for
+    /// `θ = [gain, z, a, b]`.
+    fn signal(theta: &[f64], delay: Option<f64>) -> AnySignal {
+        let mut spec: jitterid::signal::registry::Spec = json!({
+            "kind": "zpk",
+            "gain": theta[0],
+            "zeros": [theta[1]],
+            "poles": [[theta[2], theta[3]]],
+        })
+        .as_object()
+        .unwrap()
+        .clone();
+        if let Some(d) = delay {
+            spec.insert("delay".into(), json!(d));
+        }
+        let input = Input::Piecewise(PiecewiseConstant::new(vec![0.0, 100.0], vec![1.0]).unwrap());
+        SignalRegistry::builtin()
+            .build(&spec, Some(&input))
+            .unwrap()
+    }
+
+    const THETA: [f64; 4] = [2.0, -1.0, -0.5, 1.5];
+    const DELAY: f64 = 1.3;
+
+    /// `G(i2πf) e^{−i2πfD}` written out: `k (s − z) / ((s − a − ib)(s − a + ib)) e^{−sD}`.
+    fn by_hand(theta: &[f64], d: f64, f: f64) -> Complex64 {
+        let s = Complex64::new(0.0, std::f64::consts::TAU * f);
+        let (p, q) = (
+            Complex64::new(theta[2], theta[3]),
+            Complex64::new(theta[2], -theta[3]),
+        );
+        theta[0] * (s - theta[1]) / ((s - p) * (s - q)) * (-s * d).exp()
+    }
+
+    /// A covariance with correlations between every pair (`A Aᵀ`, `A` fixed), delay last.
+    fn covariance() -> Vec<Vec<f64>> {
+        let a = [
+            [0.19, 0.01, -0.02, 0.03, 0.01],
+            [0.05, 0.12, 0.01, -0.01, 0.02],
+            [-0.01, 0.02, 0.04, 0.01, -0.01],
+            [0.02, -0.01, 0.01, 0.04, 0.005],
+            [0.01, 0.02, -0.005, 0.01, 0.02],
+        ];
+        (0..5)
+            .map(|i| {
+                (0..5)
+                    .map(|j| (0..5).map(|k| a[i][k] * a[j][k]).sum())
+                    .collect()
+            })
+            .collect()
+    }
+
+    const FREQS: [f64; 4] = [0.01, 0.1, 0.25, 0.45];
+
+    #[test]
+    fn exported_model_and_phase_carry_the_delay() {
+        let s = signal(&THETA, Some(DELAY));
+        assert_eq!(model_forms(&s).unwrap().delay, Some(DELAY));
+        assert_eq!(model_forms(&signal(&THETA, None)).unwrap().delay, None);
+        let points = bode_of(&s, &FREQS, None).unwrap().unwrap();
+        for p in &points {
+            let h = by_hand(&THETA, DELAY, p.f_hz);
+            assert!((p.magnitude_db - 20.0 * h.norm().log10()).abs() < 1e-10);
+            // The CSV's phase is unwrapped; equal to arg H up to whole turns.
+            let turns = (p.phase_deg - h.arg().to_degrees()) / 360.0;
+            assert!((turns - turns.round()).abs() < 1e-10, "{p:?}");
+        }
+        // Unwrapped along the grid: the delay alone turns the phase by −360 f D.
+        let plain = bode_of(&signal(&THETA, None), &FREQS, None)
+            .unwrap()
+            .unwrap();
+        for (a, b) in points.iter().zip(&plain) {
+            assert!((a.phase_deg - b.phase_deg + 360.0 * a.f_hz * DELAY).abs() < 1e-9);
+        }
+    }
+
+    /// Central differences of `value(θ)` in each of the five parameters (delay last).
+    fn gradient(value: impl Fn(&[f64]) -> f64) -> Vec<f64> {
+        let base = [THETA[0], THETA[1], THETA[2], THETA[3], DELAY];
+        (0..5)
+            .map(|j| {
+                let h = 1e-6;
+                let (mut up, mut down) = (base, base);
+                up[j] += h;
+                down[j] -= h;
+                (value(&up) - value(&down)) / (2.0 * h)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_delayed_phase_band_matches_finite_differences() {
+        let c = covariance();
+        let s = signal(&THETA, Some(DELAY));
+        let points = bode_of(&s, &FREQS, Some(&c)).unwrap().unwrap();
+        for p in &points {
+            let f = p.f_hz;
+            let reference = by_hand(&THETA, DELAY, f);
+            // The phase relative to the base point's, so that no wrap enters the difference.
+            let phase = |t: &[f64]| (by_hand(t, t[4], f) / reference).arg().to_degrees();
+            let magnitude = |t: &[f64]| 20.0 * by_hand(t, t[4], f).norm().log10();
+            let sd = |g: Vec<f64>| BAND_SIGMAS * quadratic(&c, &g).sqrt();
+            let (dp, dm) = (sd(gradient(phase)), sd(gradient(magnitude)));
+            let half = p.phase_deg_hi.unwrap() - p.phase_deg;
+            assert!((half - dp).abs() < 1e-6 * dp, "f {f}: {half} vs {dp}");
+            let half = p.magnitude_db_hi.unwrap() - p.magnitude_db;
+            assert!((half - dm).abs() < 1e-6 * dm, "f {f}: {half} vs {dm}");
+        }
+        // A covariance without the delay's row is refused, not read as G's alone.
+        let short: Vec<Vec<f64>> = c[..4].iter().map(|r| r[..4].to_vec()).collect();
+        assert!(bode_of(&s, &FREQS, Some(&short)).unwrap().is_err());
+    }
+
+    #[test]
+    fn the_delayed_step_is_shifted_and_its_band_matches_finite_differences() {
+        let c = covariance();
+        let times = [0.0, 0.5, 1.29, 1.31, 2.0, 4.5, 9.0];
+        let delayed = step_of(&signal(&THETA, Some(DELAY)), &times, Some(&c))
+            .unwrap()
+            .unwrap();
+        let step_at = |t: &[f64], time: f64| {
+            if time < t[4] {
+                return 0.0;
+            }
+            step_of(&signal(&t[..4], None), &[time - t[4]], None)
+                .unwrap()
+                .unwrap()[0]
+                .value
+        };
+        for p in &delayed {
+            assert!(
+                (p.value - step_at(&[THETA[0], THETA[1], THETA[2], THETA[3], DELAY], p.t)).abs()
+                    < 1e-12
+            );
+            if p.t < DELAY {
+                assert_eq!(p.value, 0.0);
+                continue;
+            }
+            let g = gradient(|t| step_at(t, p.t));
+            let sd = BAND_SIGMAS * quadratic(&c, &g).sqrt();
+            let half = p.hi.unwrap() - p.value;
+            assert!(
+                (half - sd).abs() < 1e-6 * sd.max(1e-9),
+                "t {}: {half} vs {sd}",
+                p.t
+            );
+        }
+    }
 }

@@ -53,9 +53,13 @@ fn log_band(grid: &SampleGrid) -> Vec<f64> {
 /// Points of a curve.
 type Curve = Vec<(f64, f64)>;
 
-/// `G(i2πf)` of a rational system, `None` for other signals.
+/// `G(i2πf) e^{−i2πfD}` of a rational system with input delay `D` (0 without), `None` for
+/// other signals.
 fn frequency_response(signal: &AnySignal, f: f64) -> Option<Complex64> {
-    export::tf_of(signal).map(|tf| tf.response(Complex64::new(0.0, std::f64::consts::TAU * f)))
+    let w = std::f64::consts::TAU * f;
+    let delay = export::delay_of(signal).unwrap_or(0.0);
+    export::tf_of(signal)
+        .map(|tf| tf.response(Complex64::new(0.0, w)) * Complex64::from_polar(1.0, -w * delay))
 }
 
 /// Magnitude and unwrapped phase (degrees) of `G(i2πf)`.

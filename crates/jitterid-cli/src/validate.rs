@@ -257,39 +257,30 @@ fn read_validation(exp: &Experiment, path: &Path) -> CliResult<(SampleGrid, Vec<
     Ok((grid, y, name))
 }
 
-/// The rational system's part of a signal's parameter covariance: its leading block, since a
-/// signal lists the system's own parameters first (then `delay`, then the `initial.*`
-/// coefficients of a free response, on which `G` does not depend). `None` without a
-/// covariance, or for a system with an input delay (its `e^{−i2πfD}` is not in the rational
-/// model, so neither its response nor its band would be the fitted system's).
+/// The system's part of a signal's parameter covariance, `G`'s parameters then the delay: its
+/// leading block, since a signal lists the system's own parameters first (then `delay`, then
+/// the `initial.*` coefficients of a free response, on which `G e^{−sD}` does not depend).
+/// `None` without a covariance.
 fn system_covariance(s: &Structure, cov: Option<&[Vec<f64>]>) -> Option<Vec<Vec<f64>>> {
     let names = s.signal.param_names();
     let p = names
         .iter()
-        .take_while(|n| *n != "delay" && !n.starts_with("initial."))
+        .take_while(|n| !n.starts_with("initial."))
         .count();
     let cov = cov?;
     (cov.len() >= p && cov.iter().take(p).all(|r| r.len() >= p))
         .then(|| cov[..p].iter().map(|r| r[..p].to_vec()).collect())
 }
 
-/// Whether the fitted system delays its input (not a rational transfer function then).
-fn has_delay(s: &Structure) -> bool {
-    s.signal.param_names().iter().any(|n| n == "delay")
-}
-
 /// The frequency response on 200 frequencies log-spaced from `1/(NT)` to the Nyquist
-/// frequency `1/(2T)`; `None` for a system that is not rational (or has an input delay).
-/// `flag` names the option.
+/// frequency `1/(2T)`, with the delay's phase for a delayed system; `None` for a system that
+/// is not rational. `flag` names the option.
 fn frequency_response(
     s: &Structure,
     grid: &SampleGrid,
     cov: Option<&[Vec<f64>]>,
     flag: &str,
 ) -> CliResult<Option<Vec<BodePoint>>> {
-    if has_delay(s) {
-        return Ok(None);
-    }
     let cov = system_covariance(s, cov);
     let freqs = validation::log_spaced(1.0 / grid.duration(), 0.5 / grid.interval(), 200)
         .map_err(|e| cli_err!("{flag}: {e}"))?;
@@ -299,16 +290,14 @@ fn frequency_response(
 }
 
 /// The unit-step response on 200 times from the step to 8 time constants of the slowest pole
-/// (where its mode has decayed to e⁻⁸), at most the record's duration; `None` for a system that
-/// is not rational (or has an input delay).
+/// (where its mode has decayed to e⁻⁸), at most the record's duration, plus the input delay of
+/// a delayed system (its response is zero until then); `None` for a system that is not
+/// rational.
 fn step(
     s: &Structure,
     grid: &SampleGrid,
     cov: Option<&[Vec<f64>]>,
 ) -> CliResult<Option<Vec<StepPoint>>> {
-    if has_delay(s) {
-        return Ok(None);
-    }
     let cov = system_covariance(s, cov);
     let slowest = export::tf_of(&s.signal)
         .and_then(|tf| tf.to_zpk().ok())
@@ -322,6 +311,7 @@ fn step(
         Some(r) if r > 0.0 && r.is_finite() => (8.0 / r).min(grid.duration()),
         _ => grid.duration(),
     };
+    let horizon = horizon + export::delay_of(&s.signal).unwrap_or(0.0);
     let times: Vec<f64> = (0..200).map(|i| horizon * i as f64 / 199.0).collect();
     export::step_of(&s.signal, &times, cov.as_deref())
         .transpose()
@@ -443,12 +433,8 @@ pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
     };
     let mut outputs = OutputSet::new();
     if let Some(path) = &o.bode {
-        let points =
-            frequency_response(&fitted, &exp.grid, cov.as_deref(), "--bode")?.ok_or_else(|| {
-                cli_err!(
-                    "--bode: the system is not a rational transfer function without an input delay"
-                )
-            })?;
+        let points = frequency_response(&fitted, &exp.grid, cov.as_deref(), "--bode")?
+            .ok_or_else(|| cli_err!("--bode: the system is not a rational transfer function"))?;
         outputs.file(path, bode_csv(&points));
     }
     if let Some(dir) = &o.plot {

@@ -247,8 +247,8 @@ fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
 /// A system fitted with the free response from an unknown initial state: its Bode band comes
 /// from the block of the system's own parameters (gain, zero, poles; `G` does not depend on
 /// `initial.*`), checked against `G(s) = k (s − z)/((s − p)(s − p̄))` and its log-derivatives
-/// written out here. A system with an input delay has no rational Bode diagram: `--bode` is
-/// refused by name, and `--plot` draws the time and correlation figures only.
+/// written out here. A system with an input delay: its exported model and `--bode` CSV carry
+/// the delay, and `--plot` draws its Bode and step figures.
 #[test]
 fn validate_bode_band_of_a_system_with_a_free_initial_response() {
     use jitterid::num_complex::Complex64;
@@ -304,26 +304,54 @@ fn validate_bode_band_of_a_system_with_a_free_initial_response() {
         );
     }
 
+    // A delayed system: `fit --json`'s model carries the delay, the `--bode` CSV is
+    // `G(i2πf) e^{−i2πfD}` (G from the exported `tf`, written out here), and `--plot` adds the
+    // Bode and step figures.
     let exp = example("dead-time.toml");
     assert!(run(&["simulate", &exp, "--out", s(&data)]).status.success());
-    let figs = dir.join("delayed");
-    let o = run(&[
-        "validate",
-        &exp,
-        "--data",
-        s(&data),
-        "--plot",
-        s(&figs),
-        "--out",
-        s(&fit),
-    ]);
+    let o = run(&["fit", &exp, "--data", s(&data), "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(files_in(&figs), ["correlations.svg", "time.svg"]);
-    let o = run(&["validate", &exp, "--data", s(&data), "--bode", s(&bode)]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("--bode") && stderr(&o).contains("delay"),
-        "{}",
-        stderr(&o)
+    std::fs::write(&fit, stdout(&o)).unwrap();
+    let m: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let delay = m["model"]["delay"].as_f64().expect("model.delay");
+    let estimate = m["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "delay")
+        .unwrap()["estimate"]
+        .as_f64()
+        .unwrap();
+    assert_eq!(delay, estimate);
+    let coefficients = |key: &str| -> Vec<f64> {
+        m["model"]["tf"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (num, den) = (coefficients("num"), coefficients("den"));
+    let polynomial =
+        |c: &[f64], s: Complex64| c.iter().fold(Complex64::new(0.0, 0.0), |a, &x| a * s + x);
+    let figs = dir.join("delayed");
+    let args = ["--model", s(&fit), "--bode", s(&bode), "--plot", s(&figs)];
+    let o = run(&[&["validate", exp.as_str(), "--data", s(&data)], &args[..]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        files_in(&figs),
+        ["bode.svg", "correlations.svg", "step.svg", "time.svg"]
     );
+    let csv = std::fs::read_to_string(&bode).unwrap();
+    for row in csv.lines().skip(1).step_by(20) {
+        let v: Vec<f64> = row.split(',').map(|x| x.parse().unwrap()).collect();
+        let s_ = Complex64::new(0.0, v[1]);
+        let h = polynomial(&num, s_) / polynomial(&den, s_) * (-s_ * delay).exp();
+        assert!((v[2] - 20.0 * h.norm().log10()).abs() < 1e-9, "{row}");
+        // The CSV's phase is unwrapped along the grid: arg H up to whole turns.
+        let turns = (v[3] - h.arg().to_degrees()) / 360.0;
+        assert!((turns - turns.round()).abs() < 1e-9, "{row}");
+        // The band includes the delay's share (the phase band widens with f).
+        assert!(v[7] > v[3] && v[6] < v[3], "{row}");
+    }
 }

@@ -139,7 +139,8 @@ fn the_full_structure_prefers_the_two_point_family() {
 }
 
 /// Steps 3 and 5: the Box–Jenkins fit converges, every parameter with a truth lies within 3
-/// standard errors of the generator's value, and the JSON carries the three model forms.
+/// standard errors of the generator's value, and the JSON carries the three model forms and the
+/// delay.
 #[test]
 fn the_fit_recovers_the_truth_within_three_standard_errors() {
     let (exp, est) = (shipped("model.toml"), shipped("estimation.csv"));
@@ -173,6 +174,9 @@ fn the_fit_recovers_the_truth_within_three_standard_errors() {
     for form in ["zpk", "tf", "ss"] {
         assert!(v["model"][form].is_object(), "{form}");
     }
+    // Step 4: the exported model carries the delay, the parameter's estimate.
+    let delay = params.iter().find(|p| p["name"] == "delay").unwrap();
+    assert_eq!(v["model"]["delay"], delay["estimate"]);
 }
 
 /// Step 4: `validate` of the fitted model on both records: the residuals, whitened by the
