@@ -472,6 +472,17 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
             p.stderr.map_or("–".into(), fmt_num)
         );
     }
+    // The exported model of a delayed system is two pieces: say how they combine.
+    if let (Some(d), Some(_)) = (
+        export::delay_of(&f.fitted.signal),
+        export::tf_of(&f.fitted.signal),
+    ) {
+        let _ = writeln!(
+            out,
+            "model: G(s) e^(-sD) with input delay D = {} s (the parameter delay; --json: model.zpk, model.tf, model.ss give G, model.delay gives D)",
+            fmt_num(d)
+        );
+    }
     if let Some(dir) = plot {
         let _ = writeln!(
             out,

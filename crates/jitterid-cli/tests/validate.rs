@@ -332,6 +332,13 @@ fn validate_bode_band_of_a_system_with_a_free_initial_response() {
             .collect()
     };
     let (num, den) = (coefficients("num"), coefficients("den"));
+    // The table says how the exported pieces combine.
+    let o = run(&["fit", &exp, "--data", s(&data)]);
+    assert!(
+        stdout(&o).contains("model: G(s) e^(-sD) with input delay D = "),
+        "{}",
+        stdout(&o)
+    );
     let polynomial =
         |c: &[f64], s: Complex64| c.iter().fold(Complex64::new(0.0, 0.0), |a, &x| a * s + x);
     let figs = dir.join("delayed");
