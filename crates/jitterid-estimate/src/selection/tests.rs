@@ -134,6 +134,11 @@ fn jittered_record(jitter: &AnyJitter, n: usize, seed: u64) -> (Record, Input) {
 /// A screened candidate of `family` with BCLS BIC `bic` (fitted unless `bic` is infinite).
 fn screened(poles: usize, family: &str, bic: f64, converged: bool) -> Candidate {
     let model = template(0, poles).unwrap();
+    let input: Input = jitterid_signal::Multisine::sine(0.1, 1.0, 0.0)
+        .unwrap()
+        .into();
+    let model = LtiResponse::new(model, input);
+    let model = AnySignal::with_spectrum("tf", model, |_| Spec::new());
     let none = JitterRegistry::builtin()
         .from_std_dev("none", 0.0, &serde_json::Map::new())
         .unwrap();
