@@ -83,7 +83,9 @@ fn exact_fit(record: &Record, family: &str, (signal, jitter): (AnySignal, AnyJit
 /// system with the family's jitter at the winner's standard deviation. Families of equal
 /// spread have nearly the same first moment, so that is a start near the family's best fit
 /// even where the family's own BCLS fits ended in a wrong local minimum of the jitter's scale
-/// (periodic `J₀` makes the BCLS cost oscillate in the scale).
+/// (periodic `J₀` makes the BCLS cost oscillate in the scale). A family whose own finalist is
+/// at the winner's order with a jitter of nearly the winner's spread gets no extra start: its
+/// own start is already there.
 pub(super) fn starts(
     candidates: &[Candidate],
     registry: &JitterRegistry,
@@ -112,12 +114,24 @@ pub(super) fn starts(
         if !same_order || c.family == candidates[w].family || c.family == "none" {
             continue;
         }
+        // A finalist at the winner's order whose BCLS jitter has the winner's spread already
+        // starts where this start would: a second fit from there finds the same optimum.
+        let near = |f: &(AnySignal, AnyJitter)| (f.1.std_dev() - std).abs() <= SAME_SPREAD * std;
+        if chosen.contains(&i) && c.fitted.as_ref().is_some_and(near) {
+            continue;
+        }
         if let Ok(j) = registry.from_std_dev(&c.family, std, &serde_json::Map::new()) {
             out.push((i, (model.clone(), j)));
         }
     }
     out
 }
+
+/// Relative difference of jitter standard deviations below which a family's own BCLS fit is
+/// taken to start its likelihood fit where the winner's system would (the extra start is then
+/// skipped). A wrong BCLS basin of an oscillating `γ` lies near another zero of `J₀` or `cos`,
+/// at a scale far from the right one.
+const SAME_SPREAD: f64 = 0.1;
 
 /// An exact fit, the structure at its estimate and its BIC, or why it failed.
 type ExactFit = Result<(crate::Fit, Structure, f64), String>;
