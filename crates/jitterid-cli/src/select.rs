@@ -89,24 +89,32 @@ pub fn select(o: &SelectOptions) -> CliResult<Outcome> {
     })?;
     let record = fitting::record(&exp.grid, table.column("y")?.to_vec())
         .map_err(|e| cli_err!("{}: {e}", table.name))?;
+    // The candidates carry the system's delay (a parameter when the system is estimated,
+    // else the input is delayed by it) and, with `initial = "estimate"`, a free response.
+    let delay = exp.system.kind.get("delay").and_then(Value::as_f64);
+    let known_delay = delay.filter(|_| !exp.system.estimate);
+    let delay_err = |e: String| cli_err!("{}: [system] delay: {e}", exp.file);
+    let input = delayed_input(&input, known_delay).map_err(delay_err)?;
+    let options = SelectionOptions {
+        delay: delay.filter(|_| exp.system.estimate),
+        initial_state: exp.system.kind.contains_key("initial"),
+        ..SelectionOptions::default()
+    };
     let validation = match &o.validation {
         Some(path) => {
             let t = read_data(&exp, path)?;
-            let vi = read_input(&exp, path, None)?.unwrap_or_else(|| input.clone());
+            let vi = match read_input(&exp, path, None)? {
+                Some(vi) => delayed_input(&vi, known_delay).map_err(delay_err)?,
+                None => input.clone(),
+            };
             let r = fitting::record(&exp.grid, t.column("y")?.to_vec())
                 .map_err(|e| cli_err!("{}: {e}", t.name))?;
             Some((r, vi))
         }
         None => None,
     };
-    let ranked = run_select(
-        &record,
-        &input,
-        &grid,
-        JitterRegistry::builtin(),
-        &SelectionOptions::default(),
-    )
-    .map_err(|e| cli_err!("{}: {e}", exp.file))?;
+    let ranked = run_select(&record, &input, &grid, JitterRegistry::builtin(), &options)
+        .map_err(|e| cli_err!("{}: {e}", exp.file))?;
     let fits: Vec<Option<f64>> = ranked
         .iter()
         .map(|c| {

@@ -82,3 +82,79 @@ fn bad_grids_exit_2_naming_the_key() {
         assert!(err.contains(&format!("[select] {key}")), "{select}: {err}");
     }
 }
+
+/// `examples/experiments/dead-time.toml` (Table 2's system, input delayed by 1.5 s) with an
+/// input history of 50 s before `t0` and `initial = "estimate"`, under `[select]`.
+fn delayed_experiment(dir: &Path, name: &str, estimate: bool) -> String {
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/experiments/dead-time.toml"),
+    )
+    .unwrap()
+    .replace("high = 1.0\n", "high = 1.0\nhistory = 50.0\n")
+    .replace(
+        "estimate = true\ndelay = 1.5",
+        &format!("estimate = {estimate}\ninitial = \"estimate\"\ndelay = 1.5"),
+    );
+    assert!(base.contains("history = 50.0") && base.contains("initial = \"estimate\""));
+    let path = dir.join(name);
+    let select = "poles = [2, 2]\nzeros = [0, 1]\nfamilies = [\"gaussian\"]";
+    std::fs::write(&path, format!("{base}\n[select]\n{select}\n")).unwrap();
+    path.display().to_string()
+}
+
+fn json_of(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn candidates_carry_the_experiments_delay_and_initial_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = delayed_experiment(dir.path(), "estimated.toml", true);
+    let data = dir.path().join("d.csv").display().to_string();
+    assert!(jitterid(&["simulate", &exp, "--seed", "3", "--out", &data])
+        .status
+        .success());
+    let v = json_of(&jitterid(&["select", &exp, "--data", &data, "--json"]));
+    let best = &v["best"];
+    // The truth: 2 poles, 1 zero. Without the delay a candidate spends a zero on its phase.
+    assert_eq!(
+        (best["poles"].as_u64(), best["zeros"].as_u64()),
+        (Some(2), Some(1))
+    );
+    let est = &best["estimates"];
+    for key in ["initial.0", "initial.1"] {
+        assert!(est[key].is_f64(), "{key} in {est}");
+    }
+    // The independent route: `fit` of the file's own structure (BCLS, the jitter known)
+    // estimates the delay with a standard error; the selection's estimate (exact ML, the
+    // jitter's family Gaussian) is another estimate of the same 1.5 s, so both lie within a
+    // few standard errors of it.
+    let fit = json_of(&jitterid(&["fit", &exp, "--data", &data, "--json"]));
+    let delay = fit["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "delay")
+        .unwrap();
+    let se = delay["stderr"].as_f64().unwrap();
+    let d = est["delay"].as_f64().unwrap();
+    assert!(se > 0.0 && se < 0.5, "delay stderr {se}");
+    assert!((d - 1.5).abs() < 4.0 * se, "select's delay {d}, se {se}");
+
+    // A known delay (the system's keys not estimated) delays the input: no `delay` parameter,
+    // and the same order wins.
+    let known = delayed_experiment(dir.path(), "known.toml", false);
+    let v = json_of(&jitterid(&["select", &known, "--data", &data, "--json"]));
+    let best = &v["best"];
+    assert_eq!(
+        (best["poles"].as_u64(), best["zeros"].as_u64()),
+        (Some(2), Some(1))
+    );
+    assert!(best["estimates"].get("delay").is_none(), "{best}");
+    assert!(best["estimates"]["initial.1"].is_f64(), "{best}");
+}

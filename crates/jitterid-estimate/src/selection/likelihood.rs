@@ -13,12 +13,12 @@
 //! Only the finalists are refitted because an exact fit costs several BCLS fits; the screen
 //! picks the order within a family reliably.
 
-use super::{Candidate, Structure};
+use super::{structure_of, Candidate, Structure};
 use crate::ml::{ml_estimate, ExactMl, MlOptions};
-use crate::{ModelStructure, Record};
+use crate::Record;
 use jitterid_jitter::registry::JitterRegistry;
 use jitterid_jitter::{AnyJitter, JitterModel};
-use jitterid_signal::{Input, LtiResponse, Signal, TransferFunction};
+use jitterid_signal::{AnySignal, Signal};
 use rayon::prelude::*;
 
 /// Index of the best screened candidate of every family, in the order the families first
@@ -54,22 +54,12 @@ pub(super) fn finalists(candidates: &[Candidate]) -> Vec<usize> {
 /// jitter's share of the spread, so every sample has a representable likelihood even where the
 /// BCLS estimate of a bounded law's reach is a little short, and the search shrinks it.
 /// Returns the fit, the structure at the estimate and the BIC.
-fn exact_fit(
-    record: &Record,
-    input: &Input,
-    family: &str,
-    (model, jitter): (TransferFunction, AnyJitter),
-) -> ExactFit {
-    let signal = LtiResponse::new(model, input.clone());
+fn exact_fit(record: &Record, family: &str, (signal, jitter): (AnySignal, AnyJitter)) -> ExactFit {
     let m = signal.expected_values(record.grid(), &jitter);
     let y = record.y();
     let n = y.len() as f64;
     let rms = (y.iter().zip(&m).map(|(y, m)| (y - m).powi(2)).sum::<f64>() / n).sqrt();
-    let structure: Structure = if family == "none" {
-        ModelStructure::oe(signal, jitter)
-    } else {
-        ModelStructure::joe(signal, jitter)
-    };
+    let structure = structure_of(family, signal, jitter);
     let options = MlOptions {
         noise_std_start: (rms.is_finite() && rms > 0.0).then_some(rms),
         ..MlOptions::default()
@@ -93,11 +83,13 @@ fn exact_fit(
 /// system with the family's jitter at the winner's standard deviation. Families of equal
 /// spread have nearly the same first moment, so that is a start near the family's best fit
 /// even where the family's own BCLS fits ended in a wrong local minimum of the jitter's scale
-/// (periodic `J₀` makes the BCLS cost oscillate in the scale).
+/// (periodic `J₀` makes the BCLS cost oscillate in the scale). A family whose own finalist is
+/// at the winner's order with a jitter of nearly the winner's spread gets no extra start: its
+/// own start is already there.
 pub(super) fn starts(
     candidates: &[Candidate],
     registry: &JitterRegistry,
-) -> Vec<(usize, (TransferFunction, AnyJitter))> {
+) -> Vec<(usize, (AnySignal, AnyJitter))> {
     let chosen = finalists(candidates);
     let mut out: Vec<_> = chosen
         .iter()
@@ -122,12 +114,24 @@ pub(super) fn starts(
         if !same_order || c.family == candidates[w].family || c.family == "none" {
             continue;
         }
+        // A finalist at the winner's order whose BCLS jitter has the winner's spread already
+        // starts where this start would: a second fit from there finds the same optimum.
+        let near = |f: &(AnySignal, AnyJitter)| (f.1.std_dev() - std).abs() <= SAME_SPREAD * std;
+        if chosen.contains(&i) && c.fitted.as_ref().is_some_and(near) {
+            continue;
+        }
         if let Ok(j) = registry.from_std_dev(&c.family, std, &serde_json::Map::new()) {
             out.push((i, (model.clone(), j)));
         }
     }
     out
 }
+
+/// Relative difference of jitter standard deviations below which a family's own BCLS fit is
+/// taken to start its likelihood fit where the winner's system would (the extra start is then
+/// skipped). A wrong BCLS basin of an oscillating `γ` lies near another zero of `J₀` or `cos`,
+/// at a scale far from the right one.
+const SAME_SPREAD: f64 = 0.1;
 
 /// An exact fit, the structure at its estimate and its BIC, or why it failed.
 type ExactFit = Result<(crate::Fit, Structure, f64), String>;
@@ -138,14 +142,13 @@ type ExactFit = Result<(crate::Fit, Structure, f64), String>;
 /// A candidate fitted from two [`starts`] keeps the converged fit of higher likelihood.
 pub(super) fn refine_finalists(
     record: &Record,
-    input: &Input,
     registry: &JitterRegistry,
     candidates: &mut [Candidate],
 ) {
     let jobs = starts(candidates, registry);
     let fits: Vec<_> = jobs
         .par_iter()
-        .map(|(i, start)| exact_fit(record, input, &candidates[*i].family, start.clone()))
+        .map(|(i, start)| exact_fit(record, &candidates[*i].family, start.clone()))
         .collect();
     // Converged before not converged before failed, then the lower BIC.
     let key = |r: &ExactFit| match r {
@@ -175,7 +178,7 @@ pub(super) fn refine_finalists(
                     c.converged = true;
                     c.failure = None;
                     c.parameters = fit.names.iter().cloned().zip(fit.params).collect();
-                    c.fitted = Some((structure.signal.model().clone(), structure.jitter));
+                    c.fitted = Some((structure.signal, structure.jitter));
                 } else {
                     c.likelihood_failure = Some(format!(
                         "exact likelihood did not converge: {}",

@@ -37,8 +37,10 @@
 //! The two BICs are never compared with each other.
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
-use jitterid_signal::{Input, LtiResponse, Signal, TransferFunction};
+use jitterid_signal::registry::{SignalRegistry, Spec};
+use jitterid_signal::{AnySignal, Input, LtiResponse, PiecewiseConstant, Signal, TransferFunction};
 use rayon::prelude::*;
+use serde_json::json;
 
 use crate::validation::fit_percent;
 use crate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
@@ -66,6 +68,14 @@ pub struct SelectionOptions {
     /// the finalists ranked by the likelihood's BIC (default true); false ranks by the BCLS
     /// screen alone.
     pub refine_by_likelihood: bool,
+    /// An input delay (dead time, s, `≥ 0`) every candidate carries as its parameter `delay`,
+    /// estimated with the system from this start (the initializer fits the response to the
+    /// input delayed by it); `None`: no delay. A known delay is not a parameter: pass the
+    /// input delayed by it instead.
+    pub delay: Option<f64>,
+    /// Whether every candidate carries the free response from an unknown state at the record's
+    /// first instant (parameters `initial.0 … initial.{n−1}` for `n` poles, started at 0).
+    pub initial_state: bool,
 }
 
 impl Default for SelectionOptions {
@@ -73,6 +83,8 @@ impl Default for SelectionOptions {
         Self {
             jitter_fractions: vec![0.1, 0.25, 0.4],
             refine_by_likelihood: true,
+            delay: None,
+            initial_state: false,
         }
     }
 }
@@ -108,17 +120,24 @@ pub struct Candidate {
     pub parameters: Vec<(String, f64)>,
     /// Why the candidate failed, if it did.
     pub failure: Option<String>,
-    /// The fitted transfer function and jitter (absent for a failed candidate).
-    pub fitted: Option<(TransferFunction, AnyJitter)>,
+    /// The fitted system and jitter (absent for a failed candidate): the rational model
+    /// (registry kind `tf`), with the [`SelectionOptions::delay`] and
+    /// [`SelectionOptions::initial_state`] the selection ran with.
+    pub fitted: Option<(AnySignal, AnyJitter)>,
 }
 
 impl Candidate {
     /// The normalised fit percent ([`fit_percent`]) of the candidate's expected samples
     /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`; `None` for a
-    /// failed candidate or where the fit percent is undefined (constant data).
+    /// failed candidate or where the fit percent is undefined (constant data). The fitted
+    /// delay is kept; a fitted free response is not (it is the estimation record's state, and
+    /// the validation record starts from its own).
     pub fn validation_fit(&self, record: &Record, input: &Input) -> Option<f64> {
-        let (model, jitter) = self.fitted.as_ref()?;
-        let signal = LtiResponse::new(model.clone(), input.clone());
+        let (signal, jitter) = self.fitted.as_ref()?;
+        let mut spec = signal.spec();
+        spec.remove("initial");
+        spec.remove("origin");
+        let signal = SignalRegistry::builtin().build(&spec, Some(input)).ok()?;
         let m = signal.expected_values(record.grid(), jitter);
         fit_percent(record.y(), &m).ok()
     }
@@ -221,16 +240,62 @@ fn template(zeros: usize, poles: usize) -> Result<TransferFunction, String> {
     TransferFunction::new(&vec![1.0; zeros + 1], &den).map_err(|e| e.to_string())
 }
 
-type Structure = ModelStructure<LtiResponse<TransferFunction>, AnyJitter, crate::WhiteNoise>;
+type Structure = ModelStructure<AnySignal, AnyJitter, crate::WhiteNoise>;
+
+/// The structure a candidate of `family` is fitted in: its system estimated, its jitter too
+/// unless the family is `"none"`.
+fn structure_of(family: &str, signal: AnySignal, jitter: AnyJitter) -> Structure {
+    if family == "none" {
+        ModelStructure::oe(signal, jitter)
+    } else {
+        ModelStructure::joe(signal, jitter)
+    }
+}
+
+/// `input` delayed by `delay` seconds (a piecewise-constant input's edges moved later).
+fn delayed_input(input: &Input, delay: f64) -> Result<Input, String> {
+    match input {
+        Input::Piecewise(p) => {
+            let edges = p.edges().iter().map(|e| e + delay).collect();
+            PiecewiseConstant::new(edges, p.levels().to_vec())
+                .map(Input::Piecewise)
+                .map_err(|e| e.to_string())
+        }
+        Input::Tones(_) => Err("a delay needs an input made of steps, not tones".into()),
+    }
+}
+
+/// The candidate's signal: `model` driven by `input`, with the options' delay and free
+/// response from an unknown state at the record's first instant (coefficients at 0).
+fn candidate_signal(
+    model: &TransferFunction,
+    input: &Input,
+    record: &Record,
+    options: &SelectionOptions,
+) -> Result<AnySignal, String> {
+    let mut spec = Spec::new();
+    spec.insert("kind".into(), json!("tf"));
+    spec.insert("num".into(), json!(model.num()));
+    spec.insert("den".into(), json!(model.den()));
+    if let Some(d) = options.delay {
+        spec.insert("delay".into(), json!(d));
+    }
+    if options.initial_state {
+        spec.insert("initial".into(), json!(vec![0.0; model.den().len() - 1]));
+        spec.insert("origin".into(), json!(record.grid().start()));
+    }
+    SignalRegistry::builtin()
+        .build(&spec, Some(input))
+        .map_err(|e| e.to_string())
+}
 
 /// One BCLS fit of a candidate from the initializer's model with the jitter at `fraction · T`.
 fn fit_from(
     record: &Record,
     input: &Input,
     registry: &JitterRegistry,
-    family: &str,
-    poles: usize,
-    zeros: usize,
+    options: &SelectionOptions,
+    (family, poles, zeros): (&str, usize, usize),
     fraction: f64,
 ) -> Result<(Structure, crate::Fit), String> {
     let sigma = fraction * record.grid().interval();
@@ -238,14 +303,18 @@ fn fit_from(
         .from_std_dev(family, sigma, &serde_json::Map::new())
         .map_err(|e| format!("jitter start: {e}"))?;
     let model = template(zeros, poles).map_err(|e| format!("template: {e}"))?;
-    let signal = LtiResponse::new(model, input.clone());
-    let structure = if family == "none" {
-        ModelStructure::oe(signal, jitter)
-    } else {
-        ModelStructure::joe(signal, jitter)
+    // The initializer fits the response to the input as the system sees it, so that the
+    // rational model does not absorb the delay's phase as well.
+    let driven = match options.delay {
+        Some(d) => delayed_input(input, d).map_err(|e| format!("delay: {e}"))?,
+        None => input.clone(),
     };
-    let structure = initialize(&structure, record, &InitOptions::default())
+    let rational = ModelStructure::oe(LtiResponse::new(model, driven), jitter.clone());
+    let rational = initialize(&rational, record, &InitOptions::default())
         .map_err(|e| format!("initializer: {e}"))?;
+    let signal = candidate_signal(rational.signal.model(), input, record, options)
+        .map_err(|e| format!("candidate system: {e}"))?;
+    let structure = structure_of(family, signal, rational.jitter);
     // The ranking needs the cost only; the sandwich covariance would dominate the time.
     let options = EstimateOptions {
         covariance: false,
@@ -286,7 +355,14 @@ fn fit_candidate(
     let mut best: Option<(Structure, crate::Fit)> = None;
     let mut last_error = String::new();
     for &fraction in fractions {
-        match fit_from(record, input, registry, &family, poles, zeros, fraction) {
+        match fit_from(
+            record,
+            input,
+            registry,
+            options,
+            (&family, poles, zeros),
+            fraction,
+        ) {
             Ok((s, fit)) => {
                 let better = match &best {
                     None => true,
@@ -330,7 +406,7 @@ fn fit_candidate(
         fitted: structure
             .with_params(&fit.params)
             .ok()
-            .map(|s| (s.signal.model().clone(), s.jitter)),
+            .map(|s| (s.signal, s.jitter)),
     }
 }
 
@@ -362,7 +438,7 @@ pub fn select(
         .map(|c| fit_candidate(record, input, registry, options, c))
         .collect();
     if options.refine_by_likelihood {
-        likelihood::refine_finalists(record, input, registry, &mut out);
+        likelihood::refine_finalists(record, registry, &mut out);
     }
     // A stable sort keeps grid order among equal keys: deterministic for any thread count.
     let group = |c: &Candidate| match (c.ranked_by_likelihood, c.converged) {

@@ -134,6 +134,11 @@ fn jittered_record(jitter: &AnyJitter, n: usize, seed: u64) -> (Record, Input) {
 /// A screened candidate of `family` with BCLS BIC `bic` (fitted unless `bic` is infinite).
 fn screened(poles: usize, family: &str, bic: f64, converged: bool) -> Candidate {
     let model = template(0, poles).unwrap();
+    let input: Input = jitterid_signal::Multisine::sine(0.1, 1.0, 0.0)
+        .unwrap()
+        .into();
+    let model = LtiResponse::new(model, input);
+    let model = AnySignal::with_spectrum("tf", model, |_| Spec::new());
     let none = JitterRegistry::builtin()
         .from_std_dev("none", 0.0, &serde_json::Map::new())
         .unwrap();
@@ -170,6 +175,44 @@ fn finalists_are_the_screens_best_of_each_family() {
         screened(1, "two-point", f64::INFINITY, false),
     ];
     assert_eq!(likelihood::finalists(&c), vec![2, 1, 6]);
+}
+
+/// `c` with its fitted jitter replaced by its family's at standard deviation `std`.
+fn with_spread(mut c: Candidate, std: f64) -> Candidate {
+    let j = JitterRegistry::builtin()
+        .from_std_dev(&c.family, std, &serde_json::Map::new())
+        .unwrap();
+    c.fitted.as_mut().unwrap().1 = j;
+    c
+}
+
+#[test]
+fn extra_starts_only_where_the_familys_own_start_is_elsewhere() {
+    let registry = JitterRegistry::builtin();
+    // The winner: 2/gaussian at std 0.5. Periodic's finalist at the winner's order and
+    // within 10 % of its spread: no extra start; two-point's at a scale 40 % off: one.
+    let c = [
+        with_spread(screened(2, "gaussian", 1.0, true), 0.5),
+        with_spread(screened(2, "periodic", 2.0, true), 0.52),
+        with_spread(screened(2, "two-point", 3.0, true), 0.3),
+        screened(2, "none", 9.0, true),
+    ];
+    let jobs: Vec<usize> = likelihood::starts(&c, registry)
+        .iter()
+        .map(|j| j.0)
+        .collect();
+    assert_eq!(jobs, vec![0, 1, 2, 3, 2]);
+    // Periodic's finalist at another order: its candidate at the winner's order gets a start.
+    let c = [
+        with_spread(screened(2, "gaussian", 1.0, true), 0.5),
+        with_spread(screened(2, "periodic", 5.0, true), 0.5),
+        with_spread(screened(3, "periodic", 2.0, true), 0.5),
+    ];
+    let jobs: Vec<usize> = likelihood::starts(&c, registry)
+        .iter()
+        .map(|j| j.0)
+        .collect();
+    assert_eq!(jobs, vec![0, 2, 1]);
 }
 
 /// The mechanism of `cargo xtask reproduce select` on a few short records: with the jitter at
