@@ -136,14 +136,6 @@ pub fn bode_of(
     transfer_function_of(signal).map(|t| delayed_bode(&t, delay, freqs, covariance))
 }
 
-/// `Σ_ij g_i C_ij g_j`, the delta-method variance.
-fn quadratic(covariance: &[Vec<f64>], g: &[f64]) -> f64 {
-    g.iter()
-        .zip(covariance)
-        .map(|(gi, row)| gi * row.iter().zip(g).map(|(c, gj)| c * gj).sum::<f64>())
-        .sum()
-}
-
 /// The covariance without its delay row and column (`p + 1` rows for a delayed model of `p`
 /// parameters), checked to be square with that many rows.
 fn split_covariance(
@@ -187,8 +179,11 @@ fn delayed_bode<M: RationalModel>(
         phase.push(-360.0 * f);
         let mut magnitude: Vec<f64> = dlog.iter().map(|g| 20.0 / LN_10 * g.re).collect();
         magnitude.push(0.0);
-        let dm = BAND_SIGMAS * quadratic(c, &magnitude).max(0.0).sqrt();
-        let dp = BAND_SIGMAS * quadratic(c, &phase).max(0.0).sqrt();
+        let dm = BAND_SIGMAS
+            * validation::delta_method_variance(c, &magnitude)
+                .max(0.0)
+                .sqrt();
+        let dp = BAND_SIGMAS * validation::delta_method_variance(c, &phase).max(0.0).sqrt();
         point.magnitude_db_lo = Some(point.magnitude_db - dm);
         point.magnitude_db_hi = Some(point.magnitude_db + dm);
         point.phase_deg_lo = Some(point.phase_deg - dp);
@@ -224,16 +219,8 @@ fn delayed_step<M: RationalModel>(
         return validation::step_response(model, times, covariance);
     };
     let p = model.params().len();
-    split_covariance(covariance, p, true)?;
-    if let Some(c) = covariance {
-        if let Some(v) = c.iter().flatten().find(|v| !v.is_finite()) {
-            return Err(EstimateError::BadArgument {
-                name: "covariance",
-                value: *v,
-                reason: "every entry must be finite",
-            });
-        }
-    }
+    // The whole covariance, the delay's row and column included: `p + 1` square and finite.
+    validation::check_covariance(covariance, p + 1)?;
     let modal = model.modal();
     times
         .iter()
@@ -264,7 +251,8 @@ fn delayed_step<M: RationalModel>(
                 0.0
             };
             grad.push(-impulse);
-            let band = covariance.map(|c| BAND_SIGMAS * quadratic(c, &grad).max(0.0).sqrt());
+            let band = covariance
+                .map(|c| BAND_SIGMAS * validation::delta_method_variance(c, &grad).max(0.0).sqrt());
             Ok(StepPoint {
                 t,
                 value,
@@ -382,7 +370,7 @@ mod tests {
             // The phase relative to the base point's, so that no wrap enters the difference.
             let phase = |t: &[f64]| (by_hand(t, t[4], f) / reference).arg().to_degrees();
             let magnitude = |t: &[f64]| 20.0 * by_hand(t, t[4], f).norm().log10();
-            let sd = |g: Vec<f64>| BAND_SIGMAS * quadratic(&c, &g).sqrt();
+            let sd = |g: Vec<f64>| BAND_SIGMAS * validation::delta_method_variance(&c, &g).sqrt();
             let (dp, dm) = (sd(gradient(phase)), sd(gradient(magnitude)));
             let half = p.phase_deg_hi.unwrap() - p.phase_deg;
             assert!((half - dp).abs() < 1e-6 * dp, "f {f}: {half} vs {dp}");
@@ -420,7 +408,7 @@ mod tests {
                 continue;
             }
             let g = gradient(|t| step_at(t, p.t));
-            let sd = BAND_SIGMAS * quadratic(&c, &g).sqrt();
+            let sd = BAND_SIGMAS * validation::delta_method_variance(&c, &g).sqrt();
             let half = p.hi.unwrap() - p.value;
             assert!(
                 (half - sd).abs() < 1e-6 * sd.max(1e-9),

@@ -21,6 +21,6 @@ pub use fit_percent::fit_percent;
 pub use log_grid::log_spaced;
 pub use residuals::{standardized_residuals, Residuals};
 pub use response::{
-    bode, log_response_gradient, step_response, step_value_and_gradient, BodePoint, StepPoint,
-    BAND_SIGMAS,
+    bode, check_covariance, delta_method_variance, log_response_gradient, step_response,
+    step_value_and_gradient, BodePoint, StepPoint, BAND_SIGMAS,
 };

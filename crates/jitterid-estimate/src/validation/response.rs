@@ -43,8 +43,8 @@ pub struct StepPoint {
     pub hi: Option<f64>,
 }
 
-/// `Σ_ij g_i C_ij g_j`, the delta-method variance.
-fn quadratic(covariance: &[Vec<f64>], g: &[f64]) -> f64 {
+/// `Σ_ij g_i C_ij g_j`, the delta-method variance of a quantity with gradient `g`.
+pub fn delta_method_variance(covariance: &[Vec<f64>], g: &[f64]) -> f64 {
     g.iter()
         .zip(covariance)
         .map(|(gi, row)| gi * row.iter().zip(g).map(|(c, gj)| c * gj).sum::<f64>())
@@ -52,7 +52,10 @@ fn quadratic(covariance: &[Vec<f64>], g: &[f64]) -> f64 {
 }
 
 /// Checks that `covariance` is `p × p` and finite.
-fn check_covariance(covariance: Option<&[Vec<f64>]>, p: usize) -> Result<(), EstimateError> {
+///
+/// Errors: [`EstimateError::WrongParamCount`] for another shape, [`EstimateError::BadArgument`]
+/// naming the first entry that is not finite.
+pub fn check_covariance(covariance: Option<&[Vec<f64>]>, p: usize) -> Result<(), EstimateError> {
     let Some(c) = covariance else { return Ok(()) };
     if c.len() != p || c.iter().any(|row| row.len() != p) {
         return Err(EstimateError::WrongParamCount {
@@ -119,7 +122,7 @@ pub fn bode<M: RationalModel>(
         let band = |scale: f64, part: fn(&Complex64) -> f64| {
             covariance.map(|c| {
                 let grad: Vec<f64> = dlog.iter().map(|d| scale * part(d)).collect();
-                BAND_SIGMAS * quadratic(c, &grad).max(0.0).sqrt()
+                BAND_SIGMAS * delta_method_variance(c, &grad).max(0.0).sqrt()
             })
         };
         let dm = band(20.0 / LN_10, |d| d.re);
@@ -177,7 +180,8 @@ pub fn step_response<M: RationalModel>(
                 });
             }
             let (value, grad) = step_value_and_gradient(model, t);
-            let d = covariance.map(|c| BAND_SIGMAS * quadratic(c, &grad).max(0.0).sqrt());
+            let d =
+                covariance.map(|c| BAND_SIGMAS * delta_method_variance(c, &grad).max(0.0).sqrt());
             Ok(StepPoint {
                 t,
                 value,
