@@ -16,6 +16,7 @@ use crate::plots::{self, RecordPlot, ValidatePlots};
 use crate::whiten;
 use jitterid::estimate::validation::{self, BodePoint, CorrelationTest, StepPoint};
 use jitterid::estimate::{residual_flatness, NoiseModel};
+use jitterid::signal::registry::SignalRegistry;
 use jitterid::signal::{Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use serde::Serialize;
@@ -58,6 +59,10 @@ pub struct RecordReport {
     pub cross_correlation: Option<CorrelationTest>,
     /// Largest band power of the residual spectrum over the others (`null`: too few bins).
     pub flatness: Option<f64>,
+    /// A validation record's own initial state (`initial.*`, re-estimated on it with the system
+    /// held); absent for the estimation record and for a model without a free response.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<Vec<f64>>,
 }
 
 /// The JSON of `validate`.
@@ -200,6 +205,7 @@ fn check_record(
         whiteness,
         cross_correlation: cross,
         flatness,
+        initial_state: None,
     };
     Ok((report, cmp.expected))
 }
@@ -227,6 +233,50 @@ fn tested_residuals(
     .ok_or_else(|| {
         cli_err!("{name}: validation: the noise model's spectrum is not positive and finite")
     })
+}
+
+/// The fitted model on a validation record: driven by the record's input and, for a model with
+/// a free response, started from the record's own state, re-estimated on the record with the
+/// system held ([`validation::fit_initial_state`]): the state the estimation record started
+/// from says nothing about another record's.
+fn for_validation_record(
+    fitted: &Structure,
+    grid: &SampleGrid,
+    y: &[f64],
+    input: Option<&Input>,
+    name: &str,
+) -> CliResult<Structure> {
+    let mut spec = fitted.signal.spec();
+    let free = spec.contains_key("initial");
+    if !free && input.is_none() {
+        return Ok(fitted.clone());
+    }
+    if free {
+        // The free response's time origin is the record's first requested instant.
+        spec.insert("origin".into(), serde_json::json!(grid.time(0)));
+    }
+    let mut s = fitted.clone();
+    s.signal = SignalRegistry::builtin()
+        .build(&spec, input)
+        .map_err(|e| cli_err!("{name}: the model on the validation record: {e}"))?;
+    if !free {
+        return Ok(s);
+    }
+    validation::fit_initial_state(&s, grid, y)
+        .map_err(|e| cli_err!("{name}: the validation record's initial state: {e}"))
+}
+
+/// The free response's coefficients of a signal that has them.
+fn initial_state(signal: &jitterid::signal::AnySignal) -> Option<Vec<f64>> {
+    let names = signal.param_names();
+    let params = signal.params();
+    let q: Vec<f64> = names
+        .iter()
+        .zip(params)
+        .filter(|(n, _)| n.starts_with(validation::INITIAL_PREFIX))
+        .map(|(_, v)| v)
+        .collect();
+    (!q.is_empty()).then_some(q)
 }
 
 /// A validation record: its grid (the experiment's `T`, its own length and start) and samples.
@@ -418,15 +468,11 @@ pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
     let validation = match &o.validation {
         Some(path) => {
             let (grid, yv, name) = read_validation(&exp, path)?;
-            let mut s = fitted.clone();
             let u = record_input(&exp, path, &grid)?;
-            if let Some(u) = &u {
-                s.signal = fitted
-                    .signal
-                    .with_input(u)
-                    .map_err(|e| cli_err!("{name}: the validation input: {e}"))?;
-            }
-            let (report, expected) = check_record(&s, &grid, &yv, noise_std, u.as_ref(), &name)?;
+            let s = for_validation_record(&fitted, &grid, &yv, u.as_ref(), &name)?;
+            let (mut report, expected) =
+                check_record(&s, &grid, &yv, noise_std, u.as_ref(), &name)?;
+            report.initial_state = initial_state(&s.signal);
             Some((report, expected, grid, yv))
         }
         None => None,

@@ -180,8 +180,9 @@ fn the_fit_recovers_the_truth_within_three_standard_errors() {
 }
 
 /// Step 4: `validate` of the fitted model on both records: the residuals, whitened by the
-/// fitted noise model, pass the whiteness and cross-correlation tests, and the fit percents
-/// are those the page quotes (above 40 % on both records).
+/// fitted noise model, pass the whiteness and cross-correlation tests, the fit percents are
+/// those the page quotes (above 40 % on both records), and the validation record has its own
+/// initial state.
 #[test]
 fn validate_passes_on_both_records() {
     let dir = scratch_in("walkthrough", "validate");
@@ -218,6 +219,12 @@ fn validate_passes_on_both_records() {
         );
         assert!(r["fit_percent"].as_f64().unwrap() > 40.0, "{record}");
     }
+    // The validation record is compared from its own state (two coefficients, one per pole),
+    // re-estimated on it; the estimation record's state is the fit's parameters.
+    let q = v["validation"]["initial_state"].as_array().unwrap();
+    assert_eq!(q.len(), 2, "{q:?}");
+    assert!(q.iter().all(|x| x.as_f64().unwrap().is_finite()), "{q:?}");
+    assert!(v["estimation"].get("initial_state").is_none());
 }
 
 /// `fit --init auto` with an input delay: the initializer fits the response to the input

@@ -3,14 +3,14 @@
 //! Carlo spread of fitted models.
 
 use jitterid_estimate::validation::{
-    bode, cross_correlation, default_max_lag, log_response_gradient, standardized_residuals,
-    step_response, step_value_and_gradient, whiteness,
+    bode, cross_correlation, default_max_lag, fit_initial_state, log_response_gradient,
+    standardized_residuals, step_response, step_value_and_gradient, whiteness,
 };
 use jitterid_estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
 use jitterid_jitter::UniformSum;
 use jitterid_signal::{
-    simulate, Input, LtiResponse, RandomBinary, RationalModel, Root, SampleGrid, Signal,
-    TransferFunction, Zpk,
+    simulate, Input, LtiResponse, PiecewiseConstant, RandomBinary, RationalModel, Root, SampleGrid,
+    Signal, TransferFunction, WithInitialState, Zpk,
 };
 use rand::SeedableRng;
 
@@ -226,4 +226,71 @@ fn delta_method_band_matches_the_monte_carlo_spread() {
         (delta / spread - 1.0).abs() < 3.0 * rel_se,
         "delta-method σ {delta:.4} dB vs Monte Carlo spread {spread:.4} dB"
     );
+}
+
+/// A third-order response on 120 samples from an initial state `q`, under uniform-sum jitter.
+fn free_response_case(q: Vec<f64>) -> (SampleGrid, WithInitialState<LtiResponse<Zpk>>, UniformSum) {
+    let grid = SampleGrid::new(0.0, 1.0, 120).unwrap();
+    let input =
+        PiecewiseConstant::new(vec![0.0, 7.5, 23.2, 41.0, 130.0], vec![1.0, -0.5, 0.8, 0.2])
+            .unwrap();
+    let response = LtiResponse::new(third_order(), input);
+    let signal = WithInitialState::new(response, 0.0, q).unwrap();
+    (grid, signal, UniformSum::new(2, 0.4).unwrap())
+}
+
+#[test]
+fn a_records_own_initial_state_is_recovered_from_its_expected_samples() {
+    let q = vec![0.7, -1.1, 0.4];
+    let (grid, truth, jitter) = free_response_case(q.clone());
+    let y = truth.expected_values(&grid, &jitter);
+    // The model as fitted on another record: same system, another state.
+    let (_, other, _) = free_response_case(vec![-2.0, 0.5, 3.0]);
+    let fitted = fit_initial_state(&ModelStructure::oe(other, jitter), &grid, &y).unwrap();
+    let got = fitted.signal.initial();
+    for (g, w) in got.iter().zip(&q) {
+        assert!((g - w).abs() < 1e-9, "initial state {got:?}, truth {q:?}");
+    }
+    // The system's own parameters are held.
+    assert_eq!(
+        fitted.signal.response().model().params(),
+        truth.response().model().params()
+    );
+}
+
+#[test]
+fn the_fitted_initial_state_minimises_the_residual_sum_of_squares() {
+    let (grid, truth, jitter) = free_response_case(vec![0.7, -1.1, 0.4]);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let y = simulate(&truth, &jitter, &grid, 0.05, &mut rng).unwrap().y;
+    let s = ModelStructure::oe(truth.clone(), jitter);
+    let fitted = fit_initial_state(&s, &grid, &y).unwrap();
+    let rss = |q: &[f64]| {
+        let sig = WithInitialState::new(truth.response().clone(), 0.0, q.to_vec()).unwrap();
+        let m = sig.expected_values(&grid, &s.jitter);
+        y.iter().zip(&m).map(|(y, m)| (y - m).powi(2)).sum::<f64>()
+    };
+    let q = fitted.signal.initial().to_vec();
+    let best = rss(&q);
+    // Any step away from the least-squares state raises the sum (the normal equations are
+    // well conditioned: every mode is visible over the first 20 samples).
+    for j in 0..q.len() {
+        for h in [-1e-3, 1e-3] {
+            let mut p = q.clone();
+            p[j] += h;
+            assert!(rss(&p) > best, "q_{j} {h:+}: {} ≤ {best}", rss(&p));
+        }
+    }
+}
+
+#[test]
+fn a_signal_without_a_free_response_is_returned_unchanged() {
+    let (grid, truth, jitter) = free_response_case(vec![0.7, -1.1, 0.4]);
+    let s = ModelStructure::oe(truth.response().clone(), jitter);
+    let y = s.signal.expected_values(&grid, &s.jitter);
+    assert_eq!(fit_initial_state(&s, &grid, &y).unwrap(), s);
+    assert!(matches!(
+        fit_initial_state(&s, &grid, &y[1..]),
+        Err(jitterid_estimate::EstimateError::DataLength { .. })
+    ));
 }

@@ -2,12 +2,14 @@
 //! expected samples explain ([`fit_percent`], [`compare`]), whether its standardised residuals
 //! are white and unrelated to the input ([`standardized_residuals`], [`whiteness`],
 //! [`cross_correlation`]), and its frequency and step responses with delta-method confidence
-//! bands ([`bode`], [`step_response`]) on log-spaced grids ([`log_spaced`]).
+//! bands ([`bode`], [`step_response`]) on log-spaced grids ([`log_spaced`]). A validation
+//! record's own initial state, for a model with one, comes from [`fit_initial_state`].
 //! `docs/method.md` ("Validation") states the definitions.
 
 mod compare;
 mod correlation;
 mod fit_percent;
+mod initial;
 mod log_grid;
 mod residuals;
 mod response;
@@ -18,6 +20,7 @@ pub use correlation::{
     DEFAULT_MAX_LAG, LAG_ALPHA, TEST_ALPHA, Z_99,
 };
 pub use fit_percent::fit_percent;
+pub use initial::{fit_initial_state, INITIAL_PREFIX};
 pub use log_grid::log_spaced;
 pub use residuals::{standardized_residuals, Residuals};
 pub use response::{
