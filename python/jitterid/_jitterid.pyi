@@ -127,8 +127,11 @@ class System:
         self,
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """The controllable canonical realisation ``(A, B, C, D)``."""
+    @property
+    def delay(self) -> Optional[float]:
+        """The input delay ``D`` (s), ``None`` without one."""
     def frequency_response(self, f: npt.ArrayLike) -> npt.NDArray[np.complex128]:
-        """``G(i2πf)`` at ``f`` (Hz)."""
+        """``G(i2πf) e^{−i2πfD}`` at ``f`` (Hz), ``D`` the input delay (0 without one)."""
     def step(self, t: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """The unit-step response at ``t`` (s), exact."""
 

@@ -8,7 +8,7 @@ use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{TfForm, ZpkForm};
 use jitterid::signal::registry::{SignalRegistry, Spec};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
-use jitterid_cli::export::tf_of;
+use jitterid_cli::export::{delay_of, tf_of};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
@@ -182,15 +182,24 @@ impl System {
         ))
     }
 
-    /// `G(i2πf)` at frequencies `f` (Hz).
+    /// The input delay `D` (s) of a delayed system, `None` without one.
+    #[getter]
+    fn delay(&self) -> Option<f64> {
+        delay_of(&self.model)
+    }
+
+    /// `G(i2πf) e^{−i2πfD}` at frequencies `f` (Hz): the rational part times the input
+    /// delay's phase (`D = 0` without a delay), the response the step response is of.
     fn frequency_response<'py>(
         &self,
         py: Python<'py>,
         f: RealsIn<'py>,
     ) -> PyResult<Bound<'py, PyArrayDyn<Complex64>>> {
         let tf = self.rational()?;
+        let d = delay_of(&self.model).unwrap_or(0.0);
         Ok(map_reals(py, &f, |f| {
-            tf.response(Complex64::new(0.0, std::f64::consts::TAU * f))
+            let w = std::f64::consts::TAU * f;
+            tf.response(Complex64::new(0.0, w)) * Complex64::from_polar(1.0, -w * d)
         }))
     }
 

@@ -25,6 +25,18 @@ def test_frequency_response_equals_polynomial_evaluation():
     np.testing.assert_allclose(h.frequency_response(f), direct, rtol=1e-13)
 
 
+def test_a_delayed_system_has_the_delay_in_its_phase_and_its_step():
+    d = 1.3
+    gd = jitterid.system.from_name("zpk", gain=0.2, zeros=[-0.5], poles=[[-0.25, 0.3]], delay=d)
+    assert gd.delay == d and G.delay is None
+    f = np.linspace(0.0, 0.5, 11)
+    np.testing.assert_allclose(
+        gd.frequency_response(f), G.frequency_response(f) * np.exp(-2j * np.pi * f * d), rtol=1e-13
+    )
+    t = np.array([0.5, 1.3, 2.0, 7.7, 40.0])
+    np.testing.assert_allclose(gd.step(t), G.step(t - d), rtol=1e-12, atol=1e-15)
+
+
 def test_conversions_round_trip():
     num, den = G.tf_coefficients()
     np.testing.assert_allclose(num, [0.2, 0.1], rtol=1e-14)
