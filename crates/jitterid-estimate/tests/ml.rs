@@ -1005,3 +1005,48 @@ fn diag_sine_fisher() {
         (0..5).map(|i| acc[i][i]).collect::<Vec<_>>()
     );
 }
+
+/// A point whose quadrature would need more than `MAX_SAMPLE_NODES` nodes for a sample — a
+/// tiny noise level, a jitter reaching across a hundred input switches, a model nowhere near
+/// the samples — is a typed error, found quickly, not an evaluation that runs for minutes; a
+/// search that starts there reports it. The same model at the data's noise level evaluates.
+#[test]
+fn an_overlarge_quadrature_is_a_typed_error() {
+    let n = 300;
+    let grid = SampleGrid::new(0.0, 1.0, n).unwrap();
+    let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap();
+    let mut rng = StdRng::seed_from_u64(5);
+    let u = RandomBinary::new(1.0, 0.0, 1.0)
+        .unwrap()
+        .generate(-60.0, n as f64 + 60.0, &mut rng)
+        .unwrap();
+    let signal = LtiResponse::new(g, u);
+    let truth = UniformSum::new(0, 0.3).unwrap();
+    let data = simulate(&signal, &truth, &grid, 0.01, &mut rng).unwrap();
+    // The samples lifted far above anything the model produces.
+    let far: Vec<f64> = data.y.iter().map(|y| y + 100.0).collect();
+    let record = Record::new(grid, far).unwrap();
+    let wide = UniformSum::new(0, 50.0).unwrap();
+    let structure = ModelStructure::oe(signal.clone(), wide)
+        .with_estimated(false, true, false)
+        .with_noise_std(1e-12)
+        .unwrap();
+    let exact = ExactMl::default();
+    let tiny = exact.log_likelihoods(&structure, &record, 1e-12);
+    assert!(
+        matches!(
+            tiny,
+            Err(MlError::QuadratureTooLarge { limit: MAX_SAMPLE_NODES, noise_std })
+                if noise_std == 1e-12
+        ),
+        "{tiny:?}"
+    );
+    assert!(matches!(
+        ml_estimate(&structure, &record, &exact, &MlOptions::default()),
+        Err(MlError::QuadratureTooLarge { .. })
+    ));
+    // At a noise level of the signal's scale every sample's rule is small.
+    let structure = structure.with_noise_std(1.0).unwrap();
+    let lp = exact.log_likelihoods(&structure, &record, 1.0).unwrap();
+    assert!(lp.iter().all(|v| v.is_finite()));
+}

@@ -1,7 +1,10 @@
 //! The likelihood criteria as one trait, and the data they are evaluated on.
 
 use super::cheb::PiecewiseCheb;
-use super::exact::{signal_table, ExactMl, JitterPrep, SampleModel, Scratch, SignalEval};
+use super::exact::{
+    signal_table, ExactMl, JitterPrep, RuleTooLarge, SampleModel, Scratch, SignalEval,
+    MAX_SAMPLE_NODES,
+};
 use super::MlError;
 use crate::data::Record;
 use crate::noise::NoiseModel;
@@ -212,24 +215,36 @@ impl ExactMl {
         let glen = channels + 1;
         let one = |scratch: &mut Scratch, k: usize| {
             let y = record.y()[k];
+            let too_large = |_: RuleTooLarge| MlError::QuadratureTooLarge {
+                limit: MAX_SAMPLE_NODES,
+                noise_std: sigma,
+            };
             if want {
                 let mut g = vec![0.0; glen];
-                let lp = sm.log_p(grid.time(k), y, Some(&mut g), scratch);
-                (lp, Some(g))
+                let lp = sm
+                    .log_p(grid.time(k), y, Some(&mut g), scratch)
+                    .map_err(too_large)?;
+                Ok((lp, Some(g)))
             } else {
-                (sm.log_p(grid.time(k), y, None, scratch), None)
+                let lp = sm
+                    .log_p(grid.time(k), y, None, scratch)
+                    .map_err(too_large)?;
+                Ok((lp, None))
             }
         };
         let n = grid.len();
+        // Collected as a `Result`: the first over-large rule stops the other samples' work.
         let out: Vec<(f64, Option<Vec<f64>>)> = if self.parallel && n >= 64 {
             (0..n)
                 .into_par_iter()
                 .with_min_len(16)
                 .map_init(Scratch::default, one)
-                .collect()
+                .collect::<Result<_, MlError>>()?
         } else {
             let mut scratch = Scratch::default();
-            (0..n).map(|k| one(&mut scratch, k)).collect()
+            (0..n)
+                .map(|k| one(&mut scratch, k))
+                .collect::<Result<_, MlError>>()?
         };
         if let Some((index, (lp, _))) = out.iter().enumerate().find(|(_, (lp, _))| !lp.is_finite())
         {

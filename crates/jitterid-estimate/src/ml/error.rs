@@ -46,6 +46,18 @@ pub enum MlError {
         /// Duration `N·T` of the record (s).
         duration: f64,
     },
+    /// The exact likelihood's quadrature rule of a sample would hold more than `limit` nodes
+    /// ([`MAX_SAMPLE_NODES`](super::MAX_SAMPLE_NODES)): the noise level is tiny next to the
+    /// signal's range over the jitter's reach and the model passes nowhere near the sample, a
+    /// point of negligible likelihood that is not evaluated. (No sample index: which sample is
+    /// found first depends on how samples are shared between threads.)
+    #[error("the exact likelihood needs more than {limit} quadrature nodes for a sample: the noise level {noise_std} is too small for the signal's range over the jitter's reach")]
+    QuadratureTooLarge {
+        /// The bound.
+        limit: usize,
+        /// The measurement-noise level `σ_v` of the evaluation.
+        noise_std: f64,
+    },
     /// The exact likelihood needs a measurement-noise level `σ_v > 0`.
     #[error("the exact likelihood needs a measurement noise std > 0, got {value}")]
     NoNoise {

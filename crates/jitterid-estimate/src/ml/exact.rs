@@ -60,7 +60,9 @@
 //! the weights if that sum underflows, so `log p` is finite whenever one node carries a
 //! representable contribution. A sample whose likelihood is still zero is reported as
 //! [`MlError::LikelihoodUnderflow`]; `σ_v = 0` as [`MlError::NoNoise`]; a reach wider than the
-//! record as [`MlError::ReachExceedsRecord`].
+//! record as [`MlError::ReachExceedsRecord`]; a sample whose rule would hold more than
+//! [`MAX_SAMPLE_NODES`] nodes as [`MlError::QuadratureTooLarge`] (a search treats all of them
+//! as points outside the model's domain and steps back).
 
 use super::cheb::{basis, coefficients, PiecewiseCheb, CHEB_POINTS};
 use super::MlError;
@@ -123,6 +125,20 @@ impl ExactMl {
         pos("window", self.window)
     }
 }
+
+/// Most quadrature nodes the rule of one sample may hold. A sample needs many nodes only
+/// where the noise level is tiny next to the signal's range over the jitter's reach and the
+/// model passes nowhere near the sample (every sub-interval then gets its own rule, up to
+/// [`MAX_SUBDIVISIONS`] per interval, and a wide reach has many intervals): a point whose
+/// likelihood is astronomically small, which a search reaches only by an overlong trial step.
+/// This bound (`2¹⁸`, four times the most that one refined interval can hold; a fully refined
+/// sample of the `select` study at its estimate needs about 10³) caps the time and memory of one
+/// evaluation instead of letting such a trial point run for minutes.
+pub const MAX_SAMPLE_NODES: usize = 1 << 18;
+
+/// A sample's rule would exceed [`MAX_SAMPLE_NODES`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RuleTooLarge;
 
 /// A coarse interval with its Gauss–Legendre nodes and density-weighted weights.
 #[derive(Debug, Clone)]
@@ -360,7 +376,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         y: f64,
         grad: Option<&mut [f64]>,
         scratch: &mut Scratch,
-    ) -> f64 {
+    ) -> Result<f64, RuleTooLarge> {
         let jp = self.jitter;
         // Segment searches start afresh for every sample: a node on the boundary of two table
         // segments then takes the same segment whichever samples this thread saw before, so a
@@ -375,12 +391,12 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                     if let Some(g) = grad {
                         g.copy_from_slice(&scratch.ch[..g.len()]);
                     }
-                    return v;
+                    return Ok(v);
                 }
             }
         }
-        self.build_rule(t, y, &local, scratch);
-        self.sum(t, y, grad, scratch)
+        self.build_rule(t, y, &local, scratch)?;
+        Ok(self.sum(t, y, grad, scratch))
     }
 
     /// The range of `s(t + τ)` over the coarse nodes of the jitter (for the Fisher
@@ -604,7 +620,13 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         near
     }
 
-    fn build_rule(&self, t: f64, y: f64, local: &[f64], scratch: &mut Scratch) {
+    fn build_rule(
+        &self,
+        t: f64,
+        y: f64,
+        local: &[f64],
+        scratch: &mut Scratch,
+    ) -> Result<(), RuleTooLarge> {
         let jp = self.jitter;
         let res = self.opts.resolution * self.sigma;
         scratch.tau.clear();
@@ -642,6 +664,10 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         let steep = std::mem::take(&mut scratch.steep);
         for st in &steep {
             self.refine(t, st, !near, res, scratch);
+            if scratch.tau.len() > MAX_SAMPLE_NODES {
+                scratch.steep = steep;
+                return Err(RuleTooLarge);
+            }
         }
         scratch.steep = steep;
         for atom in &jp.atoms {
@@ -650,6 +676,7 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             let s = self.signal.value(t + atom.position, &mut scratch.sig_hint);
             scratch.s.push(s);
         }
+        Ok(())
     }
 
     /// Splits a steep interval into sub-intervals of signal range about `res` and pushes the

@@ -274,6 +274,10 @@ where
         .map(|(up, dn, d)| (up.as_ref().map(model), dn.as_ref().map(model), *d))
         .collect();
     let (gx, gw) = gl16();
+    let too_large = || MlError::QuadratureTooLarge {
+        limit: super::exact::MAX_SAMPLE_NODES,
+        noise_std: sigma,
+    };
     let per_sample = |k: usize| -> Result<(Vec<f64>, f64), MlError> {
         let t = grid.time(k);
         let mut scratch = Scratch::default();
@@ -290,7 +294,9 @@ where
             let mid = ya + (i as f64 + 0.5) * width;
             for (x, w) in gx.iter().zip(gw) {
                 let y = mid + 0.5 * width * x;
-                let lp = base.log_p(t, y, Some(&mut g), &mut scratch);
+                let lp = base
+                    .log_p(t, y, Some(&mut g), &mut scratch)
+                    .map_err(|_| too_large())?;
                 if !lp.is_finite() {
                     return Err(MlError::LikelihoodUnderflow {
                         index: k,
@@ -305,10 +311,12 @@ where
                 score[..layout.ns].copy_from_slice(&g[..layout.ns]);
                 for (j, (up, dn, denom)) in shifted.iter().enumerate() {
                     let f = |sm: &Option<SampleModel<'_, S>>, scratch: &mut Scratch| {
-                        sm.as_ref().map(|sm| sm.log_p(t, y, None, scratch))
+                        sm.as_ref()
+                            .map(|sm| sm.log_p(t, y, None, scratch).map_err(|_| too_large()))
+                            .transpose()
                     };
-                    let lu = f(up, &mut scratch).unwrap_or(lp);
-                    let ld = f(dn, &mut scratch).unwrap_or(lp);
+                    let lu = f(up, &mut scratch)?.unwrap_or(lp);
+                    let ld = f(dn, &mut scratch)?.unwrap_or(lp);
                     score[layout.ns + j] = (lu - ld) / denom;
                 }
                 if let Some(si) = layout.sigma_index() {

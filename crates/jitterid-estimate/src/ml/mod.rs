@@ -80,7 +80,7 @@ pub mod sine;
 
 pub use criterion::{Evaluation, GradientRequest, LikelihoodCriterion, LikelihoodData};
 pub use error::MlError;
-pub use exact::ExactMl;
+pub use exact::{ExactMl, MAX_SAMPLE_NODES};
 pub use fisher::{
     delta_method_std, exact_fisher, gaussian_fisher, FisherInformation, FisherOptions,
 };
