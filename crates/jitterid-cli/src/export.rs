@@ -3,15 +3,13 @@
 //! delay `D` of a delayed system (the model is `G(s) e^{−sD}`), and the covariance of the
 //! reported parameters.
 
-use jitterid::estimate::validation::{BodePoint, StepPoint, BAND_SIGMAS};
+use jitterid::estimate::validation::{BodePoint, StepPoint};
 use jitterid::estimate::{validation, EstimateError};
-use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
 use jitterid::signal::registry::{SignalRegistry, SpecReader};
 use jitterid::signal::RationalModel;
 use jitterid::signal::{AnySignal, SignalError, TransferFunction, Zpk};
 use serde::Serialize;
-use std::f64::consts::LN_10;
 
 /// The model in the three export forms.
 #[derive(Debug, Clone, Serialize)]
@@ -136,60 +134,17 @@ pub fn bode_of(
     transfer_function_of(signal).map(|t| delayed_bode(&t, delay, freqs, covariance))
 }
 
-/// The covariance without its delay row and column (`p + 1` rows for a delayed model of `p`
-/// parameters), checked to be square with that many rows.
-fn split_covariance(
-    covariance: Option<&[Vec<f64>]>,
-    p: usize,
-    delayed: bool,
-) -> Result<Option<Vec<Vec<f64>>>, EstimateError> {
-    let Some(c) = covariance else { return Ok(None) };
-    let n = p + usize::from(delayed);
-    if c.len() != n || c.iter().any(|row| row.len() != n) {
-        return Err(EstimateError::WrongParamCount {
-            expected: n,
-            got: c.iter().map(Vec::len).find(|&l| l != n).unwrap_or(c.len()),
-        });
-    }
-    Ok(Some(c[..p].iter().map(|r| r[..p].to_vec()).collect()))
-}
-
-/// [`validation::bode`] of `G`, then the delay's phase `−360 f D` degrees and its share of the
-/// phase band: `∂ arg/∂D = −2πf`, with the delay's variance and its covariance with `G`'s
-/// parameters (the magnitude does not depend on `D`).
+/// `G`'s Bode diagram, with the delay's phase and band for a delayed system.
 fn delayed_bode<M: RationalModel>(
     model: &M,
     delay: Option<f64>,
     freqs: &[f64],
     covariance: Option<&[Vec<f64>]>,
 ) -> Result<Vec<BodePoint>, EstimateError> {
-    let Some(d) = delay else {
-        return validation::bode(model, freqs, covariance);
-    };
-    let p = model.params().len();
-    let own = split_covariance(covariance, p, true)?;
-    let mut points = validation::bode(model, freqs, own.as_deref())?;
-    for point in &mut points {
-        let f = point.f_hz;
-        point.phase_deg -= 360.0 * f * d;
-        let Some(c) = covariance else { continue };
-        let (_, dlog) = validation::log_response_gradient(model, f);
-        let to_deg = 180.0 / std::f64::consts::PI;
-        let mut phase: Vec<f64> = dlog.iter().map(|g| to_deg * g.im).collect();
-        phase.push(-360.0 * f);
-        let mut magnitude: Vec<f64> = dlog.iter().map(|g| 20.0 / LN_10 * g.re).collect();
-        magnitude.push(0.0);
-        let dm = BAND_SIGMAS
-            * validation::delta_method_variance(c, &magnitude)
-                .max(0.0)
-                .sqrt();
-        let dp = BAND_SIGMAS * validation::delta_method_variance(c, &phase).max(0.0).sqrt();
-        point.magnitude_db_lo = Some(point.magnitude_db - dm);
-        point.magnitude_db_hi = Some(point.magnitude_db + dm);
-        point.phase_deg_lo = Some(point.phase_deg - dp);
-        point.phase_deg_hi = Some(point.phase_deg + dp);
+    match delay {
+        Some(d) => validation::delayed_bode(model, d, freqs, covariance),
+        None => validation::bode(model, freqs, covariance),
     }
-    Ok(points)
 }
 
 /// The unit-step response of a rational signal's system with delta-method bands; `None` for
@@ -207,65 +162,24 @@ pub fn step_of(
     transfer_function_of(signal).map(|t| delayed_step(&t, delay, times, covariance))
 }
 
-/// The step response `y_G(t − D)` with the band of `(∇_θ y_G(t − D), −h(t − D))`, `h = y_G'`
-/// the impulse response `Σ r_i e^{p_i t}` for `t > 0` (modal form).
+/// `G`'s step response, shifted by the delay (with its band) for a delayed system.
 fn delayed_step<M: RationalModel>(
     model: &M,
     delay: Option<f64>,
     times: &[f64],
     covariance: Option<&[Vec<f64>]>,
 ) -> Result<Vec<StepPoint>, EstimateError> {
-    let Some(d) = delay else {
-        return validation::step_response(model, times, covariance);
-    };
-    let p = model.params().len();
-    // The whole covariance, the delay's row and column included: `p + 1` square and finite.
-    validation::check_covariance(covariance, p + 1)?;
-    let modal = model.modal();
-    times
-        .iter()
-        .map(|&t| {
-            if !(t.is_finite() && t >= 0.0) {
-                return Err(EstimateError::BadArgument {
-                    name: "time",
-                    value: t,
-                    reason: "must be finite and >= 0",
-                });
-            }
-            let shifted = t - d;
-            let (value, mut grad) = if shifted >= 0.0 {
-                let (v, g) = validation::step_value_and_gradient(model, shifted);
-                (v, g)
-            } else {
-                (0.0, vec![0.0; p])
-            };
-            let impulse: f64 = if shifted > 0.0 {
-                modal
-                    .poles
-                    .iter()
-                    .zip(&modal.residues)
-                    .map(|(&pole, &r)| r * (pole * shifted).exp())
-                    .sum::<Complex64>()
-                    .re
-            } else {
-                0.0
-            };
-            grad.push(-impulse);
-            let band = covariance
-                .map(|c| BAND_SIGMAS * validation::delta_method_variance(c, &grad).max(0.0).sqrt());
-            Ok(StepPoint {
-                t,
-                value,
-                lo: band.map(|b| value - b),
-                hi: band.map(|b| value + b),
-            })
-        })
-        .collect()
+    match delay {
+        Some(d) => validation::delayed_step_response(model, d, times, covariance),
+        None => validation::step_response(model, times, covariance),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use jitterid::estimate::validation::BAND_SIGMAS;
+    use jitterid::num_complex::Complex64;
     use jitterid::signal::{Input, PiecewiseConstant};
     use serde_json::json;
 

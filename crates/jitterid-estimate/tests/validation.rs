@@ -294,3 +294,43 @@ fn a_signal_without_a_free_response_is_returned_unchanged() {
         Err(jitterid_estimate::EstimateError::DataLength { .. })
     ));
 }
+
+#[test]
+fn a_delay_turns_the_phase_and_shifts_the_step_and_bad_delays_are_named() {
+    use jitterid_estimate::validation::{delayed_bode, delayed_step_response};
+    let g = third_order();
+    let p = g.params().len();
+    let freqs = [0.01, 0.1, 0.3];
+    let plain = bode(&g, &freqs, None).unwrap();
+    let late = delayed_bode(&g, 2.5, &freqs, None).unwrap();
+    for (a, b) in late.iter().zip(&plain) {
+        assert!((a.phase_deg - (b.phase_deg - 360.0 * a.f_hz * 2.5)).abs() < 1e-9);
+        assert_eq!(a.magnitude_db, b.magnitude_db);
+    }
+    // With the delay's variance alone the phase band is ±2 · 360 f σ_D and the magnitude has
+    // none.
+    let mut c = vec![vec![0.0; p + 1]; p + 1];
+    c[p][p] = 0.04;
+    for q in delayed_bode(&g, 2.5, &freqs, Some(&c)).unwrap() {
+        let half = q.phase_deg_hi.unwrap() - q.phase_deg;
+        assert!((half - 2.0 * 360.0 * q.f_hz * 0.2).abs() < 1e-9, "{q:?}");
+        assert_eq!(q.magnitude_db_hi, Some(q.magnitude_db));
+    }
+    let times = [0.0, 1.0, 2.5, 4.0, 9.0];
+    let shifted = delayed_step_response(&g, 2.5, &times, None).unwrap();
+    let own = step_response(&g, &[0.0, 1.5, 6.5], None).unwrap();
+    assert_eq!((shifted[0].value, shifted[1].value), (0.0, 0.0));
+    for (a, b) in shifted[2..].iter().zip(&own) {
+        assert!((a.value - b.value).abs() < 1e-12);
+    }
+    for bad in [-1.0, f64::NAN] {
+        assert!(matches!(
+            delayed_bode(&g, bad, &freqs, None),
+            Err(jitterid_estimate::EstimateError::BadArgument { name: "delay", .. })
+        ));
+        assert!(delayed_step_response(&g, bad, &times, None).is_err());
+    }
+    // A covariance without the delay's row is refused, not read as G's alone.
+    let short = vec![vec![0.0; p]; p];
+    assert!(delayed_bode(&g, 2.5, &freqs, Some(&short)).is_err());
+}

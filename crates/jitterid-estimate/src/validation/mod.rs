@@ -2,12 +2,14 @@
 //! expected samples explain ([`fit_percent`], [`compare`]), whether its standardised residuals
 //! are white and unrelated to the input ([`standardized_residuals`], [`whiteness`],
 //! [`cross_correlation`]), and its frequency and step responses with delta-method confidence
-//! bands ([`bode`], [`step_response`]) on log-spaced grids ([`log_spaced`]). A validation
+//! bands ([`bode`], [`step_response`]; with an input delay [`delayed_bode`],
+//! [`delayed_step_response`]) on log-spaced grids ([`log_spaced`]). A validation
 //! record's own initial state, for a model with one, comes from [`fit_initial_state`].
 //! `docs/method.md` ("Validation") states the definitions.
 
 mod compare;
 mod correlation;
+mod delayed;
 mod fit_percent;
 mod initial;
 mod log_grid;
@@ -19,6 +21,7 @@ pub use correlation::{
     allowed_outside, cross_correlation, default_max_lag, whiteness, CorrelationTest,
     DEFAULT_MAX_LAG, LAG_ALPHA, TEST_ALPHA, Z_99,
 };
+pub use delayed::{delayed_bode, delayed_step_response};
 pub use fit_percent::fit_percent;
 pub use initial::{fit_initial_state, INITIAL_PREFIX};
 pub use log_grid::log_spaced;

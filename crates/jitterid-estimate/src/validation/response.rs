@@ -172,22 +172,38 @@ pub fn step_response<M: RationalModel>(
     times
         .iter()
         .map(|&t| {
-            if !(t.is_finite() && t >= 0.0) {
-                return Err(EstimateError::BadArgument {
-                    name: "time",
-                    value: t,
-                    reason: "must be finite and >= 0",
-                });
-            }
+            non_negative("time", t)?;
             let (value, grad) = step_value_and_gradient(model, t);
-            let d =
-                covariance.map(|c| BAND_SIGMAS * delta_method_variance(c, &grad).max(0.0).sqrt());
-            Ok(StepPoint {
-                t,
-                value,
-                lo: d.map(|d| value - d),
-                hi: d.map(|d| value + d),
-            })
+            Ok(step_point(t, value, &grad, covariance))
         })
         .collect()
+}
+
+/// An argument that must be finite and ≥ 0 (a time, a delay).
+pub(super) fn non_negative(name: &'static str, value: f64) -> Result<(), EstimateError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(EstimateError::BadArgument {
+            name,
+            value,
+            reason: "must be finite and >= 0",
+        })
+    }
+}
+
+/// The point at `t` with its band from the gradient `grad` and `covariance`.
+pub(super) fn step_point(
+    t: f64,
+    value: f64,
+    grad: &[f64],
+    covariance: Option<&[Vec<f64>]>,
+) -> StepPoint {
+    let d = covariance.map(|c| BAND_SIGMAS * delta_method_variance(c, grad).max(0.0).sqrt());
+    StepPoint {
+        t,
+        value,
+        lo: d.map(|d| value - d),
+        hi: d.map(|d| value + d),
+    }
 }
