@@ -286,13 +286,9 @@ pub fn truth_values(
         // After an input with a history the free response's coefficients are those of each
         // realisation's state at t0: no one truth.
         let names = signal_truth.param_names();
-        out.extend(
-            signal_truth
-                .params()
-                .into_iter()
-                .zip(&names)
-                .map(|(p, n)| (exp.history == 0.0 || !n.starts_with("initial.")).then_some(p)),
-        );
+        out.extend(signal_truth.params().into_iter().zip(&names).map(|(p, n)| {
+            (exp.history == 0.0 || !n.starts_with(jitterid::signal::INITIAL_PREFIX)).then_some(p)
+        }));
     }
     if s.estimate_jitter {
         let t = &exp.jitter.truth;

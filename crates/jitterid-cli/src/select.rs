@@ -19,7 +19,7 @@ use jitterid::estimate::{initial_model, InitError, InitOptions};
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::JitterModel;
 use jitterid::signal::registry::{roots_json, SignalRegistry, Spec};
-use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Root, TransferFunction, Zpk};
+use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -233,13 +233,8 @@ fn f64s(spec: &Spec, key: &str) -> Option<Vec<f64>> {
 /// delay. The initializer fits the frequency response from this input to the output, so that
 /// the rational model it returns does not carry the delay's phase a second time.
 fn delayed_input(input: &Input, delay: Option<f64>) -> Result<Input, String> {
-    match (input, delay) {
-        (Input::Piecewise(p), Some(d)) if d > 0.0 => {
-            let edges = p.edges().iter().map(|e| e + d).collect();
-            PiecewiseConstant::new(edges, p.levels().to_vec())
-                .map(Input::Piecewise)
-                .map_err(|e| e.to_string())
-        }
+    match delay {
+        Some(d) if d > 0.0 => input.delayed(d).map_err(|e| e.to_string()),
         _ => Ok(input.clone()),
     }
 }

@@ -315,7 +315,7 @@ fn system_covariance(s: &Structure, cov: Option<&[Vec<f64>]>) -> Option<Vec<Vec<
     let names = s.signal.param_names();
     let p = names
         .iter()
-        .take_while(|n| !n.starts_with("initial."))
+        .take_while(|n| !n.starts_with(validation::INITIAL_PREFIX))
         .count();
     let cov = cov?;
     (cov.len() >= p && cov.iter().take(p).all(|r| r.len() >= p))

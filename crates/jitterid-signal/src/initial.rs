@@ -52,6 +52,9 @@ pub struct WithInitialState<S> {
     initial: Vec<f64>,
 }
 
+/// Prefix of the names of the free response's coefficients: `initial.0 … initial.{n−1}`.
+pub const INITIAL_PREFIX: &str = "initial.";
+
 /// One representative mode (a real pole or the upper member of a pair) and what its
 /// coefficient `c = q(p)/A'(p)` depends on.
 struct Mode {
@@ -268,7 +271,7 @@ fn jitter_factors(jitter: &dyn JitterModel, p: Complex64) -> (Complex64, Complex
 impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
     fn param_names(&self) -> Vec<String> {
         let mut names = self.inner.param_names();
-        names.extend((0..self.initial.len()).map(|j| format!("initial.{j}")));
+        names.extend((0..self.initial.len()).map(|j| format!("{INITIAL_PREFIX}{j}")));
         names
     }
 

@@ -22,6 +22,24 @@ impl Input {
             Input::Tones(m) => m.value(t),
         }
     }
+
+    /// `u(t − delay)`: a piecewise-constant input with its edges moved `delay` seconds later
+    /// (what drives the rational part of a system with an input delay).
+    ///
+    /// # Errors
+    ///
+    /// [`SignalError::NotFinite`] for a NaN or infinite delay, [`SignalError::NeedsSteps`] for
+    /// tones (a tone's delay is a phase).
+    pub fn delayed(&self, delay: f64) -> Result<Input, SignalError> {
+        crate::error::finite("delay", delay)?;
+        match self {
+            Input::Piecewise(p) => {
+                let edges = p.edges.iter().map(|e| e + delay).collect();
+                PiecewiseConstant::new(edges, p.levels.clone()).map(Input::Piecewise)
+            }
+            Input::Tones(_) => Err(SignalError::NeedsSteps { what: "a delay" }),
+        }
+    }
 }
 
 impl From<PiecewiseConstant> for Input {

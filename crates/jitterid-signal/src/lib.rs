@@ -57,7 +57,7 @@ pub use any::AnySignal;
 pub use delay::Delayed;
 pub use error::SignalError;
 pub use grid::SampleGrid;
-pub use initial::{ModalSignal, WithInitialState};
+pub use initial::{ModalSignal, WithInitialState, INITIAL_PREFIX};
 pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone, MAX_SWITCHES};
 pub use lti::{LtiResponse, ModalState};
 pub use pulse::PulseResponse;

@@ -265,3 +265,24 @@ fn registry_builds_delay_and_initial_state() {
         assert_eq!(e.key(), Some(key), "{e}");
     }
 }
+
+#[test]
+fn a_delayed_input_is_the_input_moved_later_and_tones_are_refused() {
+    let u: jitterid_signal::Input = PiecewiseConstant::new(vec![0.0, 2.5, 7.0], vec![1.0, -0.5])
+        .unwrap()
+        .into();
+    let d = 1.3;
+    let late = u.delayed(d).unwrap();
+    for t in [-1.0, 0.0, 1.0, 1.3, 3.0, 3.8, 8.2, 8.3, 12.0] {
+        assert_eq!(late.value(t), u.value(t - d), "t = {t}");
+    }
+    assert!(matches!(
+        u.delayed(f64::NAN),
+        Err(SignalError::NotFinite { name: "delay", .. })
+    ));
+    let tones: jitterid_signal::Input = Multisine::sine(0.1, 1.0, 0.0).unwrap().into();
+    assert!(matches!(
+        tones.delayed(d),
+        Err(SignalError::NeedsSteps { .. })
+    ));
+}

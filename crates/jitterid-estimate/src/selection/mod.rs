@@ -38,7 +38,7 @@
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
 use jitterid_signal::registry::{SignalRegistry, Spec};
-use jitterid_signal::{AnySignal, Input, LtiResponse, PiecewiseConstant, Signal, TransferFunction};
+use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -252,19 +252,6 @@ fn structure_of(family: &str, signal: AnySignal, jitter: AnyJitter) -> Structure
     }
 }
 
-/// `input` delayed by `delay` seconds (a piecewise-constant input's edges moved later).
-fn delayed_input(input: &Input, delay: f64) -> Result<Input, String> {
-    match input {
-        Input::Piecewise(p) => {
-            let edges = p.edges().iter().map(|e| e + delay).collect();
-            PiecewiseConstant::new(edges, p.levels().to_vec())
-                .map(Input::Piecewise)
-                .map_err(|e| e.to_string())
-        }
-        Input::Tones(_) => Err("a delay needs an input made of steps, not tones".into()),
-    }
-}
-
 /// The candidate's signal: `model` driven by `input`, with the options' delay and free
 /// response from an unknown state at the record's first instant (coefficients at 0).
 fn candidate_signal(
@@ -306,7 +293,7 @@ fn fit_from(
     // The initializer fits the response to the input as the system sees it, so that the
     // rational model does not absorb the delay's phase as well.
     let driven = match options.delay {
-        Some(d) => delayed_input(input, d).map_err(|e| format!("delay: {e}"))?,
+        Some(d) => input.delayed(d).map_err(|e| format!("delay: {e}"))?,
         None => input.clone(),
     };
     let rational = ModelStructure::oe(LtiResponse::new(model, driven), jitter.clone());

@@ -3,10 +3,8 @@
 use crate::{EstimateError, ModelStructure, NoiseModel};
 use faer::Mat;
 use jitterid_jitter::JitterModel;
+pub use jitterid_signal::INITIAL_PREFIX;
 use jitterid_signal::{SampleGrid, Signal};
-
-/// Prefix of the parameters of a free response from an unknown initial state.
-pub const INITIAL_PREFIX: &str = "initial.";
 
 /// Singular values below this fraction of the largest are dropped: directions of the initial
 /// state that the record cannot see (a mode that has decayed before the first sample).
