@@ -129,9 +129,13 @@ pub(super) fn starts(
 
 /// Relative difference of jitter standard deviations below which a family's own BCLS fit is
 /// taken to start its likelihood fit where the winner's system would (the extra start is then
-/// skipped). A wrong BCLS basin of an oscillating `γ` lies near another zero of `J₀` or `cos`,
-/// at a scale far from the right one.
-const SAME_SPREAD: f64 = 0.1;
+/// skipped). A wrong BCLS basin of an oscillating `γ` lies near another zero of it, at a scale
+/// at least twice the right one: consecutive zeros of `J₀` (periodic) are at 2.405, 5.520, …
+/// (ratio 2.3), of `cos` (two-point) at π/2, 3π/2, … (ratio 3); a law whose `γ` has no zeros
+/// (Gaussian) has no such basins at all. Fits of different families in the right basin differ
+/// in spread by some 10–15 %, since each matches the first moment with its own `γ`; 25 % keeps
+/// those together and stays far below the factor between basins.
+const SAME_SPREAD: f64 = 0.25;
 
 /// An exact fit, the structure at its estimate and its BIC, or why it failed.
 type ExactFit = Result<(crate::Fit, Structure, f64), String>;

@@ -42,7 +42,7 @@ use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 use serde_json::json;
 
-use crate::validation::fit_percent;
+use crate::validation::{fit_initial_state, fit_percent};
 use crate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
 
 mod likelihood;
@@ -130,15 +130,27 @@ impl Candidate {
     /// The normalised fit percent ([`fit_percent`]) of the candidate's expected samples
     /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`; `None` for a
     /// failed candidate or where the fit percent is undefined (constant data). The fitted
-    /// delay is kept; a fitted free response is not (it is the estimation record's state, and
-    /// the validation record starts from its own).
+    /// delay is kept. A candidate with a free response starts from the validation record's own
+    /// state, re-estimated on that record with everything else held
+    /// ([`fit_initial_state`](crate::validation::fit_initial_state), as
+    /// `jitterid validate` does): the estimation record's state says nothing about another
+    /// record's.
     pub fn validation_fit(&self, record: &Record, input: &Input) -> Option<f64> {
         let (signal, jitter) = self.fitted.as_ref()?;
         let mut spec = signal.spec();
-        spec.remove("initial");
-        spec.remove("origin");
+        let free = spec.contains_key("initial");
+        if free {
+            // The free response's time origin is the record's first requested instant.
+            spec.insert("origin".into(), json!(record.grid().start()));
+        }
         let signal = SignalRegistry::builtin().build(&spec, Some(input)).ok()?;
-        let m = signal.expected_values(record.grid(), jitter);
+        let mut structure = ModelStructure::oe(signal, jitter.clone());
+        if free {
+            structure = fit_initial_state(&structure, record.grid(), record.y()).ok()?;
+        }
+        let m = structure
+            .signal
+            .expected_values(record.grid(), &structure.jitter);
         fit_percent(record.y(), &m).ok()
     }
 }
