@@ -125,18 +125,32 @@ impl Rational {
         let num = poly::pad(&num, n);
         let d_num: Vec<Vec<f64>> = d_num.iter().map(|d| poly::pad(d, n)).collect();
         let d_den: Vec<Vec<f64>> = d_den.iter().map(|d| poly::pad(d, n)).collect();
-        let da = poly::derivative(&den);
-        let dda = poly::derivative(&da);
         let dn = poly::derivative(&num);
         let np = d_num.len();
         let mut residues = Vec::with_capacity(poles.len());
         let mut d_poles = Vec::with_capacity(poles.len());
         let mut d_residues = Vec::with_capacity(poles.len());
-        for &p in &poles {
-            let a1 = poly::eval(&da, p);
+        for (i, &p) in poles.iter().enumerate() {
+            // `A'(p_i)` and `A''(p_i)` from the poles, `A = Π (s − p_l)`, not from the
+            // coefficients: near a repeated pole `A'(p_i)` is a small difference of large
+            // terms, and its value from the coefficients is not the one that makes the residues
+            // sum back to `N/A` (a relative error of `ε/|p_i − p_l|` in each residue, whose terms
+            // of size `1/|p_i − p_l|` then cancel to a wrong response). From the poles the
+            // partial fractions are exact for the poles as computed.
+            let others = || poles.iter().enumerate().filter(move |&(l, _)| l != i);
+            let a1: Complex64 = others().map(|(_, &q)| p - q).product();
+            // `A''(p_i) = 2 Σ_{l≠i} Π_{m≠i,l} (p_i − p_m)`, as products (exactly 2 for two poles).
+            let a2: Complex64 = 2.0
+                * others()
+                    .map(|(l, _)| {
+                        others()
+                            .filter(|&(m, _)| m != l)
+                            .map(|(_, &q)| p - q)
+                            .product::<Complex64>()
+                    })
+                    .sum::<Complex64>();
             let np_ = poly::eval(&num, p);
             let r = np_ / a1;
-            let a2 = poly::eval(&dda, p);
             let n1 = poly::eval(&dn, p);
             let mut dp = Vec::with_capacity(np);
             let mut dr = Vec::with_capacity(np);
