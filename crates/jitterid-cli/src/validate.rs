@@ -16,7 +16,6 @@ use crate::plots::{self, RecordPlot, ValidatePlots};
 use crate::whiten;
 use jitterid::estimate::validation::{self, BodePoint, CorrelationTest, StepPoint};
 use jitterid::estimate::{residual_flatness, NoiseModel};
-use jitterid::signal::registry::SignalRegistry;
 use jitterid::signal::{Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use serde::Serialize;
@@ -237,8 +236,8 @@ fn tested_residuals(
 
 /// The fitted model on a validation record: driven by the record's input and, for a model with
 /// a free response, started from the record's own state, re-estimated on the record with the
-/// system held ([`validation::fit_initial_state`]): the state the estimation record started
-/// from says nothing about another record's.
+/// system held ([`validation::on_record`]): the state the estimation record started from says
+/// nothing about another record's.
 fn for_validation_record(
     fitted: &Structure,
     grid: &SampleGrid,
@@ -246,24 +245,8 @@ fn for_validation_record(
     input: Option<&Input>,
     name: &str,
 ) -> CliResult<Structure> {
-    let mut spec = fitted.signal.spec();
-    let free = spec.contains_key("initial");
-    if !free && input.is_none() {
-        return Ok(fitted.clone());
-    }
-    if free {
-        // The free response's time origin is the record's first requested instant.
-        spec.insert("origin".into(), serde_json::json!(grid.time(0)));
-    }
-    let mut s = fitted.clone();
-    s.signal = SignalRegistry::builtin()
-        .build(&spec, input)
-        .map_err(|e| cli_err!("{name}: the model on the validation record: {e}"))?;
-    if !free {
-        return Ok(s);
-    }
-    validation::fit_initial_state(&s, grid, y)
-        .map_err(|e| cli_err!("{name}: the validation record's initial state: {e}"))
+    validation::on_record(fitted, grid, y, input)
+        .map_err(|e| cli_err!("{name}: the model on the validation record: {e}"))
 }
 
 /// The free response's coefficients of a signal that has them.

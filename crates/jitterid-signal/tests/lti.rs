@@ -361,9 +361,9 @@ fn nearly_repeated_poles_follow_the_closed_form() {
         let mut worst = 0.0f64;
         let tol = 1e-12 + 64.0 * f64::EPSILON / d;
         let zpk = Zpk::new(1.0, vec![], vec![Root::Real(-1.0), Root::Real(-1.0 - d)]).unwrap();
-        // The same model from its coefficients, whose computed roots are off by up to `√ε`
-        // near the double root; the residues of those roots still sum back to a polynomial
-        // within rounding of `A`.
+        // The same model from its coefficients: its polished roots are off by about `ε/d`
+        // near the double root, and the residues of those roots are the partial fractions of
+        // `Π (s − p_l)`, whose coefficients are within `ε/d` of `A`'s: inside the bound.
         let tf = TransferFunction::new(&[1.0], &[1.0, 2.0 + d, 1.0 + d]).unwrap();
         let responses: [(&str, Box<dyn Signal>); 2] = [
             ("zpk", Box::new(LtiResponse::new(zpk, u.clone()))),

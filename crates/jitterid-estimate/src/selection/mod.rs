@@ -42,7 +42,7 @@ use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 use serde_json::json;
 
-use crate::validation::{fit_initial_state, fit_percent};
+use crate::validation::{fit_percent, on_record};
 use crate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
 
 mod likelihood;
@@ -128,29 +128,20 @@ pub struct Candidate {
 
 impl Candidate {
     /// The normalised fit percent ([`fit_percent`]) of the candidate's expected samples
-    /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`; `None` for a
-    /// failed candidate or where the fit percent is undefined (constant data). The fitted
+    /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`. The fitted
     /// delay is kept. A candidate with a free response starts from the validation record's own
     /// state, re-estimated on that record with everything else held
-    /// ([`fit_initial_state`](crate::validation::fit_initial_state), as
-    /// `jitterid validate` does): the estimation record's state says nothing about another
-    /// record's.
+    /// ([`on_record`](crate::validation::on_record), as `jitterid validate` does): the
+    /// estimation record's state says nothing about another record's. `None` for a failed
+    /// candidate, where that re-estimation or the rebuilt model fails, or where the fit percent
+    /// is undefined (constant data).
     pub fn validation_fit(&self, record: &Record, input: &Input) -> Option<f64> {
         let (signal, jitter) = self.fitted.as_ref()?;
-        let mut spec = signal.spec();
-        let free = spec.contains_key("initial");
-        if free {
-            // The free response's time origin is the record's first requested instant.
-            spec.insert("origin".into(), json!(record.grid().start()));
-        }
-        let signal = SignalRegistry::builtin().build(&spec, Some(input)).ok()?;
-        let mut structure = ModelStructure::oe(signal, jitter.clone());
-        if free {
-            structure = fit_initial_state(&structure, record.grid(), record.y()).ok()?;
-        }
-        let m = structure
+        let fitted = ModelStructure::oe(signal.clone(), jitter.clone());
+        let carried = on_record(&fitted, record.grid(), record.y(), Some(input)).ok()?;
+        let m = carried
             .signal
-            .expected_values(record.grid(), &structure.jitter);
+            .expected_values(record.grid(), &carried.jitter);
         fit_percent(record.y(), &m).ok()
     }
 }

@@ -3,8 +3,9 @@
 use crate::{EstimateError, ModelStructure, NoiseModel};
 use faer::Mat;
 use jitterid_jitter::JitterModel;
+use jitterid_signal::registry::SignalRegistry;
 pub use jitterid_signal::INITIAL_PREFIX;
-use jitterid_signal::{SampleGrid, Signal};
+use jitterid_signal::{AnySignal, Input, SampleGrid, Signal};
 
 /// Singular values below this fraction of the largest are dropped: directions of the initial
 /// state that the record cannot see (a mode that has decayed before the first sample).
@@ -103,4 +104,40 @@ fn min_norm_lstsq(a: &Mat<f64>, b: &[f64]) -> Vec<f64> {
         }
     }
     x
+}
+
+/// A fitted structure carried over to another record `y` on `grid`: its signal driven by
+/// `input` (the fitted one's input when `None`) and, for a signal with a free response, that
+/// response's time origin moved to the record's first requested instant and its coefficients
+/// re-estimated on the record ([`fit_initial_state`]); every other parameter (system, delay,
+/// jitter, noise) is held. This is how a model fitted on one record is compared on another.
+///
+/// # Errors
+///
+/// Those of the signal registry rebuilding the signal with the new input (a kind that takes
+/// no such input, say) and those of [`fit_initial_state`].
+pub fn on_record<J, N>(
+    fitted: &ModelStructure<AnySignal, J, N>,
+    grid: &SampleGrid,
+    y: &[f64],
+    input: Option<&Input>,
+) -> Result<ModelStructure<AnySignal, J, N>, EstimateError>
+where
+    J: JitterModel + Clone,
+    N: NoiseModel + Clone,
+{
+    let mut spec = fitted.signal.spec();
+    let free = spec.contains_key("initial");
+    if !free && input.is_none() {
+        return Ok(fitted.clone());
+    }
+    if free {
+        spec.insert("origin".into(), serde_json::json!(grid.time(0)));
+    }
+    let mut carried = fitted.clone();
+    carried.signal = SignalRegistry::builtin().build(&spec, input)?;
+    if !free {
+        return Ok(carried);
+    }
+    fit_initial_state(&carried, grid, y)
 }

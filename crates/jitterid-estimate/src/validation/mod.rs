@@ -4,7 +4,8 @@
 //! [`cross_correlation`]), and its frequency and step responses with delta-method confidence
 //! bands ([`bode`], [`step_response`]; with an input delay [`delayed_bode`],
 //! [`delayed_step_response`]) on log-spaced grids ([`log_spaced`]). A validation
-//! record's own initial state, for a model with one, comes from [`fit_initial_state`].
+//! record's own initial state, for a model with one, comes from [`fit_initial_state`], and
+//! [`on_record`] carries a fitted model over to another record with its own input.
 //! `docs/method.md` ("Validation") states the definitions.
 
 mod compare;
@@ -23,7 +24,7 @@ pub use correlation::{
 };
 pub use delayed::{delayed_bode, delayed_step_response};
 pub use fit_percent::fit_percent;
-pub use initial::{fit_initial_state, INITIAL_PREFIX};
+pub use initial::{fit_initial_state, on_record, INITIAL_PREFIX};
 pub use log_grid::log_spaced;
 pub use residuals::{standardized_residuals, Residuals};
 pub use response::{
