@@ -131,7 +131,7 @@ impl Candidate {
     /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`. The fitted
     /// delay is kept. A candidate with a free response starts from the validation record's own
     /// state, re-estimated on that record with everything else held
-    /// ([`on_record`](crate::validation::on_record), as `jitterid validate` does): the
+    /// ([`on_record`], as `jitterid validate` does): the
     /// estimation record's state says nothing about another record's. `None` for a failed
     /// candidate, where that re-estimation or the rebuilt model fails, or where the fit percent
     /// is undefined (constant data).
