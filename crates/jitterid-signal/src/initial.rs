@@ -133,13 +133,7 @@ impl<S: ModalSignal> WithInitialState<S> {
                 Some(std::cmp::Ordering::Equal) => 1.0,
                 _ => continue,
             };
-            let mut a_prime = Complex64::new(1.0, 0.0);
-            for (l, &pl) in poles.iter().enumerate() {
-                if l != i {
-                    a_prime *= p - pl;
-                }
-            }
-            let r = a_prime.inv();
+            let r = crate::poly::derivative_at_root(poles, i).inv();
             // q(p) and q'(p) by Horner, highest power first.
             let (mut q, mut dq) = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
             for &qj in self.initial.iter().rev() {

@@ -9,6 +9,18 @@ pub fn eval(p: &[f64], z: Complex64) -> Complex64 {
         .fold(Complex64::new(0.0, 0.0), |acc, &c| acc * z + c)
 }
 
+/// `A'(r_i) = Π_{l≠i} (r_i − r_l)` of the monic polynomial `A = Π (z − r_l)` with these
+/// roots: from the roots, so that partial fractions over them sum back to `N/A` even where two
+/// roots nearly coincide (the coefficients' `A'` there is a small difference of large terms).
+pub(crate) fn derivative_at_root(roots: &[Complex64], i: usize) -> Complex64 {
+    roots
+        .iter()
+        .enumerate()
+        .filter(|&(l, _)| l != i)
+        .map(|(_, &r)| roots[i] - r)
+        .product()
+}
+
 /// The derivative's coefficients.
 pub fn derivative(p: &[f64]) -> Vec<f64> {
     let n = p.len().saturating_sub(1);

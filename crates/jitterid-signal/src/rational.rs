@@ -132,13 +132,11 @@ impl Rational {
         let mut d_residues = Vec::with_capacity(poles.len());
         for (i, &p) in poles.iter().enumerate() {
             // `A'(p_i)` and `A''(p_i)` from the poles, `A = Π (s − p_l)`, not from the
-            // coefficients: near a repeated pole `A'(p_i)` is a small difference of large
-            // terms, and its value from the coefficients is not the one that makes the residues
-            // sum back to `N/A` (a relative error of `ε/|p_i − p_l|` in each residue, whose terms
-            // of size `1/|p_i − p_l|` then cancel to a wrong response). From the poles the
-            // partial fractions are exact for the poles as computed.
+            // coefficients: near a repeated pole the coefficients' `A'(p_i)` is not the one that
+            // makes the residues sum back to `N/A` (a relative error of `ε/|p_i − p_l|` in each
+            // residue, whose terms of size `1/|p_i − p_l|` then cancel to a wrong response).
+            let a1 = poly::derivative_at_root(&poles, i);
             let others = || poles.iter().enumerate().filter(move |&(l, _)| l != i);
-            let a1: Complex64 = others().map(|(_, &q)| p - q).product();
             // `A''(p_i) = 2 Σ_{l≠i} Π_{m≠i,l} (p_i − p_m)`, as products (exactly 2 for two poles).
             let a2: Complex64 = 2.0
                 * others()
