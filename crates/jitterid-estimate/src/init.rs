@@ -76,7 +76,9 @@ use std::f64::consts::{PI, TAU};
 /// Singular values below this fraction of the largest make the linear fit rank deficient.
 const RANK_TOL: f64 = 1e-12;
 
-/// Relative separation given to poles that come out repeated (a [`Zpk`] needs distinct poles).
+/// Relative separation given to poles that come out repeated. A [`Zpk`] takes repeated poles
+/// (through its realisation rather than its modal form), but a start with distinct poles lets
+/// the search move each one; the reproduced starts depend on this value.
 const SEPARATION: f64 = 1e-6;
 
 /// Options of the initializer.

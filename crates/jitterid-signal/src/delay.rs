@@ -54,8 +54,8 @@ impl<M: RationalModel> Delayed<M> {
         self.delay
     }
 
-    /// The model's modal form (its poles do not depend on `delay`).
-    pub fn modal(&self) -> &Modal {
+    /// The model's modal form, where it has one (its poles do not depend on `delay`).
+    pub fn modal(&self) -> Option<&Modal> {
         self.inner.model().modal()
     }
 

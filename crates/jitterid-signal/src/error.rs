@@ -54,9 +54,9 @@ pub enum SignalError {
         /// The length given.
         got: usize,
     },
-    /// A pole with a non-negative real part: the model is not stable, so its spectrum and its
-    /// steady state are not defined.
-    #[error("pole {re}{im:+}i is not stable (its real part must be < 0)")]
+    /// A pole with a positive real part: the model is unstable. (Poles on the imaginary axis,
+    /// integrators and undamped modes, are accepted: a record is finite.)
+    #[error("pole {re}{im:+}i is unstable (its real part must be ≤ 0)")]
     Unstable {
         /// Real part of the pole.
         re: f64,
@@ -70,15 +70,6 @@ pub enum SignalError {
         zeros: usize,
         /// Number of poles (denominator degree).
         poles: usize,
-    },
-    /// Two poles coincide (within a relative `1e-9`); the modal form used for exact responses
-    /// needs distinct poles.
-    #[error("repeated pole near {re}{im:+}i: the exact response needs distinct poles")]
-    RepeatedPole {
-        /// Real part of the pole.
-        re: f64,
-        /// Imaginary part of the pole.
-        im: f64,
     },
     /// A complex pair was given with a non-positive imaginary part.
     #[error("complex pair `{name}` must have imaginary part > 0, got {value}")]

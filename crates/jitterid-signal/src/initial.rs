@@ -1,30 +1,36 @@
 //! The free response from an unknown state at the record's start, added to an LTI response.
 
+use crate::confluent::{dot, Confluent, FreeRows};
 use crate::delay::Delayed;
+use crate::expm::mat_vec;
 use crate::lti::LtiResponse;
-use crate::rational::{Modal, RationalModel};
+use crate::rational::{Modal, Rational, RationalModel};
 use crate::signal::{local_breaks, Jacobian, Signal};
 use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
 use num_complex::Complex64;
 
-/// A signal whose output is a rational model's response: its modal form gives the modes a
+/// A signal whose output is a rational model's response: its denominator gives the modes a
 /// free response is made of.
 pub trait ModalSignal: Signal {
-    /// The modal form of the model (poles and their derivatives with respect to this
-    /// signal's leading parameters).
-    fn modal(&self) -> &Modal;
+    /// The model (its derivatives are with respect to this signal's leading parameters).
+    fn rational(&self) -> &Rational;
+
+    /// The model's modal form, where it has one ([`Rational::modal`]).
+    fn modal(&self) -> Option<&Modal> {
+        self.rational().modal()
+    }
 }
 
 impl<M: RationalModel> ModalSignal for LtiResponse<M> {
-    fn modal(&self) -> &Modal {
-        self.model().modal()
+    fn rational(&self) -> &Rational {
+        self.model().rational()
     }
 }
 
 impl<M: RationalModel> ModalSignal for Delayed<M> {
-    fn modal(&self) -> &Modal {
-        Delayed::modal(self)
+    fn rational(&self) -> &Rational {
+        self.response().model().rational()
     }
 }
 
@@ -81,7 +87,7 @@ impl<S: ModalSignal> WithInitialState<S> {
     pub fn new(response: S, origin: f64, initial: Vec<f64>) -> Result<Self, SignalError> {
         crate::error::finite("origin", origin)?;
         crate::error::all_finite("initial", &initial)?;
-        let n = response.modal().poles.len();
+        let n = response.rational().poles().len();
         if initial.len() != n {
             return Err(SignalError::WrongLength {
                 name: "initial",
@@ -98,7 +104,7 @@ impl<S: ModalSignal> WithInitialState<S> {
 
     /// `response` from rest at `origin` (every `q_j = 0`), as a start for estimation.
     pub fn at_rest(response: S, origin: f64) -> Result<Self, SignalError> {
-        let n = response.modal().poles.len();
+        let n = response.rational().poles().len();
         Self::new(response, origin, vec![0.0; n])
     }
 
@@ -119,11 +125,27 @@ impl<S: ModalSignal> WithInitialState<S> {
 
     /// The free response alone, `f(t)`.
     pub fn free_value(&self, t: f64) -> f64 {
-        free_of(&self.modes(), t - self.origin)
+        self.free().value(t - self.origin)
     }
 
+    /// The free response's form: modes, or readouts of the model's realisation where it has
+    /// no modal form.
+    fn free(&self) -> Free {
+        match self.inner.modal() {
+            Some(_) => Free::Modes(self.modes()),
+            None => {
+                let cf = Confluent::new(self.inner.rational());
+                let rows = cf.free_rows(self.inner.rational(), &self.initial);
+                Free::Confluent(Box::new((cf, rows)))
+            }
+        }
+    }
+
+    /// The modes (empty for a model without a modal form).
     fn modes(&self) -> Vec<Mode> {
-        let m = self.inner.modal();
+        let Some(m) = self.inner.modal() else {
+            return Vec::new();
+        };
         let ni = self.inner.num_params();
         let poles = &m.poles;
         let mut out = Vec::new();
@@ -183,7 +205,12 @@ impl<S: ModalSignal> WithInitialState<S> {
         values: Option<&mut [f64]>,
         cols: Option<&mut Jacobian>,
     ) {
-        let modes = self.modes();
+        let modes = match self.free() {
+            Free::Modes(modes) => modes,
+            Free::Confluent(c) => {
+                return self.add_free_confluent(&c.0, &c.1, grid, jitter, values, cols)
+            }
+        };
         let ni = self.inner.num_params();
         let deltas: Vec<f64> = grid.times().map(|t| t - self.origin).collect();
         let mut e = vec![Complex64::new(0.0, 0.0); deltas.len()];
@@ -208,6 +235,64 @@ impl<S: ModalSignal> WithInitialState<S> {
                     add_re(col, m.w * b * m0, zero, &e, &deltas);
                 }
             }
+        }
+    }
+}
+
+impl<S: ModalSignal> WithInitialState<S> {
+    /// [`add_free`](Self::add_free) for a model without a modal form: every entry is a
+    /// readout of `w_k = E[e^{M(t_k + τ − t0)}] e_1 = e^{M(t_k − t0)} E[e^{Mτ}] e_1`, carried
+    /// along the grid by `e^{MT}`.
+    fn add_free_confluent(
+        &self,
+        cf: &Confluent,
+        rows: &FreeRows,
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+        mut values: Option<&mut [f64]>,
+        mut cols: Option<&mut Jacobian>,
+    ) {
+        let ni = self.inner.num_params();
+        let mean = cf.expected_from(jitter, &cf.impulse_state(0.0));
+        let carry = cf.carry(grid.interval());
+        let mut w = vec![0.0; mean.len()];
+        let mut next = w.clone();
+        for (k, t) in grid.times().enumerate() {
+            if k % RESTART == 0 {
+                // Restarted from a direct exponential, as the modes are.
+                mat_vec(&cf.carry(t - self.origin), &mean, &mut w);
+            } else {
+                mat_vec(&carry, &w, &mut next);
+                std::mem::swap(&mut w, &mut next);
+            }
+            if let Some(v) = values.as_deref_mut() {
+                v[k] += dot(&rows.value, &w);
+            }
+            if let Some(cols) = cols.as_deref_mut() {
+                let (inner, free) = cols.split_at_mut(ni);
+                for (col, row) in inner.iter_mut().zip(&rows.grads) {
+                    col[k] += dot(row, &w);
+                }
+                for (col, row) in free.iter_mut().zip(&rows.basis) {
+                    col[k] += dot(row, &w);
+                }
+            }
+        }
+    }
+}
+
+/// The free response: its modes, or the readouts of the model's realisation.
+enum Free {
+    Modes(Vec<Mode>),
+    Confluent(Box<(Confluent, FreeRows)>),
+}
+
+impl Free {
+    /// `f` at `delta = t − t0`.
+    fn value(&self, delta: f64) -> f64 {
+        match self {
+            Free::Modes(modes) => free_of(modes, delta),
+            Free::Confluent(c) => dot(&c.1.value, &c.0.impulse_state(delta)),
         }
     }
 }
@@ -300,6 +385,18 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
         self.inner.value_gradient(t, &mut grad[..ni]);
         grad[ni..].iter_mut().for_each(|g| *g = 0.0);
         let delta = t - self.origin;
+        if let Free::Confluent(c) = self.free() {
+            let (cf, rows) = &*c;
+            let z = cf.impulse_state(delta);
+            let (inner, free) = grad.split_at_mut(ni);
+            for (g, row) in inner.iter_mut().zip(&rows.grads) {
+                *g += dot(row, &z);
+            }
+            for (g, row) in free.iter_mut().zip(&rows.basis) {
+                *g += dot(row, &z);
+            }
+            return;
+        }
         for m in self.modes() {
             let e = (m.p * delta).exp();
             let (inner, free) = grad.split_at_mut(ni);
@@ -346,7 +443,11 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
 
     fn expected_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
         let mut sq = self.inner.expected_squares(grid, jitter);
-        let modes = self.modes();
+        let free = self.free();
+        let modes = match &free {
+            Free::Modes(modes) => modes.as_slice(),
+            Free::Confluent(_) => &[],
+        };
         let breaks = self.inner.breakpoints();
         let (lo, hi) = jitter.reach();
         let mut smooth = None;
@@ -359,7 +460,8 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
                 .map(|m| m.w * m.c.norm() * (m.p.re * (t + lo - self.origin)).exp())
                 .sum();
             let extra_bound = 2.0 * bound * sq[k].max(0.0).sqrt() + bound * bound;
-            if extra_bound <= 1e-17 * sq[k] || bound == 0.0 {
+            let modal = matches!(free, Free::Modes(_));
+            if modal && (extra_bound <= 1e-17 * sq[k] || bound == 0.0) {
                 continue;
             }
             let local = local_breaks(&breaks, t, lo, hi);
@@ -371,7 +473,7 @@ impl<S: ModalSignal + Clone> Signal for WithInitialState<S> {
                 &cut
             };
             sq[k] += rule.expect(|tau| {
-                let f = free_of(&modes, t + tau - self.origin);
+                let f = free.value(t + tau - self.origin);
                 f * (2.0 * self.inner.value(t + tau) + f)
             });
         }

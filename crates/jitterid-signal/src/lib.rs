@@ -35,8 +35,10 @@
 #![warn(missing_docs)]
 
 mod any;
+mod confluent;
 mod delay;
 mod error;
+mod expm;
 pub mod forms;
 mod grid;
 mod initial;

@@ -1,5 +1,6 @@
 //! The exact response of a rational model to a known input, and its exact jittered moments.
 
+use crate::confluent::Confluent;
 use crate::input::Input;
 use crate::rational::{Modal, RationalModel};
 use crate::reach::{InReach, Route, SquaresRule};
@@ -45,6 +46,9 @@ pub struct LtiResponse<M> {
     /// The modal state right after every step, so that `s(t)` and its gradient cost
     /// `O(log J + poles)`. Built on the first evaluation in time: estimation never needs it.
     prefix: OnceLock<Prefix>,
+    /// For a model without a modal form: its realisation and the state right after every
+    /// step, built on the first evaluation in time.
+    confluent: OnceLock<(Confluent, Vec<f64>)>,
 }
 
 impl<M: RationalModel> LtiResponse<M> {
@@ -60,14 +64,25 @@ impl<M: RationalModel> LtiResponse<M> {
             input,
             steps,
             prefix: OnceLock::new(),
+            confluent: OnceLock::new(),
         }
+    }
+
+    /// The realisation used where the model has no modal form ([`Confluent`]), with the
+    /// state right after every step.
+    fn confluent_prefix(&self) -> &(Confluent, Vec<f64>) {
+        self.confluent.get_or_init(|| {
+            let cf = Confluent::new(self.model.rational());
+            let prefix = cf.prefix(&self.steps);
+            (cf, prefix)
+        })
     }
 
     fn prefix_states(&self) -> Prefix {
         let poles: Vec<Complex64> = self
             .representatives()
             .iter()
-            .map(|&(i, _)| self.modal().poles[i])
+            .map(|&(i, _)| self.modal_poles()[i])
             .collect();
         let np = poles.len();
         let zero = Complex64::new(0.0, 0.0);
@@ -105,11 +120,15 @@ impl<M: RationalModel> LtiResponse<M> {
     /// `s(t) = G(0) u(t) + Σ_i w_i Re((r_i/p_i) x_i(t))` (`w_i = 2` for a pair, 1 for a real pole).
     ///
     /// `O(log J + poles)` per instant, from states tabulated once per model at the input's
-    /// steps. `None` for a tone input (whose response is a closed form in `t`).
+    /// steps. `None` for a tone input (whose response is a closed form in `t`) and for a
+    /// model without a modal form (repeated poles, integrators: [`Rational::modal`]).
+    ///
+    /// [`Rational::modal`]: crate::Rational::modal
     pub fn state(&self, t: f64) -> Option<ModalState> {
         let Input::Piecewise(_) = self.input else {
             return None;
         };
+        self.modal()?;
         let reps = self.representatives();
         let np = reps.len();
         let zero = Complex64::new(0.0, 0.0);
@@ -131,7 +150,7 @@ impl<M: RationalModel> LtiResponse<M> {
             y: Vec::with_capacity(np),
         };
         for (k, &(i, _)) in reps.iter().enumerate() {
-            let e = (self.modal().poles[i] * dt).exp();
+            let e = (self.modal_poles()[i] * dt).exp();
             state.x.push(e * x0[k]);
             state.y.push(e * (y0[k] + dt * x0[k]));
         }
@@ -142,11 +161,17 @@ impl<M: RationalModel> LtiResponse<M> {
     /// piecewise-constant input: what a composite model (a static nonlinearity of this response)
     /// needs at each instant.
     pub fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
+        if let (Input::Piecewise(_), None) = (&self.input, self.modal()) {
+            let (cf, prefix) = self.confluent_prefix();
+            return cf.value_at(&self.steps, prefix, t, Some(grad));
+        }
         let Some(state) = self.state(t) else {
             self.value_gradient(t, grad);
             return self.value(t);
         };
-        let m = self.modal();
+        let Some(m) = self.modal() else {
+            return 0.0;
+        };
         let reps = self.representatives();
         let mut s = m.dc_gain * state.level;
         for (&(i, w), x) in reps.iter().zip(&state.x) {
@@ -171,8 +196,14 @@ impl<M: RationalModel> LtiResponse<M> {
     /// `ṡ(t)` for a piecewise-constant input, away from the input's steps: `Σ_i r_i x_i(t)`
     /// (the feed-through's jumps at the steps are left out). `None` for a tone input.
     pub fn rate_at(&self, t: f64) -> Option<f64> {
+        let Input::Piecewise(_) = self.input else {
+            return None;
+        };
+        let Some(m) = self.modal() else {
+            let (cf, prefix) = self.confluent_prefix();
+            return Some(cf.rate_at(&self.steps, prefix, t));
+        };
         let state = self.state(t)?;
-        let m = self.modal();
         Some(
             self.representatives()
                 .iter()
@@ -192,25 +223,34 @@ impl<M: RationalModel> LtiResponse<M> {
         let Input::Piecewise(_) = self.input else {
             return None;
         };
-        let m = self.modal();
-        let reps = self.representatives();
-        let mut out = Vec::with_capacity(grid.len());
-        self.modal_expectations(grid, jitter, &reps, false, |_, a, _| {
-            out.push(
-                reps.iter()
-                    .zip(a)
-                    .map(|(&(i, w), a)| w * (m.residues[i] * a).re)
-                    .sum(),
-            );
-        });
-        if m.direct != 0.0 {
+        let (mut out, direct) = match self.modal() {
+            Some(m) => {
+                let reps = self.representatives();
+                let mut out = Vec::with_capacity(grid.len());
+                self.modal_expectations(grid, jitter, &reps, false, |_, a, _| {
+                    out.push(
+                        reps.iter()
+                            .zip(a)
+                            .map(|(&(i, w), a)| w * (m.residues[i] * a).re)
+                            .sum(),
+                    );
+                });
+                (out, m.direct)
+            }
+            None => {
+                let (cf, _) = self.confluent_prefix();
+                let direct = self.model.rational().num()[0];
+                (cf.expected_rates(&self.steps, grid, jitter), direct)
+            }
+        };
+        if direct != 0.0 {
             let (lo, hi) = jitter.reach();
             self.walk(grid, lo, hi, &[], false, |k, t, _, _, _, in_reach| {
                 let jumps: f64 = in_reach
                     .iter()
                     .map(|&(tj, du)| du * jitter.pdf(tj - t))
                     .sum();
-                out[k] += m.direct * jumps;
+                out[k] += direct * jumps;
             });
         }
         Some(out)
@@ -231,15 +271,19 @@ impl<M: RationalModel> LtiResponse<M> {
         &self.steps
     }
 
-    fn modal(&self) -> &Modal {
+    fn modal(&self) -> Option<&Modal> {
         self.model.modal()
+    }
+
+    /// The modal form, in the routes taken only when there is one (empty without).
+    fn modal_poles(&self) -> &[Complex64] {
+        self.modal().map_or(&[], |m| &m.poles)
     }
 
     /// One representative per conjugate pair (upper half plane) and each real pole, with its
     /// multiplicity in `Re Σ`: the sum over all poles of a real quantity is `Σ w·Re(term)`.
     fn representatives(&self) -> Vec<(usize, f64)> {
-        self.modal()
-            .poles
+        self.modal_poles()
             .iter()
             .enumerate()
             .filter_map(|(i, p)| match p.im.partial_cmp(&0.0) {
@@ -268,7 +312,7 @@ impl<M: RationalModel> LtiResponse<M> {
         with_b: bool,
         mut visit: impl FnMut(f64, &[Complex64], &[Complex64]),
     ) {
-        let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| self.modal().poles[i]).collect();
+        let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| self.modal_poles()[i]).collect();
         let np = poles.len();
         let (lo, hi) = jitter.reach();
         let mut queries = 0;
@@ -376,7 +420,10 @@ impl<M: RationalModel> LtiResponse<M> {
     /// needs too many nodes (a fast, lightly damped pole: `|p|/|Re p|` nodes per piece), the
     /// square is expanded instead ([`squares_by_expansion`](Self::squares_by_expansion)).
     fn piecewise_squares(&self, grid: &SampleGrid, jitter: &dyn JitterModel) -> Vec<f64> {
-        let m = self.modal();
+        let Some(m) = self.modal() else {
+            let (cf, _) = self.confluent_prefix();
+            return cf.expected_squares(&self.steps, grid, jitter);
+        };
         let reps = self.representatives();
         let poles: Vec<Complex64> = reps.iter().map(|&(i, _)| m.poles[i]).collect();
         let coef: Vec<Complex64> = reps
@@ -448,7 +495,7 @@ impl<M: RationalModel> LtiResponse<M> {
         poles: &[Complex64],
         coef: &[Complex64],
     ) -> Vec<f64> {
-        let dc = self.modal().dc_gain;
+        let dc = self.modal().map_or(0.0, |m| m.dc_gain);
         let np = poles.len();
         let pairs: Vec<(usize, usize)> =
             (0..np).flat_map(|i| (i..np).map(move |j| (i, j))).collect();
@@ -652,6 +699,7 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
             input: self.input.clone(),
             steps: self.steps.clone(),
             prefix: OnceLock::new(),
+            confluent: OnceLock::new(),
         })
     }
 
@@ -670,7 +718,10 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
                 if j == 0 {
                     return 0.0;
                 }
-                let m = self.modal();
+                let Some(m) = self.modal() else {
+                    let (cf, prefix) = self.confluent_prefix();
+                    return cf.value_at(&self.steps, prefix, t, None);
+                };
                 let reps = self.representatives();
                 let prefix = self.prefix.get_or_init(|| self.prefix_states());
                 let x = &prefix.x[(j - 1) * reps.len()..j * reps.len()];
@@ -710,7 +761,7 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     }
 
     fn rate(&self) -> f64 {
-        let poles = self.modal().poles.iter().map(|p| p.norm());
+        let poles = self.model.rational().poles().iter().map(|p| p.norm());
         let tones = match &self.input {
             Input::Tones(m) => m.tones().iter().map(|c| TAU * c.frequency).collect(),
             Input::Piecewise(_) => Vec::new(),
@@ -729,7 +780,10 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         if let Input::Tones(_) = self.input {
             return self.tones_expectation(grid, jitter, None);
         }
-        let m = self.modal();
+        let Some(m) = self.modal() else {
+            let (cf, _) = self.confluent_prefix();
+            return cf.expected_values(&self.steps, grid, jitter);
+        };
         let reps = self.representatives();
         let coef = value_terms(m, &reps);
         let mut out = Vec::with_capacity(grid.len());
@@ -746,7 +800,10 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
             self.tones_expectation(grid, jitter, Some(&mut cols));
             return cols;
         }
-        let m = self.modal();
+        let Some(m) = self.modal() else {
+            let (cf, _) = self.confluent_prefix();
+            return cf.expected_values_and_gradient(&self.steps, grid, jitter).1;
+        };
         let reps = self.representatives();
         let terms = gradient_terms(m, &reps, np);
         let mut cols: Jacobian = (0..np).map(|_| Vec::with_capacity(grid.len())).collect();
@@ -768,7 +825,10 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
             );
         }
         let np = self.model.params().len();
-        let m = self.modal();
+        let Some(m) = self.modal() else {
+            let (cf, _) = self.confluent_prefix();
+            return cf.expected_values_and_gradient(&self.steps, grid, jitter);
+        };
         let reps = self.representatives();
         let coef = value_terms(m, &reps);
         let terms = gradient_terms(m, &reps, np);
@@ -960,7 +1020,7 @@ mod tests {
     }
 
     fn parts_of<M: RationalModel>(s: &LtiResponse<M>) -> (Vec<Complex64>, Vec<Complex64>) {
-        let m = s.modal();
+        let m = s.modal().unwrap();
         let reps = s.representatives();
         (
             reps.iter().map(|&(i, _)| m.poles[i]).collect(),

@@ -1,16 +1,29 @@
 //! Proper, stable continuous-time transfer functions `G(s) = N(s)/A(s)` in two
 //! parameterisations, and their modal (partial-fraction) form with parameter derivatives.
 
+use crate::confluent::Confluent;
 use crate::error::{all_finite, finite, tf_coefficients, SignalError};
 use crate::poly;
 use num_complex::Complex64;
 use std::fmt;
 
-/// Relative distance below which two poles count as repeated.
-const REPEATED_POLE_TOL: f64 = 1e-9;
+/// Relative distance (to the larger of `|p|` and 1) below which two poles are taken as
+/// repeated, and the response goes by the confluent route instead of the modal form: the
+/// modal form's rounding error grows like `ε/gap` in `s` and `ε/gap²` in its gradient, which at
+/// this gap are `2e-12` and `2e-8` of the response's scale.
+const CONFLUENT_GAP: f64 = 1e-4;
+
+/// Relative real part (to the larger of `|p|` and 1) within which a pole counts as on the
+/// imaginary axis (marginally stable: an integrator, an undamped oscillator). Beyond it on the
+/// right a pole is unstable.
+const MARGINAL: f64 = 1e-9;
 
 /// The modal form `G(s) = D + Σ_i r_i / (s − p_i)` over all poles (conjugate pairs appear as
 /// two entries), with derivatives of `D`, `p_i`, `r_i` and `G(0)` with respect to each parameter.
+///
+/// It exists for models whose poles are distinct and strictly stable
+/// ([`Rational::modal`]); the others (repeated poles, integrators) are evaluated through a
+/// state-space realisation instead.
 ///
 /// Derived from a [`Rational`] (serialized, not deserialized: read the rational model instead).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -45,7 +58,8 @@ pub struct Rational {
     den: Vec<f64>,
     d_num: Vec<Vec<f64>>,
     d_den: Vec<Vec<f64>>,
-    modal: Modal,
+    poles: Vec<Complex64>,
+    modal: Option<Modal>,
 }
 
 impl Rational {
@@ -54,7 +68,8 @@ impl Rational {
     /// `d_num[j]`, `d_den[j]` are the derivatives of the coefficients with respect to parameter
     /// `j` (one pair per parameter, each no longer than its polynomial, right-aligned: a
     /// shorter row is padded with leading zeros; `A` stays monic, so a row of `d_den` as long
-    /// as `A` has a leading 0). The poles are the roots of `A`, which must be stable and distinct.
+    /// as `A` has a leading 0). The poles are the roots of `A`: stable or on the imaginary
+    /// axis (integrators, undamped modes), distinct or repeated.
     pub fn new(
         num: Vec<f64>,
         den: Vec<f64>,
@@ -110,21 +125,31 @@ impl Rational {
         d_den: Vec<Vec<f64>>,
     ) -> Result<Self, SignalError> {
         for p in &poles {
-            if p.re >= 0.0 || p.re.is_nan() {
+            if p.re > MARGINAL * p.norm().max(1.0) || p.re.is_nan() {
                 return Err(SignalError::Unstable { re: p.re, im: p.im });
             }
         }
-        for (i, p) in poles.iter().enumerate() {
-            for q in &poles[i + 1..] {
-                if (p - q).norm() <= REPEATED_POLE_TOL * p.norm().max(1.0) {
-                    return Err(SignalError::RepeatedPole { re: p.re, im: p.im });
-                }
-            }
-        }
+        // The modal form only where it is accurate: strictly stable, well separated poles.
+        let modal_form = poles.iter().all(|p| p.re < -MARGINAL * p.norm().max(1.0))
+            && poles.iter().enumerate().all(|(i, p)| {
+                poles[i + 1..]
+                    .iter()
+                    .all(|q| (p - q).norm() > CONFLUENT_GAP * p.norm().max(q.norm()).max(1.0))
+            });
         let n = den.len();
         let num = poly::pad(&num, n);
         let d_num: Vec<Vec<f64>> = d_num.iter().map(|d| poly::pad(d, n)).collect();
         let d_den: Vec<Vec<f64>> = d_den.iter().map(|d| poly::pad(d, n)).collect();
+        if !modal_form {
+            return Ok(Self {
+                num,
+                den,
+                d_num,
+                d_den,
+                poles,
+                modal: None,
+            });
+        }
         let dn = poly::derivative(&num);
         let np = d_num.len();
         let mut residues = Vec::with_capacity(poles.len());
@@ -172,7 +197,7 @@ impl Rational {
             .collect();
         let modal = Modal {
             direct: num[0],
-            poles,
+            poles: poles.clone(),
             residues,
             dc_gain,
             d_poles,
@@ -188,7 +213,8 @@ impl Rational {
             den,
             d_num,
             d_den,
-            modal,
+            poles,
+            modal: Some(modal),
         })
     }
 
@@ -206,9 +232,64 @@ impl Rational {
         }
     }
 
-    /// The modal form.
-    pub fn modal(&self) -> &Modal {
-        &self.modal
+    /// The modal form, for distinct and strictly stable poles; `None` for a model with a
+    /// repeated (or nearly repeated) pole or a pole on the imaginary axis, whose responses go
+    /// through a state-space realisation.
+    pub fn modal(&self) -> Option<&Modal> {
+        self.modal.as_ref()
+    }
+
+    /// The poles, the roots of the denominator (conjugate pairs as two entries).
+    pub fn poles(&self) -> &[Complex64] {
+        &self.poles
+    }
+
+    /// `∂N/∂θ_j`, coefficients padded to the denominator's length.
+    pub(crate) fn d_num(&self) -> &[Vec<f64>] {
+        &self.d_num
+    }
+
+    /// `∂A/∂θ_j`, coefficients (with a leading 0: `A` stays monic).
+    pub(crate) fn d_den(&self) -> &[Vec<f64>] {
+        &self.d_den
+    }
+
+    /// The unit-step response `t ≥ 0` after the step from rest, and its gradient into `grad`
+    /// (one entry per parameter).
+    pub fn step_response(&self, t: f64, grad: &mut [f64]) -> f64 {
+        let Some(m) = &self.modal else {
+            return Confluent::new(self).step_response(t, grad);
+        };
+        let mut value = Complex64::new(m.dc_gain, 0.0);
+        for (j, g) in grad.iter_mut().enumerate() {
+            *g = m.d_dc_gain.get(j).copied().unwrap_or(0.0);
+        }
+        for (i, (&pole, &r)) in m.poles.iter().zip(&m.residues).enumerate() {
+            let e = (pole * t).exp();
+            value += r / pole * e;
+            for (j, g) in grad.iter_mut().enumerate() {
+                let (Some(&dp), Some(&dr)) = (m.d_poles[i].get(j), m.d_residues[i].get(j)) else {
+                    continue;
+                };
+                *g += ((dr / pole - r * dp / (pole * pole) + r / pole * t * dp) * e).re;
+            }
+        }
+        value.re
+    }
+
+    /// The impulse response `t > 0` after the impulse (without the feed-through's `D δ(t)`).
+    pub fn impulse_response(&self, t: f64) -> f64 {
+        match &self.modal {
+            Some(m) => {
+                m.poles
+                    .iter()
+                    .zip(&m.residues)
+                    .map(|(&p, &r)| r * (p * t).exp())
+                    .sum::<Complex64>()
+                    .re
+            }
+            None => Confluent::new(self).impulse_response(t),
+        }
     }
 
     /// Numerator coefficients (padded to the denominator's length).
@@ -278,8 +359,9 @@ pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
         self.response(Complex64::new(0.0, std::f64::consts::TAU * f))
     }
 
-    /// The modal form.
-    fn modal(&self) -> &Modal {
+    /// The modal form, where the poles are distinct and strictly stable
+    /// ([`Rational::modal`]).
+    fn modal(&self) -> Option<&Modal> {
         self.rational().modal()
     }
 }
@@ -663,7 +745,7 @@ mod tests {
     #[test]
     fn modal_form_reproduces_response() {
         let g = paper();
-        let m = g.modal();
+        let m = g.modal().unwrap();
         for s in [Complex64::new(0.0, 1.3), Complex64::new(-0.1, 0.2)] {
             let modal: Complex64 = m.direct
                 + m.poles
@@ -685,7 +767,7 @@ mod tests {
 
     fn check_fd<M: RationalModel>(g: &M) {
         let p0 = g.params();
-        let m = g.modal().clone();
+        let m = g.modal().unwrap().clone();
         for j in 0..p0.len() {
             let h = 1e-6 * p0[j].abs().max(1.0);
             let mut pp = p0.clone();
@@ -693,8 +775,8 @@ mod tests {
             let mut pm = p0.clone();
             pm[j] -= h;
             let (mp, mm) = (
-                g.with_params(&pp).unwrap().modal().clone(),
-                g.with_params(&pm).unwrap().modal().clone(),
+                g.with_params(&pp).unwrap().modal().unwrap().clone(),
+                g.with_params(&pm).unwrap().modal().unwrap().clone(),
             );
             let fd_gain = (mp.dc_gain - mm.dc_gain) / (2.0 * h);
             assert!(
@@ -738,10 +820,13 @@ mod tests {
             ),
             Err(SignalError::Improper { .. })
         ));
-        assert!(matches!(
-            Zpk::new(1.0, vec![], vec![Root::Real(-1.0), Root::Real(-1.0)]),
-            Err(SignalError::RepeatedPole { .. })
-        ));
+        // A repeated pole and a pole at the origin are valid, without a modal form.
+        for poles in [
+            vec![Root::Real(-1.0), Root::Real(-1.0)],
+            vec![Root::Real(0.0), Root::Real(-1.0)],
+        ] {
+            assert!(Zpk::new(1.0, vec![], poles).unwrap().modal().is_none());
+        }
         assert!(matches!(
             Zpk::new(f64::NAN, vec![], vec![Root::Real(-1.0)]),
             Err(SignalError::NotFinite { name: "gain", .. })

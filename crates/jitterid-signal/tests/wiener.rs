@@ -56,7 +56,7 @@ fn wiener_model_passes_the_contract() {
 fn state_gradient_equals_the_sum_over_steps() {
     // The O(log J) gradient against the direct sum over every earlier step of the modal form.
     let s = wiener(1000.0).0;
-    let m = s.model().modal().clone();
+    let m = s.model().modal().unwrap().clone();
     let mut grad = [0.0; 2];
     for t in [0.3, 17.9, 250.0, 999.5] {
         let v = s.value_and_gradient(t, &mut grad);

@@ -138,8 +138,12 @@ pub(super) fn root_moduli(roots: &[Root]) -> Vec<f64> {
 /// A rational system's poles in range and its step response representable: every mode's
 /// contribution `|r_i/p_i|` and the feed-through at most [`MAX_LEVEL`].
 pub(super) fn response<M: RationalModel>(m: &M, grid: &SampleGrid) -> Result<(), String> {
-    let modal = m.modal();
-    poles(modal.poles.iter().map(|p| p.norm()), grid)?;
+    poles(m.rational().poles().iter().map(|p| p.norm()), grid)?;
+    // Repeated poles and integrators have no modal form (their steps grow without bound
+    // or have no separate modes): only the range of the poles applies.
+    let Some(modal) = m.modal() else {
+        return Ok(());
+    };
     let worst = modal
         .residues
         .iter()

@@ -7,7 +7,6 @@ use super::response::{
 };
 use crate::EstimateError;
 use jitterid_signal::RationalModel;
-use num_complex::Complex64;
 use std::f64::consts::LN_10;
 
 /// The covariance without its last (the delay's) row and column, checked to be `(p + 1)`
@@ -73,7 +72,6 @@ pub fn delayed_step_response<M: RationalModel>(
     non_negative("delay", delay)?;
     let p = model.params().len();
     check_covariance(covariance, p + 1)?;
-    let modal = model.modal();
     times
         .iter()
         .map(|&t| {
@@ -85,13 +83,7 @@ pub fn delayed_step_response<M: RationalModel>(
                 (0.0, vec![0.0; p])
             };
             let impulse: f64 = if shifted > 0.0 {
-                modal
-                    .poles
-                    .iter()
-                    .zip(&modal.residues)
-                    .map(|(&pole, &r)| r * (pole * shifted).exp())
-                    .sum::<Complex64>()
-                    .re
+                model.rational().impulse_response(shifted)
             } else {
                 0.0
             };

@@ -141,22 +141,14 @@ pub fn bode<M: RationalModel>(
     Ok(out)
 }
 
-/// The unit-step response `y(t) = G(0) + Σ_i (r_i/p_i) e^{p_i t}` (modal form) and its gradient.
+/// The unit-step response `y(t)` from rest and its gradient ([`Rational::step_response`]:
+/// modal form, or the model's realisation for repeated poles and integrators).
+///
+/// [`Rational::step_response`]: jitterid_signal::Rational::step_response
 pub fn step_value_and_gradient<M: RationalModel>(model: &M, t: f64) -> (f64, Vec<f64>) {
-    let m = model.modal();
-    let p = model.params().len();
-    let mut value = Complex64::new(m.dc_gain, 0.0);
-    let mut grad: Vec<Complex64> = m.d_dc_gain.iter().map(|&d| d.into()).collect();
-    grad.resize(p, Complex64::new(0.0, 0.0));
-    for (i, (&pole, &r)) in m.poles.iter().zip(&m.residues).enumerate() {
-        let e = (pole * t).exp();
-        value += r / pole * e;
-        for (j, gj) in grad.iter_mut().enumerate() {
-            let (dp, dr) = (m.d_poles[i][j], m.d_residues[i][j]);
-            *gj += (dr / pole - r * dp / (pole * pole) + r / pole * t * dp) * e;
-        }
-    }
-    (value.re, grad.iter().map(|g| g.re).collect())
+    let mut grad = vec![0.0; model.params().len()];
+    let value = model.rational().step_response(t, &mut grad);
+    (value, grad)
 }
 
 /// The unit-step response of `model` at times `times` (s after the step, ≥ 0) with ±2σ bands

@@ -1,0 +1,469 @@
+//! The exact response of a rational model whose modal form breaks down: repeated or nearly
+//! repeated poles (`1/(s+1)²`, a pair of a search passing through the real axis), poles at the
+//! origin (`1/s`, `1/(s(s+1))`) and other poles on or right of the imaginary axis.
+//!
+//! # Route
+//!
+//! The modal form writes the step response as `G(0) + Σ_i (r_i/p_i) e^{p_i t}`; at a repeated
+//! pole the residues are infinite and terms `t^j e^{pt}` appear, and at a pole at the origin
+//! `G(0)` is. A state-space realisation has neither problem: every response is `c·e^{Mt}z`.
+//!
+//! One realisation serves the response and its gradient. With `G = N/A` (`A` monic of degree
+//! `n`), `∂G/∂θ_j = (N'_j A − N A'_j)/A²` and `G = N A/A²`: every one is a numerator over the
+//! same `A²`. So the controllable companion form of `A²` (order `2n`), driven by the input level
+//! `u` (a state of its own, constant between steps, so that a step is a jump of that state),
+//! gives `s(t)` and every `∂s/∂θ_j` as readouts `c·z(t)` of one state `z`: the parameter
+//! sensitivities of a linear system are themselves outputs of a linear system.
+//!
+//! The state is scaled (`x̃_i = ρ^{i−1} x_i`, `ρ` the largest pole modulus) so that the
+//! companion matrix's entries are of the order of `ρ` instead of `ρ^{2n}`.
+//!
+//! # Jittered moments
+//!
+//! Everything is linear in the state. The state `z_k` at `t_k + lo` (`lo` the start of the
+//! jitter's reach) from the steps before it is carried from sample to sample by `e^{MT}`;
+//! beyond that instant, `E[e^{M(τ−lo)}]` is one matrix per evaluation (the jitter's quadrature
+//! rule), and a step inside the reach at `c = t_j − t_k` adds `Δu_j E[e^{M(τ−c)} e_u 1{τ ≥ c}]`
+//! (the jitter's rule from `c`). The second moment evaluates `s` at the rule's nodes, cut at the
+//! steps inside the reach. The quadrature is exact for these integrands up to rounding (each is
+//! analytic between the cuts), as for every signal without a closed form.
+
+use crate::expm::{expm, mat_vec, vec_mat};
+use crate::poly;
+use crate::rational::Rational;
+use crate::signal::Jacobian;
+use crate::SampleGrid;
+use jitterid_jitter::JitterModel;
+
+/// A rational model and its parameter derivatives as readouts of one linear system.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Confluent {
+    /// State dimension `2n + 1` (the last state is the input level).
+    dim: usize,
+    /// The generator `M`, row-major.
+    generator: Vec<f64>,
+    /// Readout of `s`.
+    value: Vec<f64>,
+    /// Readouts of `∂s/∂θ_j`.
+    grads: Vec<Vec<f64>>,
+    /// Readout of `ṡ` between steps (`value·M`).
+    rate: Vec<f64>,
+    /// `ρ`: the largest pole modulus (1 when every pole is at the origin), the rate that sets
+    /// the quadrature's resolution.
+    scale: f64,
+    /// `A²`, the realisation's denominator.
+    den2: Vec<f64>,
+    /// `A`.
+    den: Vec<f64>,
+}
+
+impl Confluent {
+    /// The realisation of `r` and its derivatives.
+    pub(crate) fn new(r: &Rational) -> Self {
+        let den = r.den();
+        let n = den.len() - 1;
+        let a2 = poly::mul(den, den);
+        let m = 2 * n;
+        let dim = m + 1;
+        let rho = r.poles().iter().map(|p| p.norm()).fold(0.0, f64::max);
+        let scale = if rho > 0.0 && rho.is_finite() {
+            rho
+        } else {
+            1.0
+        };
+        // ρ^{1−i} for i = 1..=m.
+        let shrink: Vec<f64> = (1..=m).map(|i| scale.powi(1 - i as i32)).collect();
+        let mut generator = vec![0.0; dim * dim];
+        for i in 1..=m {
+            generator[i - 1] = -a2[i] * shrink[i - 1];
+        }
+        generator[m] = 1.0;
+        for i in 1..m {
+            generator[i * dim + i - 1] = scale;
+        }
+        let readout = |p: &[f64]| readout(&a2, scale, p);
+        let num = r.num();
+        let value = readout(&poly::mul(num, den));
+        let grads = r
+            .d_num()
+            .iter()
+            .zip(r.d_den())
+            .map(|(dn, da)| {
+                let a = poly::pad(&poly::mul(dn, den), dim);
+                let b = poly::pad(&poly::mul(num, da), dim);
+                let p: Vec<f64> = a.iter().zip(&b).map(|(a, b)| a - b).collect();
+                readout(&p)
+            })
+            .collect();
+        let mut rate = vec![0.0; dim];
+        vec_mat(&value, &generator, &mut rate);
+        Self {
+            dim,
+            generator,
+            value,
+            grads,
+            rate,
+            scale,
+            den2: a2,
+            den: den.to_vec(),
+        }
+    }
+
+    /// Readouts of the free response with Laplace transform `q(s)/A(s)` (coefficients
+    /// `q_0 … q_{n−1}`, lowest power first), from the [`impulse_state`](Self::impulse_state):
+    /// the response, its derivative with respect to each of `r`'s parameters
+    /// (`−q A'_j/A²`), and with respect to each `q_i` (`s^i A/A²`).
+    pub(crate) fn free_rows(&self, r: &Rational, q: &[f64]) -> FreeRows {
+        let q_desc: Vec<f64> = q.iter().rev().copied().collect();
+        let value = readout(&self.den2, self.scale, &poly::mul(&q_desc, &self.den));
+        let grads = r
+            .d_den()
+            .iter()
+            .map(|da| {
+                let p: Vec<f64> = poly::mul(&q_desc, da).iter().map(|c| -c).collect();
+                readout(&self.den2, self.scale, &p)
+            })
+            .collect();
+        let basis = (0..q.len())
+            .map(|i| {
+                let mut si = vec![1.0];
+                si.extend(std::iter::repeat_n(0.0, i));
+                readout(&self.den2, self.scale, &poly::mul(&si, &self.den))
+            })
+            .collect();
+        FreeRows {
+            value,
+            grads,
+            basis,
+        }
+    }
+
+    /// The state `x` after a unit impulse at 0 from rest: `e^{Mx} e_1` (defined for `x < 0`
+    /// too, as the analytic continuation of the free response).
+    pub(crate) fn impulse_state(&self, x: f64) -> Vec<f64> {
+        let e = self.exp(x);
+        (0..self.dim).map(|i| e[i * self.dim]).collect()
+    }
+
+    /// `e^{MT}`, to carry states along a grid.
+    pub(crate) fn carry(&self, interval: f64) -> Vec<f64> {
+        self.exp(interval)
+    }
+
+    /// `E[e^{Mτ}] v` over the jitter.
+    pub(crate) fn expected_from(&self, jitter: &dyn JitterModel, v: &[f64]) -> Vec<f64> {
+        let rule = jitter.rule(&[], self.scale);
+        let mut out = vec![0.0; self.dim];
+        let mut ev = vec![0.0; self.dim];
+        for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+            mat_vec(&self.exp(tau), v, &mut ev);
+            for (o, e) in out.iter_mut().zip(&ev) {
+                *o += w * e;
+            }
+        }
+        out
+    }
+
+    /// `e^{Mx}`.
+    fn exp(&self, x: f64) -> Vec<f64> {
+        expm(&self.generator, self.dim, x)
+    }
+
+    /// The state `x ≥ 0` after a unit step from rest: the last column of `e^{Mx}`.
+    fn step_state(&self, x: f64) -> Vec<f64> {
+        let e = self.exp(x);
+        (0..self.dim)
+            .map(|i| e[i * self.dim + self.dim - 1])
+            .collect()
+    }
+
+    /// The unit-step response `x ≥ 0` after the step and its gradient.
+    pub(crate) fn step_response(&self, x: f64, grad: &mut [f64]) -> f64 {
+        let z = self.step_state(x);
+        for (g, row) in grad.iter_mut().zip(&self.grads) {
+            *g = dot(row, &z);
+        }
+        dot(&self.value, &z)
+    }
+
+    /// The impulse response `x > 0` after the impulse (the step response's rate).
+    pub(crate) fn impulse_response(&self, x: f64) -> f64 {
+        dot(&self.rate, &self.step_state(x))
+    }
+
+    /// The state right after each step `(t_j, Δu_j)`, row-major.
+    pub(crate) fn prefix(&self, steps: &[(f64, f64)]) -> Vec<f64> {
+        let d = self.dim;
+        let mut out = Vec::with_capacity(steps.len() * d);
+        let mut z = vec![0.0; d];
+        let mut next = vec![0.0; d];
+        let mut prev = f64::NEG_INFINITY;
+        for &(tj, du) in steps {
+            if prev.is_finite() {
+                mat_vec(&self.exp(tj - prev), &z, &mut next);
+                std::mem::swap(&mut z, &mut next);
+            }
+            z[d - 1] += du;
+            prev = tj;
+            out.extend_from_slice(&z);
+        }
+        out
+    }
+
+    /// `s(t)` (and `∂s/∂θ_j` into `grad` when given) from the [`prefix`](Self::prefix) states.
+    pub(crate) fn value_at(
+        &self,
+        steps: &[(f64, f64)],
+        prefix: &[f64],
+        t: f64,
+        grad: Option<&mut [f64]>,
+    ) -> f64 {
+        let j = steps.partition_point(|s| s.0 <= t);
+        if j == 0 {
+            if let Some(g) = grad {
+                g.iter_mut().for_each(|g| *g = 0.0);
+            }
+            return 0.0;
+        }
+        let d = self.dim;
+        let mut z = vec![0.0; d];
+        mat_vec(
+            &self.exp(t - steps[j - 1].0),
+            &prefix[(j - 1) * d..j * d],
+            &mut z,
+        );
+        if let Some(g) = grad {
+            for (g, row) in g.iter_mut().zip(&self.grads) {
+                *g = dot(row, &z);
+            }
+        }
+        dot(&self.value, &z)
+    }
+
+    /// `ṡ(t)` between steps from the [`prefix`](Self::prefix) states.
+    pub(crate) fn rate_at(&self, steps: &[(f64, f64)], prefix: &[f64], t: f64) -> f64 {
+        let j = steps.partition_point(|s| s.0 <= t);
+        if j == 0 {
+            return 0.0;
+        }
+        let d = self.dim;
+        let mut z = vec![0.0; d];
+        mat_vec(
+            &self.exp(t - steps[j - 1].0),
+            &prefix[(j - 1) * d..j * d],
+            &mut z,
+        );
+        dot(&self.rate, &z)
+    }
+
+    /// Visits every sample `k` with the state `z_k` at `t_k + lo` due to the steps at or
+    /// before that instant and the steps inside the reach `(t_k + lo, t_k + hi]`, carrying the
+    /// state by `e^{MT}`: `O(N + J)` matrix-vector products and one exponential per step.
+    fn walk(
+        &self,
+        steps: &[(f64, f64)],
+        grid: &SampleGrid,
+        lo: f64,
+        hi: f64,
+        mut visit: impl FnMut(usize, f64, &[f64], &[(f64, f64)]),
+    ) {
+        let d = self.dim;
+        let carry = self.exp(grid.interval());
+        let mut z = vec![0.0; d];
+        let mut next = vec![0.0; d];
+        let (mut next_past, mut reach_end) = (0usize, 0usize);
+        for k in 0..grid.len() {
+            let t = grid.time(k);
+            if k > 0 {
+                mat_vec(&carry, &z, &mut next);
+                std::mem::swap(&mut z, &mut next);
+            }
+            while next_past < steps.len() && steps[next_past].0 <= t + lo {
+                let (tj, du) = steps[next_past];
+                for (zi, si) in z.iter_mut().zip(self.step_state(t + lo - tj)) {
+                    *zi += du * si;
+                }
+                next_past += 1;
+            }
+            reach_end = reach_end.max(next_past);
+            while reach_end < steps.len() && steps[reach_end].0 <= t + hi {
+                reach_end += 1;
+            }
+            visit(k, t, &z, &steps[next_past..reach_end]);
+        }
+    }
+
+    /// For each readout row, its expectation `E[row·z(t_k + τ)]` at every sample.
+    fn expected_rows(
+        &self,
+        steps: &[(f64, f64)],
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+        rows: &[&[f64]],
+    ) -> Vec<Vec<f64>> {
+        let d = self.dim;
+        let (lo, hi) = jitter.reach();
+        let full = jitter.rule(&[], self.scale);
+        let mut mean = vec![0.0; d * d];
+        for (&tau, &w) in full.nodes.iter().zip(&full.weights) {
+            for (m, e) in mean.iter_mut().zip(self.exp(tau - lo)) {
+                *m += w * e;
+            }
+        }
+        // row·E[e^{M(τ−lo)}], one per readout.
+        let through: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|row| {
+                let mut v = vec![0.0; d];
+                vec_mat(row, &mean, &mut v);
+                v
+            })
+            .collect();
+        let mut out: Vec<Vec<f64>> = rows
+            .iter()
+            .map(|_| Vec::with_capacity(grid.len()))
+            .collect();
+        let mut late = vec![0.0; d];
+        self.walk(steps, grid, lo, hi, |_, t, z, in_reach| {
+            late.iter_mut().for_each(|x| *x = 0.0);
+            for &(tj, du) in in_reach {
+                let c = tj - t;
+                let rule = jitter.rule_from(c, &[], self.scale);
+                for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                    for (l, s) in late.iter_mut().zip(self.step_state(tau - c)) {
+                        *l += du * w * s;
+                    }
+                }
+            }
+            for ((col, v), row) in out.iter_mut().zip(&through).zip(rows) {
+                col.push(dot(v, z) + dot(row, &late));
+            }
+        });
+        out
+    }
+
+    /// `m_k = E[s(t_k + τ)]`.
+    pub(crate) fn expected_values(
+        &self,
+        steps: &[(f64, f64)],
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> Vec<f64> {
+        self.expected_rows(steps, grid, jitter, &[&self.value])
+            .pop()
+            .unwrap_or_default()
+    }
+
+    /// `m_k` and `∂m_k/∂θ_j` (as columns).
+    pub(crate) fn expected_values_and_gradient(
+        &self,
+        steps: &[(f64, f64)],
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> (Vec<f64>, Jacobian) {
+        let mut rows: Vec<&[f64]> = vec![&self.value];
+        rows.extend(self.grads.iter().map(|g| g.as_slice()));
+        let mut cols = self.expected_rows(steps, grid, jitter, &rows);
+        let values = cols.remove(0);
+        (values, cols)
+    }
+
+    /// `E[ṡ(t_k + τ)]` between steps (the feed-through's jumps left to the caller).
+    pub(crate) fn expected_rates(
+        &self,
+        steps: &[(f64, f64)],
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> Vec<f64> {
+        self.expected_rows(steps, grid, jitter, &[&self.rate])
+            .pop()
+            .unwrap_or_default()
+    }
+
+    /// `E[s(t_k + τ)²]`: `s` at the jitter's quadrature nodes, the rule cut at the steps
+    /// inside the sample's reach.
+    pub(crate) fn expected_squares(
+        &self,
+        steps: &[(f64, f64)],
+        grid: &SampleGrid,
+        jitter: &dyn JitterModel,
+    ) -> Vec<f64> {
+        let d = self.dim;
+        let (lo, hi) = jitter.reach();
+        let rate = 2.0 * self.scale;
+        let full = jitter.rule(&[], rate);
+        // value·e^{M(τ_i − lo)} at the full rule's nodes, shared by every sample whose reach
+        // holds no step.
+        let full_rows: Vec<Vec<f64>> = full
+            .nodes
+            .iter()
+            .map(|&tau| {
+                let mut v = vec![0.0; d];
+                vec_mat(&self.value, &self.exp(tau - lo), &mut v);
+                v
+            })
+            .collect();
+        let mut out = Vec::with_capacity(grid.len());
+        let mut cuts = Vec::new();
+        self.walk(steps, grid, lo, hi, |_, t, z, in_reach| {
+            if in_reach.is_empty() {
+                out.push(
+                    full_rows
+                        .iter()
+                        .zip(&full.weights)
+                        .map(|(v, w)| w * dot(v, z).powi(2))
+                        .sum(),
+                );
+                return;
+            }
+            cuts.clear();
+            cuts.extend(in_reach.iter().map(|s| s.0 - t));
+            let rule = jitter.rule(&cuts, rate);
+            let mut zt = vec![0.0; d];
+            let mut acc = 0.0;
+            for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
+                mat_vec(&self.exp(tau - lo), z, &mut zt);
+                let mut s = dot(&self.value, &zt);
+                for &(tj, du) in in_reach {
+                    let x = tau - (tj - t);
+                    if x >= 0.0 {
+                        s += du * dot(&self.value, &self.step_state(x));
+                    }
+                }
+                acc += w * s * s;
+            }
+            out.push(acc);
+        });
+        out
+    }
+}
+
+/// Readouts of a free response; see [`Confluent::free_rows`].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FreeRows {
+    /// The free response.
+    pub value: Vec<f64>,
+    /// Its derivative with respect to each parameter of the model.
+    pub grads: Vec<Vec<f64>>,
+    /// Its derivative with respect to each coefficient `q_i`.
+    pub basis: Vec<Vec<f64>>,
+}
+
+/// The readout of `P(s)/A²(s)` (`P` of degree at most `2n`, decreasing powers) from the
+/// scaled companion state and the input level: `P = P_0 A² + R`, `R` read from the state,
+/// `P_0` (the feed-through) from the level.
+fn readout(a2: &[f64], scale: f64, p: &[f64]) -> Vec<f64> {
+    let dim = a2.len();
+    let m = dim - 1;
+    let p = poly::pad(p, dim);
+    let direct = p[0];
+    let mut row: Vec<f64> = (1..=m)
+        .map(|i| (p[i] - direct * a2[i]) * scale.powi(1 - i as i32))
+        .collect();
+    row.push(direct);
+    row
+}
+
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
