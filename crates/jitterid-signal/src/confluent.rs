@@ -33,6 +33,7 @@ use crate::poly;
 use crate::rational::Rational;
 use crate::signal::Jacobian;
 use crate::SampleGrid;
+use jitterid_jitter::rule::QuadratureRule;
 use jitterid_jitter::JitterModel;
 
 /// A rational model and its parameter derivatives as readouts of one linear system.
@@ -55,7 +56,23 @@ pub(crate) struct Confluent {
     den2: Vec<f64>,
     /// `A`.
     den: Vec<f64>,
+    /// Refinement zones of a mode started at 0 ([`crate::reach`]'s): `(x_end, rate)`, beyond
+    /// the last end every mode has decayed below `e^{−50}`.
+    zones: Vec<(f64, f64)>,
+    /// `h` with `‖Mh‖₁ ≤ 1/2`, and `e^{M h 2^i}`: `e^{Mx}v` is a short Taylor series on
+    /// `x mod h` then one product per binary digit of `⌊x/h⌋`.
+    block: f64,
+    powers: Vec<Vec<f64>>,
+    /// `M^k e_u / k!` for `k ≤ TAYLOR`: the step's state as a polynomial in `x` on a block.
+    step_taylor: Vec<Vec<f64>>,
 }
+
+/// Terms of the Taylor series on one block (`‖Mx‖₁ ≤ 1/2`: error below `1e-18`).
+const TAYLOR: usize = 16;
+
+/// Binary digits of `⌊x/h⌋` covered by [`Confluent::exp_apply`]'s table (beyond, the full
+/// exponential).
+const POWERS: usize = 63;
 
 impl Confluent {
     /// The realisation of `r` and its derivatives.
@@ -97,6 +114,28 @@ impl Confluent {
             .collect();
         let mut rate = vec![0.0; dim];
         vec_mat(&value, &generator, &mut rate);
+        let norm = (0..dim)
+            .map(|j| (0..dim).map(|i| generator[i * dim + j].abs()).sum::<f64>())
+            .fold(0.0, f64::max);
+        let block = 0.5 / norm.max(f64::MIN_POSITIVE);
+        let mut powers = vec![expm(&generator, dim, block)];
+        for i in 1..POWERS {
+            let mut sq = vec![0.0; dim * dim];
+            crate::expm::mat_mul(&powers[i - 1], &powers[i - 1], dim, &mut sq);
+            powers.push(sq);
+        }
+        let mut step_taylor = Vec::with_capacity(TAYLOR + 1);
+        let mut v = vec![0.0; dim];
+        v[dim - 1] = 1.0;
+        for k in 0..=TAYLOR {
+            if k > 0 {
+                let mut next = vec![0.0; dim];
+                mat_vec(&generator, &v, &mut next);
+                v = next.iter().map(|x| x / k as f64).collect();
+            }
+            step_taylor.push(v.clone());
+        }
+        let zones = crate::reach::zones(r.poles(), 1.0);
         Self {
             dim,
             generator,
@@ -106,7 +145,117 @@ impl Confluent {
             scale,
             den2: a2,
             den: den.to_vec(),
+            zones,
+            block,
+            powers,
+            step_taylor,
         }
+    }
+
+    /// `e^{Mx} v` for `x ≥ 0`: the Taylor series on `x mod h` (`taylor`, when given, holds
+    /// `M^k v/k!`; otherwise Horner's rule on `v`) and a product with `e^{M h 2^i}` for each
+    /// binary digit `i` of `⌊x/h⌋`; the full exponential for `x < 0` or beyond the table.
+    fn exp_apply(&self, x: f64, v: &[f64], taylor: Option<&[Vec<f64>]>) -> Vec<f64> {
+        let d = self.dim;
+        let blocks = (x / self.block).floor();
+        if !(x >= 0.0 && blocks < 2f64.powi(POWERS as i32)) {
+            let mut out = vec![0.0; d];
+            mat_vec(&self.exp(x), v, &mut out);
+            return out;
+        }
+        let r = x - blocks * self.block;
+        let mut out = match taylor {
+            Some(t) => {
+                // Σ r^k (M^k v/k!) by Horner in r.
+                let mut acc = t[TAYLOR].clone();
+                for term in t[..TAYLOR].iter().rev() {
+                    for (a, c) in acc.iter_mut().zip(term) {
+                        *a = *a * r + c;
+                    }
+                }
+                acc
+            }
+            None => {
+                // v + (rM)(v + (rM/2)(v + …)).
+                let mut acc = v.to_vec();
+                let mut tmp = vec![0.0; d];
+                for k in (1..=TAYLOR).rev() {
+                    mat_vec(&self.generator, &acc, &mut tmp);
+                    let f = r / k as f64;
+                    for ((a, t), vi) in acc.iter_mut().zip(&tmp).zip(v) {
+                        *a = vi + f * t;
+                    }
+                }
+                acc
+            }
+        };
+        let mut tmp = vec![0.0; d];
+        let mut digits = blocks as u64;
+        for power in &self.powers {
+            if digits == 0 {
+                break;
+            }
+            if digits & 1 == 1 {
+                mat_vec(power, &out, &mut tmp);
+                std::mem::swap(&mut out, &mut tmp);
+            }
+            digits >>= 1;
+        }
+        out
+    }
+
+    /// The refinement rate at `x` after the origins `origins` (`0` where every mode started
+    /// there has decayed).
+    fn rate_after(&self, origins: &[f64], x: f64, factor: f64) -> f64 {
+        origins
+            .iter()
+            .filter(|&&o| o <= x)
+            .map(|&o| {
+                self.zones
+                    .iter()
+                    .find(|z| x - o < z.0)
+                    .map_or(0.0, |z| factor * z.1)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The jitter's rule on `τ ≥ from` for a sum of this realisation's modes started at
+    /// `origins` (cut there too), or of products of two of them (`factor` 2): refined as the
+    /// modes alive at each place need, as [`crate::reach`] does, so that a fast decaying pole
+    /// costs nodes only near its origin.
+    fn rule_after(
+        &self,
+        jitter: &dyn JitterModel,
+        from: f64,
+        origins: &[f64],
+        factor: f64,
+    ) -> QuadratureRule {
+        let mut rule = QuadratureRule::default();
+        for (a, b) in jitter.pieces() {
+            let a = a.max(from);
+            if !(b > a) {
+                continue;
+            }
+            let mut cuts = vec![a, b];
+            for &o in origins {
+                cuts.push(o);
+                cuts.extend(self.zones.iter().map(|z| o + z.0));
+            }
+            cuts.retain(|c| (a..=b).contains(c));
+            cuts.sort_by(f64::total_cmp);
+            cuts.dedup();
+            for w in cuts.windows(2) {
+                let rate = self.rate_after(origins, 0.5 * (w[0] + w[1]), factor);
+                rule.push_interval(w[0], w[1], rate, |t| jitter.pdf(t));
+            }
+        }
+        for atom in jitter.atoms() {
+            if atom.position >= from {
+                rule.nodes.push(atom.position);
+                rule.weights.push(atom.mass);
+            }
+        }
+        rule
     }
 
     /// Readouts of the free response with Laplace transform `q(s)/A(s)` (coefficients
@@ -171,10 +320,9 @@ impl Confluent {
 
     /// The state `x ≥ 0` after a unit step from rest: the last column of `e^{Mx}`.
     fn step_state(&self, x: f64) -> Vec<f64> {
-        let e = self.exp(x);
-        (0..self.dim)
-            .map(|i| e[i * self.dim + self.dim - 1])
-            .collect()
+        let mut e_u = vec![0.0; self.dim];
+        e_u[self.dim - 1] = 1.0;
+        self.exp_apply(x, &e_u, Some(&self.step_taylor))
     }
 
     /// The unit-step response `x ≥ 0` after the step and its gradient.
@@ -196,12 +344,10 @@ impl Confluent {
         let d = self.dim;
         let mut out = Vec::with_capacity(steps.len() * d);
         let mut z = vec![0.0; d];
-        let mut next = vec![0.0; d];
         let mut prev = f64::NEG_INFINITY;
         for &(tj, du) in steps {
             if prev.is_finite() {
-                mat_vec(&self.exp(tj - prev), &z, &mut next);
-                std::mem::swap(&mut z, &mut next);
+                z = self.exp_apply(tj - prev, &z, None);
             }
             z[d - 1] += du;
             prev = tj;
@@ -226,12 +372,7 @@ impl Confluent {
             return 0.0;
         }
         let d = self.dim;
-        let mut z = vec![0.0; d];
-        mat_vec(
-            &self.exp(t - steps[j - 1].0),
-            &prefix[(j - 1) * d..j * d],
-            &mut z,
-        );
+        let z = self.exp_apply(t - steps[j - 1].0, &prefix[(j - 1) * d..j * d], None);
         if let Some(g) = grad {
             for (g, row) in g.iter_mut().zip(&self.grads) {
                 *g = dot(row, &z);
@@ -247,12 +388,7 @@ impl Confluent {
             return 0.0;
         }
         let d = self.dim;
-        let mut z = vec![0.0; d];
-        mat_vec(
-            &self.exp(t - steps[j - 1].0),
-            &prefix[(j - 1) * d..j * d],
-            &mut z,
-        );
+        let z = self.exp_apply(t - steps[j - 1].0, &prefix[(j - 1) * d..j * d], None);
         dot(&self.rate, &z)
     }
 
@@ -303,7 +439,7 @@ impl Confluent {
     ) -> Vec<Vec<f64>> {
         let d = self.dim;
         let (lo, hi) = jitter.reach();
-        let full = jitter.rule(&[], self.scale);
+        let full = self.rule_after(jitter, lo, &[lo], 1.0);
         let mut mean = vec![0.0; d * d];
         for (&tau, &w) in full.nodes.iter().zip(&full.weights) {
             for (m, e) in mean.iter_mut().zip(self.exp(tau - lo)) {
@@ -328,7 +464,7 @@ impl Confluent {
             late.iter_mut().for_each(|x| *x = 0.0);
             for &(tj, du) in in_reach {
                 let c = tj - t;
-                let rule = jitter.rule_from(c, &[], self.scale);
+                let rule = self.rule_after(jitter, c, &[c], 1.0);
                 for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
                     for (l, s) in late.iter_mut().zip(self.step_state(tau - c)) {
                         *l += du * w * s;
@@ -390,8 +526,7 @@ impl Confluent {
     ) -> Vec<f64> {
         let d = self.dim;
         let (lo, hi) = jitter.reach();
-        let rate = 2.0 * self.scale;
-        let full = jitter.rule(&[], rate);
+        let full = self.rule_after(jitter, lo, &[lo], 2.0);
         // value·e^{M(τ_i − lo)} at the full rule's nodes, shared by every sample whose reach
         // holds no step.
         let full_rows: Vec<Vec<f64>> = full
@@ -417,12 +552,12 @@ impl Confluent {
                 return;
             }
             cuts.clear();
+            cuts.push(lo);
             cuts.extend(in_reach.iter().map(|s| s.0 - t));
-            let rule = jitter.rule(&cuts, rate);
-            let mut zt = vec![0.0; d];
+            let rule = self.rule_after(jitter, lo, &cuts, 2.0);
             let mut acc = 0.0;
             for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
-                mat_vec(&self.exp(tau - lo), z, &mut zt);
+                let zt = self.exp_apply(tau - lo, z, None);
                 let mut s = dot(&self.value, &zt);
                 for &(tj, du) in in_reach {
                     let x = tau - (tj - t);

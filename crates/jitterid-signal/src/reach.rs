@@ -109,7 +109,7 @@ const FILON_PARTS: usize = 4;
 /// increasing `x_end`; on `[previous x_end, x_end)` the poles still alive vary at most at
 /// `rate` (`factor` times the largest `|p|` among them). Beyond the last `x_end` every modal
 /// term has decayed below `e^{−DECAY}`.
-fn zones(poles: &[Complex64], factor: f64) -> Vec<(f64, f64)> {
+pub(crate) fn zones(poles: &[Complex64], factor: f64) -> Vec<(f64, f64)> {
     let mut life: Vec<(f64, f64)> = poles
         .iter()
         .map(|p| {
