@@ -60,6 +60,8 @@ pub struct Rational {
     d_den: Vec<Vec<f64>>,
     poles: Vec<Complex64>,
     modal: Option<Modal>,
+    /// Whether poles right of the imaginary axis are accepted.
+    unstable: bool,
 }
 
 impl Rational {
@@ -75,6 +77,16 @@ impl Rational {
         den: Vec<f64>,
         d_num: Vec<Vec<f64>>,
         d_den: Vec<Vec<f64>>,
+    ) -> Result<Self, SignalError> {
+        Self::build(num, den, d_num, d_den, false)
+    }
+
+    fn build(
+        num: Vec<f64>,
+        den: Vec<f64>,
+        d_num: Vec<Vec<f64>>,
+        d_den: Vec<Vec<f64>>,
+        unstable: bool,
     ) -> Result<Self, SignalError> {
         tf_coefficients(&num, &den)?;
         if den[0] != 1.0 {
@@ -111,7 +123,18 @@ impl Rational {
         }
         let num = poly::pad(&num[num.len() - 1 - degree..], den.len());
         let poles = poly::roots(&den).ok_or(SignalError::Roots { name: "den" })?;
-        Self::with_poles(num, den, poles, d_num, d_den)
+        Self::with_poles(num, den, poles, d_num, d_den, unstable)
+    }
+
+    /// As [`new`](Self::new), but poles right of the imaginary axis are accepted too (a
+    /// record is finite, so its response is; an estimate may then cross the axis).
+    pub fn new_allowing_unstable(
+        num: Vec<f64>,
+        den: Vec<f64>,
+        d_num: Vec<Vec<f64>>,
+        d_den: Vec<Vec<f64>>,
+    ) -> Result<Self, SignalError> {
+        Self::build(num, den, d_num, d_den, true)
     }
 
     /// Builds and validates: `num` padded to `den`'s length, `den` monic, `poles` the roots of
@@ -123,9 +146,10 @@ impl Rational {
         poles: Vec<Complex64>,
         d_num: Vec<Vec<f64>>,
         d_den: Vec<Vec<f64>>,
+        unstable: bool,
     ) -> Result<Self, SignalError> {
         for p in &poles {
-            if p.re > MARGINAL * p.norm().max(1.0) || p.re.is_nan() {
+            if (!unstable && p.re > MARGINAL * p.norm().max(1.0)) || !p.re.is_finite() {
                 return Err(SignalError::Unstable { re: p.re, im: p.im });
             }
         }
@@ -148,6 +172,7 @@ impl Rational {
                 d_den,
                 poles,
                 modal: None,
+                unstable,
             });
         }
         let dn = poly::derivative(&num);
@@ -215,6 +240,7 @@ impl Rational {
             d_den,
             poles,
             modal: Some(modal),
+            unstable,
         })
     }
 
@@ -237,6 +263,13 @@ impl Rational {
     /// through a state-space realisation.
     pub fn modal(&self) -> Option<&Modal> {
         self.modal.as_ref()
+    }
+
+    /// Whether poles right of the imaginary axis are accepted ([`Rational::new_allowing_unstable`],
+    /// [`TransferFunction::new_allowing_unstable`], [`Zpk::new_allowing_unstable`]); kept by
+    /// `with_params`.
+    pub fn allows_unstable(&self) -> bool {
+        self.unstable
     }
 
     /// The poles, the roots of the denominator (conjugate pairs as two entries).
@@ -315,12 +348,18 @@ struct RationalFields {
     den: Vec<f64>,
     d_num: Vec<Vec<f64>>,
     d_den: Vec<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    unstable: bool,
 }
 
 impl TryFrom<RationalFields> for Rational {
     type Error = SignalError;
     fn try_from(r: RationalFields) -> Result<Self, SignalError> {
-        Self::new(r.num, r.den, r.d_num, r.d_den)
+        if r.unstable {
+            Self::new_allowing_unstable(r.num, r.den, r.d_num, r.d_den)
+        } else {
+            Self::new(r.num, r.den, r.d_num, r.d_den)
+        }
     }
 }
 
@@ -331,6 +370,7 @@ impl From<Rational> for RationalFields {
             den: r.den,
             d_num: r.d_num,
             d_den: r.d_den,
+            unstable: r.unstable,
         }
     }
 }
@@ -384,10 +424,17 @@ impl TransferFunction {
     /// denominator coefficient, an improper model, unstable or repeated poles.
     pub fn new(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
         let form = crate::forms::TfForm::new(num, den)?;
-        Self::from_monic(form.num().to_vec(), form.den().to_vec())
+        Self::from_monic(form.num().to_vec(), form.den().to_vec(), false)
     }
 
-    fn from_monic(num: Vec<f64>, den: Vec<f64>) -> Result<Self, SignalError> {
+    /// As [`new`](Self::new), but poles right of the imaginary axis are accepted, here and in
+    /// every `with_params` of the model (an estimate may cross the axis).
+    pub fn new_allowing_unstable(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
+        let form = crate::forms::TfForm::new(num, den)?;
+        Self::from_monic(form.num().to_vec(), form.den().to_vec(), true)
+    }
+
+    fn from_monic(num: Vec<f64>, den: Vec<f64>, unstable: bool) -> Result<Self, SignalError> {
         let poles = poly::roots(&den).ok_or(SignalError::Roots { name: "den" })?;
         let (nb, na) = (num.len(), den.len() - 1);
         let mut d_num = Vec::with_capacity(nb + na);
@@ -406,7 +453,7 @@ impl TransferFunction {
         }
         let num_len = num.len();
         Ok(Self {
-            rational: Rational::with_poles(num, den, poles, d_num, d_den)?,
+            rational: Rational::with_poles(num, den, poles, d_num, d_den, unstable)?,
             num_len,
         })
     }
@@ -451,7 +498,7 @@ impl RationalModel for TransferFunction {
         let num = params[..self.num_len].to_vec();
         let mut den = vec![1.0];
         den.extend_from_slice(&params[self.num_len..]);
-        Self::from_monic(num, den)
+        Self::from_monic(num, den, self.rational.unstable)
     }
 
     fn rational(&self) -> &Rational {
@@ -556,6 +603,25 @@ impl Zpk {
     /// Validates finite values, pairs with `im > 0`, at most as many zeros as poles, at least
     /// one pole, stable and distinct poles.
     pub fn new(gain: f64, zeros: Vec<Root>, poles: Vec<Root>) -> Result<Self, SignalError> {
+        Self::build(gain, zeros, poles, false)
+    }
+
+    /// As [`new`](Self::new), but poles right of the imaginary axis are accepted, here and in
+    /// every `with_params` of the model (an estimate may cross the axis).
+    pub fn new_allowing_unstable(
+        gain: f64,
+        zeros: Vec<Root>,
+        poles: Vec<Root>,
+    ) -> Result<Self, SignalError> {
+        Self::build(gain, zeros, poles, true)
+    }
+
+    fn build(
+        gain: f64,
+        zeros: Vec<Root>,
+        poles: Vec<Root>,
+        unstable: bool,
+    ) -> Result<Self, SignalError> {
         finite("gain", gain)?;
         zeros.iter().try_for_each(|z| z.validate("zero"))?;
         poles.iter().try_for_each(|p| p.validate("pole"))?;
@@ -588,7 +654,7 @@ impl Zpk {
             d_den.push(dp);
         }
         let pole_values = poles.iter().flat_map(Root::values).collect();
-        let rational = Rational::with_poles(num, den, pole_values, d_num, d_den)?;
+        let rational = Rational::with_poles(num, den, pole_values, d_num, d_den, unstable)?;
         Ok(Self {
             gain,
             zeros,
@@ -673,7 +739,7 @@ impl RationalModel for Zpk {
         let mut it = params[1..].iter().copied();
         let zeros = roots_from(&self.zeros, &mut it);
         let poles = roots_from(&self.poles, &mut it);
-        Self::new(params[0], zeros, poles)
+        Self::build(params[0], zeros, poles, self.rational.unstable)
     }
 
     fn rational(&self) -> &Rational {
@@ -686,12 +752,15 @@ impl RationalModel for Zpk {
 struct TfFields {
     num: Vec<f64>,
     den: Vec<f64>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    unstable: bool,
 }
 
 impl TryFrom<TfFields> for TransferFunction {
     type Error = SignalError;
     fn try_from(t: TfFields) -> Result<Self, SignalError> {
-        Self::new(&t.num, &t.den)
+        let form = crate::forms::TfForm::new(&t.num, &t.den)?;
+        Self::from_monic(form.num().to_vec(), form.den().to_vec(), t.unstable)
     }
 }
 
@@ -700,6 +769,7 @@ impl From<TransferFunction> for TfFields {
         Self {
             num: t.num().to_vec(),
             den: t.den().to_vec(),
+            unstable: t.rational.unstable,
         }
     }
 }
@@ -710,18 +780,21 @@ struct ZpkFields {
     gain: f64,
     zeros: Vec<Root>,
     poles: Vec<Root>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    unstable: bool,
 }
 
 impl TryFrom<ZpkFields> for Zpk {
     type Error = SignalError;
     fn try_from(z: ZpkFields) -> Result<Self, SignalError> {
-        Self::new(z.gain, z.zeros, z.poles)
+        Self::build(z.gain, z.zeros, z.poles, z.unstable)
     }
 }
 
 impl From<Zpk> for ZpkFields {
     fn from(z: Zpk) -> Self {
         Self {
+            unstable: z.rational.unstable,
             gain: z.gain,
             zeros: z.zeros,
             poles: z.poles,

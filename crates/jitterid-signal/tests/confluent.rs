@@ -31,9 +31,7 @@ fn ode_response(
         // x_1 = s^{n−1}/A u, …, x_n = 1/A u.
         let mut dx = vec![0.0; n];
         dx[0] = u - a.iter().zip(x).map(|(a, x)| a * x).sum::<f64>();
-        for i in 1..n {
-            dx[i] = x[i - 1];
-        }
+        dx[1..n].copy_from_slice(&x[..n - 1]);
         dx
     };
     let steps: Vec<(f64, f64)> = input.steps();
@@ -245,6 +243,9 @@ fn zpk_tf(s: LtiResponse<Zpk>) -> LtiResponse<TransferFunction> {
     )
 }
 
+/// `m_k` and its gradient's columns.
+type Moments = (Vec<f64>, Vec<Vec<f64>>);
+
 /// Two real poles `−1` and `−1 − δ` as `δ` passes the switch between the modal form (`δ > 1e-4`)
 /// and the realisation (`δ < 1e-4`) down to 0: `m_k` and its gradient are smooth in `δ`. A
 /// quadratic through the modal side's values predicts the realisation's to its own error
@@ -265,13 +266,12 @@ fn responses_are_continuous_through_coincidence() {
         assert_eq!(g.modal().is_some(), delta > 1e-4, "δ = {delta}");
         LtiResponse::new(g, u.clone()).expected_values_and_gradient(&grid, &jitter)
     };
-    let modal: Vec<(f64, (Vec<f64>, Vec<Vec<f64>>))> =
-        [4e-4, 2.5e-4, 1.2e-4].iter().map(|&d| (d, at(d))).collect();
+    let modal: Vec<(f64, Moments)> = [4e-4, 2.5e-4, 1.2e-4].iter().map(|&d| (d, at(d))).collect();
     let scale = modal[0].1 .0.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     for delta in [0.9e-4, 3e-5, 0.0] {
         let (values, cols) = at(delta);
         // Lagrange interpolation through the three modal points.
-        let predict = |pick: &dyn Fn(&(Vec<f64>, Vec<Vec<f64>>)) -> f64| -> f64 {
+        let predict = |pick: &dyn Fn(&Moments) -> f64| -> f64 {
             let mut sum = 0.0;
             for (i, (di, vi)) in modal.iter().enumerate() {
                 let mut l = 1.0;
@@ -305,10 +305,29 @@ fn responses_are_continuous_through_coincidence() {
     }
 }
 
-/// An unstable pole is still refused; poles just right of the axis by rounding are not.
+/// An unstable pole is refused unless asked for; then it is kept by `with_params` and through
+/// serde, and its (growing) response still matches the ODE.
 #[test]
-fn unstable_poles_are_refused() {
+fn unstable_poles_only_when_asked_for() {
     assert!(Zpk::new(1.0, vec![], vec![Root::Real(0.01)]).is_err());
     assert!(TransferFunction::new(&[1.0], &[1.0, -0.5, 1.0]).is_err());
     assert!(TransferFunction::new(&[1.0], &[1.0, 1.0, 0.0]).is_ok());
+    let g = TransferFunction::new_allowing_unstable(&[0.5, 1.0], &[1.0, -0.3, 1.0]).unwrap();
+    assert!(g.rational().allows_unstable() && g.modal().is_none());
+    let moved = g.with_params(&[0.5, 1.0, -0.2, 1.1]).unwrap();
+    assert!(moved.rational().allows_unstable());
+    let json = serde_json::to_string(&g).unwrap();
+    let back: TransferFunction = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, g);
+    let z =
+        Zpk::new_allowing_unstable(1.0, vec![], vec![Root::Real(0.2), Root::Real(-1.0)]).unwrap();
+    assert!(z.with_params(&[1.0, 0.3, -1.0]).is_ok());
+    let u = binary(3, 2.0, 0.0, 10.0).unwrap();
+    let times: Vec<f64> = (1..=40).map(|k| 0.25 * k as f64).collect();
+    let ode = ode_response(g.rational().num(), g.rational().den(), &u, &times, 1e-3);
+    let s = LtiResponse::new(g, u);
+    let scale = ode.iter().fold(1.0f64, |a, y| a.max(y.abs()));
+    for (t, want) in times.iter().zip(&ode) {
+        assert!((s.value(*t) - want).abs() <= 1e-8 * scale, "t = {t}");
+    }
 }
