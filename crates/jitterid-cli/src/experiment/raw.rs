@@ -69,6 +69,7 @@ section!(RawSystem, "table [system]" {
     estimate: bool,
     initial: String,
     delay: f64,
+    unstable: bool,
 });
 
 section!(RawNoise, "table [noise]" {

@@ -116,15 +116,24 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
         }
         None => Vec::new(),
     };
-    let zpk = Zpk::new(gain, zeros, poles).map_err(|e| cx.err(S, "poles", &p.span(), e))?;
+    let unstable = r.unstable.as_ref().is_some_and(|u| *u.get_ref());
+    let zpk = if unstable {
+        Zpk::new_allowing_unstable(gain, zeros, poles)
+    } else {
+        Zpk::new(gain, zeros, poles)
+    };
+    let zpk = zpk.map_err(|e| cx.err(S, "poles", &p.span(), e))?;
     range::response(&zpk, grid).map_err(|m| cx.err(S, "gain", &g.span(), m))?;
-    Ok(spec(
-        "zpk",
-        [
-            ("gain", json!(zpk.gain())),
-            ("zeros", roots_json(zpk.zeros())),
-            ("poles", roots_json(zpk.poles())),
-        ],
+    Ok(with_unstable(
+        spec(
+            "zpk",
+            [
+                ("gain", json!(zpk.gain())),
+                ("zeros", roots_json(zpk.zeros())),
+                ("poles", roots_json(zpk.poles())),
+            ],
+        ),
+        unstable,
     ))
 }
 
@@ -134,7 +143,13 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
     let d = cx.required(S, "den", &r.den, why)?;
     let num = cx.finite_list(S, "num", n)?;
     let den = cx.finite_list(S, "den", d)?;
-    let tf = TransferFunction::new(&num, &den).map_err(|e| cx.err(S, "den", &d.span(), e))?;
+    let unstable = r.unstable.as_ref().is_some_and(|u| *u.get_ref());
+    let tf = if unstable {
+        TransferFunction::new_allowing_unstable(&num, &den)
+    } else {
+        TransferFunction::new(&num, &den)
+    };
+    let tf = tf.map_err(|e| cx.err(S, "den", &d.span(), e))?;
     range::response(&tf, grid).map_err(|m| cx.err(S, "den", &d.span(), m))?;
     if tf.num().iter().all(|b| *b == 0.0) {
         return Err(cx.err(
@@ -144,9 +159,9 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
             "expected a nonzero numerator (a zero gain gives no signal to identify)",
         ));
     }
-    Ok(spec(
-        "tf",
-        [("num", json!(tf.num())), ("den", json!(tf.den()))],
+    Ok(with_unstable(
+        spec("tf", [("num", json!(tf.num())), ("den", json!(tf.den()))]),
+        unstable,
     ))
 }
 
@@ -211,6 +226,14 @@ fn zpk_order(kind: &Spec) -> usize {
 }
 
 /// The signal registry's spec table of `kind` with `keys`, as the door checks built them.
+/// `spec` with `unstable = true` when asked for (`[system] unstable`).
+fn with_unstable(mut spec: Spec, unstable: bool) -> Spec {
+    if unstable {
+        spec.insert("unstable".into(), json!(true));
+    }
+    spec
+}
+
 fn spec<const N: usize>(kind: &str, keys: [(&str, Value); N]) -> Spec {
     let mut spec = Spec::new();
     spec.insert(KIND_KEY.into(), kind.into());

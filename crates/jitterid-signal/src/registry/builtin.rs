@@ -68,8 +68,9 @@ fn zpk() -> SignalKind {
                 "poles",
                 "poles: a number (real) or [re, im] (the pair re ± i·im)",
                 "rad/s",
-                "at least one; real part < 0, distinct, im > 0",
+                "at least one; real part ≤ 0 (unless `unstable`), im > 0",
             ),
+            unstable_key(),
         ]
         .into_iter()
         .chain(response_keys())
@@ -83,7 +84,12 @@ fn zpk() -> SignalKind {
                 ("pole", "poles"),
                 ("poles", "poles"),
             ];
-            let g = Zpk::new(gain, zeros, poles).map_err(|e| {
+            let g = if r.flag("unstable")? {
+                Zpk::new_allowing_unstable(gain, zeros, poles)
+            } else {
+                Zpk::new(gain, zeros, poles)
+            };
+            let g = g.map_err(|e| {
                 let fallback = if matches!(e, SignalError::Improper { .. }) {
                     "zeros"
                 } else {
@@ -96,11 +102,14 @@ fn zpk() -> SignalKind {
                 r,
                 LtiResponse::new(g, input_of(input)?),
                 |g: &Zpk| {
-                    spec([
-                        ("gain", json!(g.gain())),
-                        ("zeros", roots_json(g.zeros())),
-                        ("poles", roots_json(g.poles())),
-                    ])
+                    with_unstable(
+                        spec([
+                            ("gain", json!(g.gain())),
+                            ("zeros", roots_json(g.zeros())),
+                            ("poles", roots_json(g.poles())),
+                        ]),
+                        g,
+                    )
                 },
             )
         },
@@ -122,8 +131,9 @@ fn tf() -> SignalKind {
                 "den",
                 "denominator coefficients, highest power first (normalised to monic)",
                 "",
-                "finite, leading ≠ 0, stable distinct poles",
+                "finite, leading ≠ 0, poles with real part ≤ 0 (unless `unstable`)",
             ),
+            unstable_key(),
         ]
         .into_iter()
         .chain(response_keys())
@@ -132,7 +142,12 @@ fn tf() -> SignalKind {
         |r: &SpecReader<'_>, input| {
             let (num, den) = (r.f64_list("num")?, r.f64_list("den")?);
             let keys = [("num", "num"), ("den", "den")];
-            let g = TransferFunction::new(&num, &den).map_err(|e| {
+            let g = if r.flag("unstable")? {
+                TransferFunction::new_allowing_unstable(&num, &den)
+            } else {
+                TransferFunction::new(&num, &den)
+            };
+            let g = g.map_err(|e| {
                 let fallback = if matches!(e, SignalError::Improper { .. }) {
                     "num"
                 } else {
@@ -144,10 +159,31 @@ fn tf() -> SignalKind {
                 "tf",
                 r,
                 LtiResponse::new(g, input_of(input)?),
-                |g: &TransferFunction| spec([("num", json!(g.num())), ("den", json!(g.den()))]),
+                |g: &TransferFunction| {
+                    with_unstable(spec([("num", json!(g.num())), ("den", json!(g.den()))]), g)
+                },
             )
         },
     )
+}
+
+/// The permission for poles right of the imaginary axis.
+fn unstable_key() -> ParamSpec {
+    ParamSpec::new(
+        "unstable",
+        "accept poles with a positive real part (true) or refuse them (false, the default); \
+         kept while the model is estimated, so that a search may cross the axis",
+        "",
+        "optional; true or false",
+    )
+}
+
+/// `spec` with `unstable = true` when the model accepts unstable poles.
+fn with_unstable<M: RationalModel>(mut spec: Spec, g: &M) -> Spec {
+    if g.rational().allows_unstable() {
+        spec.insert("unstable".into(), json!(true));
+    }
+    spec
 }
 
 /// The keys every LTI kind adds to its model's: an input delay and the free response from an

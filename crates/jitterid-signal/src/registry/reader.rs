@@ -78,6 +78,15 @@ impl<'a> SpecReader<'a> {
         }
     }
 
+    /// A boolean (false when absent).
+    pub fn flag(&self, key: &str) -> Result<bool, SignalError> {
+        match self.spec.get(key) {
+            None => Ok(false),
+            Some(Value::Bool(b)) => Ok(*b),
+            Some(v) => Err(self.invalid(key, format!("expected true or false, found {v}"))),
+        }
+    }
+
     /// A list of numbers (empty when absent).
     pub fn f64_list(&self, key: &str) -> Result<Vec<f64>, SignalError> {
         match self.spec.get(key) {
