@@ -13,7 +13,11 @@
 //! * Requested instants `t_k = t0 + kT` ([`SampleGrid`]).
 //! * Responses are exact: an LTI system driven by a piecewise-constant input is evaluated in
 //!   modal (partial-fraction) form, `s(t) = Σ_j Δu_j [G(0) + Σ_i (r_i/p_i) e^{p_i (t − t_j)}]`
-//!   over the input's steps; no time stepping.
+//!   over the input's steps; no time stepping. Where the modal form fails (repeated or nearly
+//!   repeated poles, integrators and other poles on the imaginary axis) a state-space
+//!   realisation of `1/A²` gives the response and its gradient through matrix exponentials;
+//!   [`Rational::modal`] tells which route a model takes. Unstable poles are refused unless
+//!   asked for ([`TransferFunction::new_allowing_unstable`], [`Zpk::new_allowing_unstable`]).
 //!
 //! # Models
 //!

@@ -1,5 +1,6 @@
-//! Proper, stable continuous-time transfer functions `G(s) = N(s)/A(s)` in two
-//! parameterisations, and their modal (partial-fraction) form with parameter derivatives.
+//! Proper continuous-time transfer functions `G(s) = N(s)/A(s)` in two parameterisations, and
+//! their modal (partial-fraction) form with parameter derivatives where the poles are distinct
+//! and strictly stable.
 
 use crate::confluent::Confluent;
 use crate::error::{all_finite, finite, tf_coefficients, SignalError};
@@ -13,9 +14,10 @@ use std::fmt;
 /// this gap are `2e-12` and `2e-8` of the response's scale.
 const CONFLUENT_GAP: f64 = 1e-4;
 
-/// Relative real part (to the larger of `|p|` and 1) within which a pole counts as on the
-/// imaginary axis (marginally stable: an integrator, an undamped oscillator). Beyond it on the
-/// right a pole is unstable.
+/// Relative real part (to the larger of `|p|` and 1) up to which a pole right of the axis counts
+/// as on it (marginally stable: an integrator, an undamped oscillator, rounded to the right);
+/// beyond it a pole is unstable. Also: a pole within this fraction of the largest pole modulus
+/// of the origin counts as at the origin (the modal form's `r/p` would be huge there).
 const MARGINAL: f64 = 1e-9;
 
 /// The modal form `G(s) = D + Σ_i r_i / (s − p_i)` over all poles (conjugate pairs appear as
@@ -153,8 +155,12 @@ impl Rational {
                 return Err(SignalError::Unstable { re: p.re, im: p.im });
             }
         }
-        // The modal form only where it is accurate: strictly stable, well separated poles.
-        let modal_form = poles.iter().all(|p| p.re < -MARGINAL * p.norm().max(1.0))
+        // The modal form only where it is accurate: poles left of the axis, none at the origin
+        // (whose `r/p` would be a cancellation of huge terms), well separated.
+        let largest = poles.iter().map(|p| p.norm()).fold(1.0, f64::max);
+        let modal_form = poles
+            .iter()
+            .all(|p| p.re < 0.0 && p.norm() > MARGINAL * largest)
             && poles.iter().enumerate().all(|(i, p)| {
                 poles[i + 1..]
                     .iter()
@@ -375,10 +381,10 @@ impl From<Rational> for RationalFields {
     }
 }
 
-/// A proper, stable, continuous-time rational model with parameters `θ`.
+/// A proper continuous-time rational model with parameters `θ`.
 ///
-/// Implementors build a [`Rational`] at construction ([`Rational::new`] validates stability,
-/// properness and distinct poles); everything else is provided.
+/// Implementors build a [`Rational`] at construction ([`Rational::new`] validates properness
+/// and stability: poles with real part `≤ 0`, repeated or not); everything else is provided.
 pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
     /// Names of the parameters.
     fn param_names(&self) -> Vec<String>;
@@ -421,7 +427,8 @@ pub struct TransferFunction {
 
 impl TransferFunction {
     /// `num` and `den` in decreasing powers. Rejects non-finite coefficients, a zero leading
-    /// denominator coefficient, an improper model, unstable or repeated poles.
+    /// denominator coefficient, an improper model, unstable poles (repeated poles and poles on
+    /// the imaginary axis are accepted).
     pub fn new(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
         let form = crate::forms::TfForm::new(num, den)?;
         Self::from_monic(form.num().to_vec(), form.den().to_vec(), false)
@@ -601,7 +608,7 @@ fn expand(roots: &[Root]) -> (Vec<f64>, Vec<Vec<f64>>) {
 
 impl Zpk {
     /// Validates finite values, pairs with `im > 0`, at most as many zeros as poles, at least
-    /// one pole, stable and distinct poles.
+    /// one pole, poles with real part `≤ 0` (repeated poles and integrators are accepted).
     pub fn new(gain: f64, zeros: Vec<Root>, poles: Vec<Root>) -> Result<Self, SignalError> {
         Self::build(gain, zeros, poles, false)
     }

@@ -55,7 +55,7 @@ pub fn roots_json(roots: &[Root]) -> Value {
 fn zpk() -> SignalKind {
     SignalKind::new(
         "zpk",
-        "k·Π(s − z)/Π(s − p) driven by the input, exact (modal form)",
+        "k·Π(s − z)/Π(s − p) driven by the input, exact (modal form, or a realisation for repeated poles and integrators)",
         vec![
             ParamSpec::new("gain", "gain k", "", "finite"),
             ParamSpec::new(
@@ -119,7 +119,7 @@ fn zpk() -> SignalKind {
 fn tf() -> SignalKind {
     SignalKind::new(
         "tf",
-        "(b_m s^m + … + b_0)/(s^n + … + a_0) driven by the input, exact (modal form)",
+        "(b_m s^m + … + b_0)/(s^n + … + a_0) driven by the input, exact (modal form, or a realisation for repeated poles and integrators)",
         vec![
             ParamSpec::new(
                 "num",
