@@ -16,9 +16,13 @@ const CONFLUENT_GAP: f64 = 1e-4;
 
 /// Relative real part (to the larger of `|p|` and 1) up to which a pole right of the axis counts
 /// as on it (marginally stable: an integrator, an undamped oscillator, rounded to the right);
-/// beyond it a pole is unstable. Also: a pole within this fraction of the largest pole modulus
-/// of the origin counts as at the origin (the modal form's `r/p` would be huge there).
+/// beyond it a pole is unstable.
 const MARGINAL: f64 = 1e-9;
+
+/// A pole within this fraction of the largest pole modulus (or of 1) of the origin is taken as
+/// an integrator: a root at 0 of a polynomial comes out of a root finder as a few `ε` of the
+/// coefficients' scale, where the modal form's `r/p` would be a cancellation of huge terms.
+const ORIGIN: f64 = 1e-12;
 
 /// The modal form `G(s) = D + Σ_i r_i / (s − p_i)` over all poles (conjugate pairs appear as
 /// two entries), with derivatives of `D`, `p_i`, `r_i` and `G(0)` with respect to each parameter.
@@ -160,7 +164,7 @@ impl Rational {
         let largest = poles.iter().map(|p| p.norm()).fold(1.0, f64::max);
         let modal_form = poles
             .iter()
-            .all(|p| p.re < 0.0 && p.norm() > MARGINAL * largest)
+            .all(|p| p.re < 0.0 && p.norm() > ORIGIN * largest)
             && poles.iter().enumerate().all(|(i, p)| {
                 poles[i + 1..]
                     .iter()

@@ -67,9 +67,11 @@ fn bad_tables_name_the_key() {
             json!({"kind": "zpk", "gain": 1.0, "poles": [[-1.0, -2.0]]}),
             "poles",
         ),
+        // An unstable pole, unless asked for; the permission must be a boolean.
+        (json!({"kind": "zpk", "gain": 1.0, "poles": [0.5]}), "poles"),
         (
-            json!({"kind": "zpk", "gain": 1.0, "poles": [-1.0, -1.0]}),
-            "poles",
+            json!({"kind": "tf", "num": [1.0], "den": [1.0, -0.5], "unstable": "yes"}),
+            "unstable",
         ),
         (json!({"kind": "zpk", "gain": "x", "poles": [-1.0]}), "gain"),
         (
