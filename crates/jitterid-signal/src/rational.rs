@@ -19,10 +19,12 @@ const CONFLUENT_GAP: f64 = 1e-4;
 /// beyond it a pole is unstable.
 const MARGINAL: f64 = 1e-9;
 
-/// A pole within this fraction of the largest pole modulus (or of 1) of the origin is taken as
-/// an integrator: a root at 0 of a polynomial comes out of a root finder as a few `ε` of the
-/// coefficients' scale, where the modal form's `r/p` would be a cancellation of huge terms.
-const ORIGIN: f64 = 1e-12;
+/// A pole closer to the origin than this fraction of the smaller of 1 rad/s and the largest
+/// pole modulus is taken as an integrator. The modal form's step response `G(0) + Σ (r_i/p_i)
+/// e^{p_i t}` cancels terms of size `|r/p|` there (a root at 0 of a polynomial comes out of a
+/// root finder as a few `ε`; a search may pass through `10⁻¹⁰`), losing `ε|r/p|` of the
+/// response; the realisation has no such term.
+const ORIGIN: f64 = 1e-6;
 
 /// The modal form `G(s) = D + Σ_i r_i / (s − p_i)` over all poles (conjugate pairs appear as
 /// two entries), with derivatives of `D`, `p_i`, `r_i` and `G(0)` with respect to each parameter.
@@ -161,10 +163,10 @@ impl Rational {
         }
         // The modal form only where it is accurate: poles left of the axis, none at the origin
         // (whose `r/p` would be a cancellation of huge terms), well separated.
-        let largest = poles.iter().map(|p| p.norm()).fold(1.0, f64::max);
+        let largest = poles.iter().map(|p| p.norm()).fold(0.0, f64::max);
         let modal_form = poles
             .iter()
-            .all(|p| p.re < 0.0 && p.norm() > ORIGIN * largest)
+            .all(|p| p.re < 0.0 && p.norm() > ORIGIN * largest.min(1.0))
             && poles.iter().enumerate().all(|(i, p)| {
                 poles[i + 1..]
                     .iter()
