@@ -3,6 +3,8 @@
 //! integration of another realisation, closed forms, the contract's independent quadrature and
 //! Monte Carlo, and the modal form itself on both sides of the switch between the two routes.
 
+mod common;
+use common::ode_response;
 use jitterid_jitter::{ExponentialDelay, Gaussian, JitterModel, NoJitter, TwoPoint, UniformSum};
 use jitterid_signal::testing::{binary, check_contract};
 use jitterid_signal::{
@@ -10,67 +12,6 @@ use jitterid_signal::{
     TransferFunction, WithInitialState, Zpk,
 };
 use proptest::prelude::*;
-
-/// `y(t)` of `num/den` driven by `input`, by classical RK4 on the controllable canonical form of
-/// `den` (order `n`, not the `2n` of the library's realisation) with steps of at most `h`,
-/// landing exactly on every input switch.
-fn ode_response(
-    num: &[f64],
-    den: &[f64],
-    input: &PiecewiseConstant,
-    times: &[f64],
-    h: f64,
-) -> Vec<f64> {
-    let n = den.len() - 1;
-    let a: Vec<f64> = den[1..].to_vec();
-    let num = jitterid_signal::poly::pad(num, n + 1);
-    let d = num[0];
-    // N − d·A: the strictly proper part's numerator, coefficients of s^{n−1} … s^0.
-    let c: Vec<f64> = (1..=n).map(|i| num[i] - d * den[i]).collect();
-    let f = |x: &[f64], u: f64| -> Vec<f64> {
-        // x_1 = s^{n−1}/A u, …, x_n = 1/A u.
-        let mut dx = vec![0.0; n];
-        dx[0] = u - a.iter().zip(x).map(|(a, x)| a * x).sum::<f64>();
-        dx[1..n].copy_from_slice(&x[..n - 1]);
-        dx
-    };
-    let steps: Vec<(f64, f64)> = input.steps();
-    let mut out = Vec::with_capacity(times.len());
-    let mut x = vec![0.0; n];
-    let mut t = steps[0].0;
-    let mut u = 0.0;
-    let mut next_step = 0;
-    for &target in times {
-        while t < target {
-            while next_step < steps.len() && steps[next_step].0 <= t {
-                u += steps[next_step].1;
-                next_step += 1;
-            }
-            let stop = steps.get(next_step).map_or(target, |s| s.0.min(target));
-            let m = ((stop - t) / h).ceil().max(1.0) as usize;
-            let dt = (stop - t) / m as f64;
-            for _ in 0..m {
-                let k1 = f(&x, u);
-                let x2: Vec<f64> = x.iter().zip(&k1).map(|(x, k)| x + 0.5 * dt * k).collect();
-                let k2 = f(&x2, u);
-                let x3: Vec<f64> = x.iter().zip(&k2).map(|(x, k)| x + 0.5 * dt * k).collect();
-                let k3 = f(&x3, u);
-                let x4: Vec<f64> = x.iter().zip(&k3).map(|(x, k)| x + dt * k).collect();
-                let k4 = f(&x4, u);
-                for i in 0..n {
-                    x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                }
-            }
-            t = stop;
-        }
-        while next_step < steps.len() && steps[next_step].0 <= t {
-            u += steps[next_step].1;
-            next_step += 1;
-        }
-        out.push(d * u + c.iter().zip(&x).map(|(c, x)| c * x).sum::<f64>());
-    }
-    out
-}
 
 /// Models without a modal form: a double and a triple real pole, a repeated complex pair,
 /// integrators (single and double) beside a stable pole, an undamped pair.

@@ -1,6 +1,8 @@
 //! The LTI response against independent routes: a fine-step ODE integration for `s(t)`, the
 //! generic quadrature route for `m_k`, and finite differences for every gradient.
 
+mod common;
+use common::ode_response;
 use jitterid_jitter::{
     ExponentialDelay, Gaussian, JitterModel, Laplace, NoJitter, Shifted, TwoPoint, UniformSum,
 };
@@ -47,57 +49,6 @@ fn jitters() -> Vec<Box<dyn JitterModel>> {
     ]
 }
 
-/// RK4 on the controllable canonical form of `N(s)/A(s)` with `A` monic:
-/// `ẋ = A_c x + B u`, `y = C x + D u` with `C_i = b_i − D a_i`.
-fn ode_response(
-    num: &[f64],
-    den: &[f64],
-    u: &PiecewiseConstant,
-    t_end: f64,
-    h: f64,
-) -> Vec<(f64, f64)> {
-    let n = den.len() - 1;
-    let d = num[0];
-    let c: Vec<f64> = (0..n).map(|i| num[i + 1] - d * den[i + 1]).collect();
-    let deriv = |x: &[f64], uval: f64| -> Vec<f64> {
-        // x[0] is the highest-order state: ẋ_0 = −Σ a_{i+1} x_i + u, ẋ_i = x_{i−1}.
-        let mut dx = vec![0.0; n];
-        dx[0] = uval - (0..n).map(|i| den[i + 1] * x[i]).sum::<f64>();
-        dx[1..n].copy_from_slice(&x[..n - 1]);
-        dx
-    };
-    let mut x = vec![0.0; n];
-    let mut out = Vec::new();
-    // Step exactly onto every edge so the input is constant within each RK4 step.
-    let mut marks: Vec<f64> = u.edges().to_vec();
-    marks.push(t_end);
-    marks.sort_by(f64::total_cmp);
-    for w in marks.windows(2) {
-        let (a, b) = (w[0], w[1].min(t_end));
-        if b <= a {
-            continue;
-        }
-        let uval = u.value(0.5 * (a + b));
-        let steps = ((b - a) / h).ceil() as usize;
-        let hh = (b - a) / steps as f64;
-        for _ in 0..steps {
-            let k1 = deriv(&x, uval);
-            let x2: Vec<f64> = x.iter().zip(&k1).map(|(x, k)| x + 0.5 * hh * k).collect();
-            let k2 = deriv(&x2, uval);
-            let x3: Vec<f64> = x.iter().zip(&k2).map(|(x, k)| x + 0.5 * hh * k).collect();
-            let k3 = deriv(&x3, uval);
-            let x4: Vec<f64> = x.iter().zip(&k3).map(|(x, k)| x + hh * k).collect();
-            let k4 = deriv(&x4, uval);
-            for i in 0..n {
-                x[i] += hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
-        }
-        let y = c.iter().zip(&x).map(|(c, x)| c * x).sum::<f64>() + d * u.value(b - 1e-12);
-        out.push((b, y));
-    }
-    out
-}
-
 #[test]
 fn response_matches_fine_step_ode_integration() {
     let u = binary_input(7, 60.0);
@@ -107,8 +58,17 @@ fn response_matches_fine_step_ode_integration() {
     ] {
         let g = TransferFunction::new(&num, &den).unwrap();
         let s = LtiResponse::new(g.clone(), u.clone());
-        let ode = ode_response(g.rational().num(), g.den(), &u, 60.0, 1e-3);
-        for (t, y) in ode {
+        // Every edge up to the end, and the end (left limits at the edges).
+        let first = u.edges()[0];
+        let mut times: Vec<f64> = u
+            .edges()
+            .iter()
+            .copied()
+            .filter(|&e| e > first && e < 60.0)
+            .collect();
+        times.push(60.0);
+        let ode = ode_response(g.rational().num(), g.den(), &u, &times, 1e-3);
+        for (t, y) in times.into_iter().zip(ode) {
             // Just before the edge, where the ODE state is; RK4 at h = 1e-3 is accurate to ~1e-11.
             let exact = s.value(t - 1e-12);
             assert!((exact - y).abs() < 1e-8, "t = {t}: exact {exact}, ode {y}");
