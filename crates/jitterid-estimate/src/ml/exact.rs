@@ -65,6 +65,7 @@
 //! as points outside the model's domain and steps back).
 
 use super::cheb::{basis, coefficients, PiecewiseCheb, CHEB_POINTS};
+use super::fastexp::{exp_nonpositive, EXP_FLOOR};
 use super::MlError;
 use jitterid_jitter::kernels::gauss::{gl16, subdivisions};
 use jitterid_jitter::rule::MAX_SUBDIVISIONS;
@@ -367,6 +368,56 @@ pub(crate) struct SampleModel<'a, S: ?Sized> {
     pub(crate) sigma: f64,
 }
 
+/// `max_i −(y − s_i)²/(2σ²)` (`inv2 = 1/(2σ²)`), in four independent lanes so that the
+/// comparisons run as vector instructions; the maximum does not depend on their order.
+#[inline]
+fn max_exponent(s: &[f64], y: f64, inv2: f64) -> f64 {
+    let mut m = [f64::NEG_INFINITY; 4];
+    let chunks = s.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for j in 0..4 {
+            let e = y - c[j];
+            let v = -e * e * inv2;
+            m[j] = if v > m[j] { v } else { m[j] };
+        }
+    }
+    for &sj in rest {
+        let e = y - sj;
+        let v = -e * e * inv2;
+        m[0] = if v > m[0] { v } else { m[0] };
+    }
+    m.iter()
+        .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a })
+}
+
+/// The log-sum-exp's terms `w_i e^{−(y − s_i)²/(2σ²) − lmax}` into `terms`, and their sum
+/// (in four interleaved partial sums, added in a fixed order, so the same for any thread).
+/// Terms below `e^{EXP_FLOOR}` are 0.
+#[inline]
+fn weighted_terms(s: &[f64], w: &[f64], y: f64, inv2: f64, lmax: f64, terms: &mut Vec<f64>) -> f64 {
+    terms.clear();
+    terms.resize(s.len(), 0.0);
+    for ((t, &si), &wi) in terms.iter_mut().zip(s).zip(w) {
+        let e = y - si;
+        let q = -e * e * inv2 - lmax;
+        let v = wi * exp_nonpositive(q);
+        *t = if q >= EXP_FLOOR { v } else { 0.0 };
+    }
+    let mut acc = [0.0; 4];
+    let chunks = terms.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for j in 0..4 {
+            acc[j] += c[j];
+        }
+    }
+    for (j, &r) in rest.iter().enumerate() {
+        acc[j] += r;
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
 impl<S: Signal + ?Sized> SampleModel<'_, S> {
     /// `log p(y)` of a sample requested at `t`, and, when `grad` is given (length
     /// `grad_channels + 1`), `∂ log p/∂θ_signal` followed by `∂ log p/∂σ_v`.
@@ -458,7 +509,9 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         }
         let mut h = [0.0; CHEB_POINTS];
         for (hi, ei) in h.iter_mut().zip(&e) {
-            *hi = (-(ei * ei - d0) * inv2).exp();
+            let q = -(ei * ei - d0) * inv2;
+            let v = exp_nonpositive(q);
+            *hi = if q >= EXP_FLOOR { v } else { 0.0 };
         }
         let c = coefficients(&h);
         let total: f64 = c.iter().zip(mu).map(|(c, m)| c * m).sum();
@@ -738,26 +791,14 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
     fn sum(&self, t: f64, y: f64, grad: Option<&mut [f64]>, scratch: &mut Scratch) -> f64 {
         let sigma = self.sigma;
         let inv2 = 0.5 / (sigma * sigma);
-        let mut lmax = f64::NEG_INFINITY;
-        for &s in &scratch.s {
-            let e = y - s;
-            lmax = lmax.max(-e * e * inv2);
-        }
+        let lmax = max_exponent(&scratch.s, y, inv2);
         if !lmax.is_finite() {
             if let Some(g) = grad {
                 g.fill(f64::NAN);
             }
             return f64::NEG_INFINITY;
         }
-        let mut total = 0.0;
-        scratch.terms.clear();
-        for (&s, &w) in scratch.s.iter().zip(&scratch.w) {
-            let e = y - s;
-            let q = -e * e * inv2 - lmax;
-            let term = if q > -745.0 { w * q.exp() } else { 0.0 };
-            total += term;
-            scratch.terms.push(term);
-        }
+        let mut total = weighted_terms(&scratch.s, &scratch.w, y, inv2, lmax, &mut scratch.terms);
         let mut shift = lmax;
         let mut use_logs = false;
         if !(total > 1e-280) {

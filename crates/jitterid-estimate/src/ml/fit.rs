@@ -253,14 +253,28 @@ where
     })
 }
 
-/// In the integer-`n` profile of a one-parameter fit, every `n` is first fitted to a loose
-/// tolerance (`3e-3` in `ln a`: with a standard error of `ln â` of 0.02 or more, a curvature
-/// of `−log L` of at most 2500, that leaves `−log L` within about `1e-2` of its minimum), and
-/// only the `n` whose loose minimum is within this margin of the best are refined; the others
-/// cannot win (refining lowers a loose minimum by less than its `1e-2` error, so the margin
-/// leaves a factor 25). The test `staged_profile_equals_full_refinement` checks the choice
-/// against refining every `n`.
+/// In the integer-`n` profile of a one-parameter fit, every `n` is first fitted loosely: to
+/// `3e-3` in `ln a`, or until the parabola through the search's three best points predicts
+/// less than [`COARSE_COST_TOLERANCE`] of further decrease (with a standard error of `ln â`
+/// of 0.02 or more, a curvature of `−log L` of at most 2500, either leaves `−log L` within
+/// about `1e-2` of its minimum), and only the `n` whose loose minimum is within this margin of
+/// the best are refined; the others cannot win (refining lowers a loose minimum by less than
+/// its `1e-2` error, so the margin leaves a factor 25; the true winner is refined whenever its
+/// loose value is within the margin of its minimum). The test
+/// `staged_profile_equals_full_refinement` checks the choice against refining every `n`.
 pub const PROFILE_MARGIN: f64 = 0.25;
+
+/// The first pass of the profile also stops when the parabola through its three best points
+/// predicts a further decrease of `−log L` below this ([`Brent::cost_tolerance`]): near the
+/// minimum, where the parabola is the function to within its cubic term, the value is then
+/// known to about this much, and the point well enough to start the refinement.
+const COARSE_COST_TOLERANCE: f64 = 1e-3;
+
+/// First bracketing step (in the transformed parameter) of a first-pass fit started from the
+/// previous value's fit: neighbouring `n` put `σ̂` within a few per cent of each other, so
+/// the bracket closes in its first three points and the parabola through them is close to the
+/// function.
+const WARM_BRACKET_STEP: f64 = 0.03;
 
 /// Whether `solver` is the default likelihood solver (the profile's coarse-then-refine
 /// schedule replaces it for one-parameter fits).
@@ -284,15 +298,19 @@ fn brent_hook<V: Any>(solver: &V) -> Option<ProgressHook> {
         .and_then(|s| s.brent.progress.clone())
 }
 
-/// Fits `structure` with its jitter replaced by `build(v)` for every `v` in `values`, in
-/// parallel, and returns the converged fit with the largest likelihood (the largest of all if
+/// Fits `structure` with its jitter replaced by `build(v)` for every `v` in `values` and
+/// returns the converged fit with the largest likelihood (the largest of all if
 /// none converged). `build` makes the start jitter of a value (see
 /// [`profile`](crate::profile)). The covariance, if asked for, is computed for the winner only.
 ///
 /// With the default solver and a single free parameter (the jitter's), every value is first
-/// fitted to a loose tolerance and only those within [`PROFILE_MARGIN`] of the best are
-/// refined; both stages run Brent's iterations from their brackets' known values
-/// ([`Brent::from_bracket`]).
+/// fitted loosely, in order, each value after the first started where the previous fit put
+/// the jitter's standard deviation (its parameter scaled by the ratio of fitted to start
+/// standard deviations: exact for a scale parameter such as the uniform sum's `a`), and only
+/// those within [`PROFILE_MARGIN`] of the best are refined, in parallel; both stages run
+/// Brent's iterations from their brackets' known values ([`Brent::from_bracket`]). With other
+/// solvers or more parameters every value is fitted once, in parallel. The likelihood's
+/// evaluations are themselves shared among threads.
 ///
 /// # Errors
 ///
@@ -339,6 +357,7 @@ where
         covariance: false,
         ..options.with_solver(Brent {
             tolerance: 3e-3,
+            cost_tolerance: COARSE_COST_TOLERANCE,
             progress: brent_hook(&options.solver),
             from_bracket: true,
             ..Brent::default()
@@ -354,15 +373,48 @@ where
         Some(o) => ml_estimate_with(s, record, data.as_ref(), known, criterion, o),
         None => ml_estimate_with(s, record, data.as_ref(), known, criterion, &plain),
     };
-    let mut fits: Vec<(i64, Result<Fit, MlError>)> = values
-        .par_iter()
-        .map(|&v| {
-            (
-                v,
-                at(v).and_then(|s| fit_with(&s, staged.then_some(&coarse), None)),
-            )
-        })
-        .collect();
+    let mut fits: Vec<(i64, Result<Fit, MlError>)> = if staged {
+        // In order, each value after the first started where the previous fit put the
+        // jitter's standard deviation, with a narrower bracket.
+        let warm = MlOptions {
+            covariance: false,
+            ..options.with_solver(Brent {
+                bracket_step: WARM_BRACKET_STEP,
+                ..coarse.solver.clone()
+            })
+        };
+        let mut ratio: Option<f64> = None;
+        let mut out = Vec::with_capacity(values.len());
+        for &v in &values {
+            let fit = at(v).and_then(|s| {
+                let started = ratio.and_then(|r| {
+                    let p = s.params();
+                    (p.len() == 1)
+                        .then(|| s.with_params(&[p[0] * r]).ok())
+                        .flatten()
+                });
+                match &started {
+                    Some(w) => fit_with(w, Some(&warm), None),
+                    None => fit_with(&s, Some(&coarse), None),
+                }
+                .map(|f| (f, s))
+            });
+            ratio = match &fit {
+                Ok((f, s)) if f.converged => fitted_jitter(s, s.jitter.clone(), f)
+                    .ok()
+                    .map(|j| j.std_dev() / s.jitter.std_dev())
+                    .filter(|r| r.is_finite() && *r > 0.0),
+                _ => None,
+            };
+            out.push((v, fit.map(|(f, _)| f)));
+        }
+        out
+    } else {
+        values
+            .par_iter()
+            .map(|&v| (v, at(v).and_then(|s| fit_with(&s, None, None))))
+            .collect()
+    };
     if staged {
         let best = fits
             .iter()

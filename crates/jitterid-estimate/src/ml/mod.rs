@@ -70,6 +70,7 @@ mod cheb;
 mod criterion;
 mod error;
 mod exact;
+mod fastexp;
 mod fisher;
 mod fit;
 mod moments;

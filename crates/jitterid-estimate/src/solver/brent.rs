@@ -34,6 +34,13 @@ pub struct Brent {
     /// result moves within the tolerance. Default false.
     #[serde(default)]
     pub from_bracket: bool,
+    /// With [`from_bracket`](Self::from_bracket): also stop when the parabola through the
+    /// three best points is convex, has its vertex inside the bracket and predicts that the
+    /// best value would fall by at most this much (the value is then known to about this
+    /// accuracy while the point may still be off by more than `tolerance`). For a loose fit
+    /// whose value is what matters, such as the first pass of a profile. Default 0 (off).
+    #[serde(default)]
+    pub cost_tolerance: f64,
 }
 
 impl Default for Brent {
@@ -44,6 +51,7 @@ impl Default for Brent {
             max_iters: 100,
             progress: None,
             from_bracket: false,
+            cost_tolerance: 0.0,
         }
     }
 }
@@ -197,7 +205,7 @@ impl Brent {
             f,
             b,
             [a, c],
-            (f64::EPSILON.sqrt(), self.tolerance),
+            (f64::EPSILON.sqrt(), self.tolerance, self.cost_tolerance),
             self.max_iters,
             report,
         );

@@ -22,14 +22,43 @@ pub(crate) struct BracketResult {
     pub(crate) converged: bool,
 }
 
+/// The decrease from `x` to the vertex of the parabola through `x`, `w`, `v` (distinct points,
+/// finite values), when the parabola is convex and its vertex lies in `[lo, hi]`.
+fn parabola_decrease(
+    (x, fx): Point,
+    (w, fw): Point,
+    (v, fv): Point,
+    (lo, hi): (f64, f64),
+) -> Option<f64> {
+    if !(fx.is_finite() && fw.is_finite() && fv.is_finite()) || x == w || x == v || w == v {
+        return None;
+    }
+    // Divided differences: slope f[x, w], f[x, v], curvature 2 f[x, w, v].
+    let (sw, sv) = ((fw - fx) / (w - x), (fv - fx) / (v - x));
+    let c = 2.0 * (sw - sv) / (w - v);
+    if !(c > 0.0) {
+        return None;
+    }
+    // f(u) = fx + g (u − x) + c (u − x)²/2 with g = f[x, w] − c (w − x)/2.
+    let g = sw - 0.5 * c * (w - x);
+    let step = -g / c;
+    let vertex = x + step;
+    (vertex >= lo && vertex <= hi).then_some(0.5 * c * step * step)
+}
+
 /// Minimises `f` inside the bracket whose interior point is `best` and whose ends are `ends`
 /// (`best.1 ≤` both ends' values), to the tolerance `eps |x| + t`, in at most `max_iters`
 /// evaluations. `report(evaluations, best value)` is called after every evaluation.
+///
+/// With `cost_tol > 0` it also stops, before evaluating, when the parabola through the three
+/// best points is convex, has its vertex inside the bracket, and predicts a decrease of the
+/// best value by at most `cost_tol` (see [`Brent::cost_tolerance`](super::Brent)); on the
+/// bracket's own three points only when their values span at most `100 cost_tol`.
 pub(crate) fn minimize_from_bracket(
     mut f: impl FnMut(f64) -> f64,
     best: Point,
     ends: [Point; 2],
-    (eps, t): (f64, f64),
+    (eps, t, cost_tol): (f64, f64, f64),
     max_iters: u64,
     mut report: impl FnMut(u64, f64),
 ) -> BracketResult {
@@ -66,6 +95,20 @@ pub(crate) fn minimize_from_bracket(
         }
         let p = (x - v) * (x - v) * (fx - fw) - (x - w) * (x - w) * (fx - fv);
         let q = 2.0 * ((x - w) * (fx - fv) - (x - v) * (fx - fw));
+        // On the bracket alone only if its values span at most 100 cost_tol: its points may be
+        // too far apart for the parabola to predict the minimum's value, but a model error of
+        // a tenth of that span still leaves the value within 10 cost_tol.
+        if cost_tol > 0.0 && (evaluations > 0 || fw.max(fv) - fx <= 100.0 * cost_tol) {
+            if let Some(drop) = parabola_decrease((x, fx), (w, fw), (v, fv), (lo, hi)) {
+                if drop <= cost_tol {
+                    return BracketResult {
+                        best: (x, fx),
+                        evaluations,
+                        converged: true,
+                    };
+                }
+            }
+        }
         let (p, q) = if q >= 0.0 { (p, q) } else { (-p, -q) };
         // Infinite values (invalid trial points) give no parabola: a golden-section step.
         let parabola_usable = p.is_finite() && q.is_finite();
@@ -143,7 +186,7 @@ mod tests {
     #[test]
     fn finds_the_minimum_to_the_tolerance_in_fewer_evaluations_than_brentopt() {
         let (lo, mid, hi) = (-10.0, -8.0, 10.0);
-        let tol = (f64::EPSILON.sqrt(), 1e-8);
+        let tol = (f64::EPSILON.sqrt(), 1e-8, 0.0);
         let mut calls = 0;
         let r = minimize_from_bracket(
             |x| {
@@ -192,7 +235,7 @@ mod tests {
         // The parabola through the bracket is the function: the first step lands on the
         // minimum; the rest only closes the bracket to the stopping test.
         let f = |x: f64| Quadratic.cost(&x).unwrap();
-        let tol = (f64::EPSILON.sqrt(), 1e-8);
+        let tol = (f64::EPSILON.sqrt(), 1e-8, 0.0);
         let mut first = None;
         let mut calls = 0;
         let r = minimize_from_bracket(
@@ -243,7 +286,7 @@ mod tests {
             f,
             (0.5, f(0.5)),
             [(0.0, f(0.0)), (1.5, f64::INFINITY)],
-            (f64::EPSILON.sqrt(), 1e-10),
+            (f64::EPSILON.sqrt(), 1e-10, 0.0),
             100,
             |_, _| {},
         );
@@ -259,12 +302,72 @@ mod tests {
             f,
             (0.5, f(0.5)),
             [(0.0, f(0.0)), (1.5, f(1.5))],
-            (f64::EPSILON.sqrt(), 1e-12),
+            (f64::EPSILON.sqrt(), 1e-12, 0.0),
             2,
             |_, _| reports += 1,
         );
         assert!(!r.converged);
         assert_eq!((r.evaluations, reports), (2, 2));
         assert!(r.best.1 <= f(0.5));
+    }
+
+    #[test]
+    fn the_parabola_predicts_a_quadratic_exactly_and_only_inside_the_bracket() {
+        let f = |x: f64| 3.0 * (x - 0.37).powi(2) + 1.0;
+        let pt = |x: f64| (x, f(x));
+        let d = parabola_decrease(pt(0.5), pt(0.2), pt(0.9), (0.0, 1.0)).unwrap();
+        assert!((d - (f(0.5) - 1.0)).abs() <= 1e-14, "{d}");
+        // The vertex 0.37 outside [0.4, 1]: no prediction.
+        assert_eq!(
+            parabola_decrease(pt(0.5), pt(0.45), pt(0.9), (0.4, 1.0)),
+            None
+        );
+        // Concave, repeated or infinite points: none.
+        let g = |x: f64| -f(x);
+        assert_eq!(
+            parabola_decrease((0.5, g(0.5)), (0.2, g(0.2)), (0.9, g(0.9)), (0.0, 1.0)),
+            None
+        );
+        assert_eq!(
+            parabola_decrease(pt(0.5), pt(0.5), pt(0.9), (0.0, 1.0)),
+            None
+        );
+        assert_eq!(
+            parabola_decrease(pt(0.5), (0.2, f64::INFINITY), pt(0.9), (0.0, 1.0)),
+            None
+        );
+    }
+
+    #[test]
+    fn a_cost_tolerance_stops_earlier_with_the_value_within_it() {
+        // The skewed function from a wide bracket: with a cost tolerance the search stops when
+        // the parabola through its three best points predicts at most that decrease, which,
+        // this close to the minimum, bounds the true remaining decrease within a factor 2.
+        let (lo, mid, hi) = (-10.0, -8.0, 10.0);
+        let x_star = skewed_minimum();
+        let f_star = skewed(x_star);
+        let run = |cost_tol: f64| {
+            minimize_from_bracket(
+                skewed,
+                (mid, skewed(mid)),
+                [(lo, skewed(lo)), (hi, skewed(hi))],
+                (f64::EPSILON.sqrt(), 1e-8, cost_tol),
+                100,
+                |_, _| {},
+            )
+        };
+        let full = run(0.0);
+        for cost_tol in [1e-2, 1e-3, 1e-4] {
+            let loose = run(cost_tol);
+            assert!(loose.converged);
+            assert!(
+                loose.evaluations < full.evaluations,
+                "{cost_tol}: {} vs {}",
+                loose.evaluations,
+                full.evaluations
+            );
+            let gap = loose.best.1 - f_star;
+            assert!((0.0..=2.0 * cost_tol).contains(&gap), "{cost_tol}: {gap}");
+        }
     }
 }
