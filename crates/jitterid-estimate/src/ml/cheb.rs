@@ -180,7 +180,14 @@ impl PiecewiseCheb {
                 acc[i] = acc[i] * x[i] + mk;
             }
         }
-        out[lanes.clone()].copy_from_slice(&acc[lanes]);
+        // A fixed-length select rather than a copy of the run-time range (a library call).
+        for i in 0..16 {
+            out[i] = if lanes.start <= i && i < lanes.end {
+                acc[i]
+            } else {
+                out[i]
+            };
+        }
     }
 
     /// Channel 0 at 16 increasing points, which may span several segments: each run of points
