@@ -75,6 +75,7 @@ pub mod registry;
 mod restricted_noise;
 mod result;
 pub mod selection;
+mod simd;
 pub mod solver;
 mod structure;
 pub mod validation;
