@@ -255,7 +255,7 @@ where
 
 /// In the integer-`n` profile of a one-parameter fit, every `n` is first fitted loosely: to
 /// `3e-3` in `ln a`, or until the parabola through the search's three best points predicts
-/// less than [`COARSE_COST_TOLERANCE`] of further decrease (with a standard error of `ln â`
+/// less than `1e-3` of further decrease (with a standard error of `ln â`
 /// of 0.02 or more, a curvature of `−log L` of at most 2500, either leaves `−log L` within
 /// about `1e-2` of its minimum), and only the `n` whose loose minimum is within this margin of
 /// the best are refined; the others cannot win (refining lowers a loose minimum by less than
