@@ -14,3 +14,33 @@ pub(crate) fn has_avx2() -> bool {
     static HAS: OnceLock<bool> = OnceLock::new();
     *HAS.get_or_init(|| std::is_x86_feature_detected!("avx2"))
 }
+
+/// Defines `fn $name(args) -> ret { body }` compiled twice, for the baseline and for AVX2, and
+/// calling the AVX2 copy when [`has_avx2`] says the processor has it. The body is the same
+/// code in both copies, so the values are too.
+macro_rules! baseline_or_avx2 {
+    (
+        $(#[$meta:meta])*
+        fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block
+    ) => {
+        $(#[$meta])*
+        #[inline]
+        fn $name($($arg: $ty),*) $(-> $ret)? {
+            #[inline(always)]
+            fn kernel($($arg: $ty),*) $(-> $ret)? $body
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2")]
+            fn wide($($arg: $ty),*) $(-> $ret)? {
+                kernel($($arg),*)
+            }
+            #[cfg(target_arch = "x86_64")]
+            if $crate::simd::has_avx2() {
+                // SAFETY: the processor has AVX2 (checked at run time), the only feature
+                // `wide` needs.
+                return unsafe { wide($($arg),*) };
+            }
+            kernel($($arg),*)
+        }
+    };
+}
+pub(crate) use baseline_or_avx2;

@@ -91,26 +91,20 @@ pub(crate) struct PiecewiseCheb {
     mono0: Vec<[f64; CHEB_POINTS]>,
 }
 
-/// Horner's rule for the monomial coefficients `m` of the local variable
-/// `x = clamp((t − mid)·scale, −1, 1)` at the 16 points `ts`, keeping the lanes in `lanes`.
-/// On x86-64 machines with AVX2 the same operations run four lanes to an instruction instead
-/// of two (`crate::simd`); no fused multiply–add is used, so the values are the same.
-#[inline]
-fn horner16(
-    m: &[f64; CHEB_POINTS],
-    (mid, scale): (f64, f64),
-    ts: &[f64; 16],
-    out: &mut [f64; 16],
-    lanes: std::ops::Range<usize>,
-) {
-    #[inline(always)]
-    fn kernel(
+crate::simd::baseline_or_avx2! {
+    /// Horner's rule for the monomial coefficients `m` of the local variable
+    /// `x = clamp((t − mid)·scale, −1, 1)` (`centre = (mid, scale)`) at the 16 points `ts`,
+    /// keeping the lanes in `lanes`. On x86-64 machines with AVX2 the same operations run four
+    /// lanes to an instruction instead of two (`crate::simd`); no fused multiply–add is used,
+    /// so the values are the same.
+    fn horner16(
         m: &[f64; CHEB_POINTS],
-        (mid, scale): (f64, f64),
+        centre: (f64, f64),
         ts: &[f64; 16],
         out: &mut [f64; 16],
         lanes: std::ops::Range<usize>,
     ) {
+        let (mid, scale) = centre;
         let mut x = [0.0; 16];
         for i in 0..16 {
             x[i] = ((ts[i] - mid) * scale).clamp(-1.0, 1.0);
@@ -130,24 +124,6 @@ fn horner16(
             };
         }
     }
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn wide(
-        m: &[f64; CHEB_POINTS],
-        centre: (f64, f64),
-        ts: &[f64; 16],
-        out: &mut [f64; 16],
-        lanes: std::ops::Range<usize>,
-    ) {
-        kernel(m, centre, ts, out, lanes);
-    }
-    #[cfg(target_arch = "x86_64")]
-    if crate::simd::has_avx2() {
-        // SAFETY: the processor has AVX2 (checked at run time), the only feature `wide` needs.
-        unsafe { wide(m, (mid, scale), ts, out, lanes) };
-        return;
-    }
-    kernel(m, (mid, scale), ts, out, lanes);
 }
 
 /// Channels whose Clenshaw recurrences [`PiecewiseCheb::eval_all`] runs side by side.

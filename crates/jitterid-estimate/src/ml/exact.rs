@@ -368,12 +368,10 @@ pub(crate) struct SampleModel<'a, S: ?Sized> {
     pub(crate) sigma: f64,
 }
 
-/// `max_i −(y − s_i)²/(2σ²)` (`inv2 = 1/(2σ²)`), in four independent lanes so that the
-/// comparisons run as vector instructions; the maximum does not depend on their order.
-#[inline]
-fn max_exponent(s: &[f64], y: f64, inv2: f64) -> f64 {
-    #[inline(always)]
-    fn kernel(s: &[f64], y: f64, inv2: f64) -> f64 {
+crate::simd::baseline_or_avx2! {
+    /// `max_i −(y − s_i)²/(2σ²)` (`inv2 = 1/(2σ²)`), in four independent lanes so that the
+    /// comparisons run as vector instructions; the maximum does not depend on their order.
+    fn max_exponent(s: &[f64], y: f64, inv2: f64) -> f64 {
         let mut m = [f64::NEG_INFINITY; 4];
         let chunks = s.chunks_exact(4);
         let rest = chunks.remainder();
@@ -392,31 +390,14 @@ fn max_exponent(s: &[f64], y: f64, inv2: f64) -> f64 {
         m.iter()
             .fold(f64::NEG_INFINITY, |a, &b| if b > a { b } else { a })
     }
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn wide(s: &[f64], y: f64, inv2: f64) -> f64 {
-        kernel(s, y, inv2)
-    }
-    #[cfg(target_arch = "x86_64")]
-    if crate::simd::has_avx2() {
-        // SAFETY: the processor has AVX2 (checked at run time), the only feature `wide` needs.
-        return unsafe { wide(s, y, inv2) };
-    }
-    kernel(s, y, inv2)
 }
 
-/// The log-sum-exp's terms `w_i e^{−(y − s_i)²/(2σ²) − lmax}` into `terms`, and their sum
-/// (in four interleaved partial sums, added in a fixed order, so the same for any thread).
-/// Terms below `e^{EXP_FLOOR}` are 0.
-#[inline]
-fn weighted_terms(
-    s: &[f64],
-    w: &[f64],
-    (y, inv2, lmax): (f64, f64, f64),
-    terms: &mut Vec<f64>,
-) -> f64 {
-    #[inline(always)]
-    fn kernel(s: &[f64], w: &[f64], (y, inv2, lmax): (f64, f64, f64), terms: &mut [f64]) -> f64 {
+crate::simd::baseline_or_avx2! {
+    /// The log-sum-exp's terms `w_i e^{−(y − s_i)²/(2σ²) − lmax}` (`p = (y, inv2, lmax)`)
+    /// into `terms` (as long as `s`), and their sum (in four interleaved partial sums, added
+    /// in a fixed order, so the same for any thread). Terms below `e^{EXP_FLOOR}` are 0.
+    fn weighted_terms(s: &[f64], w: &[f64], p: (f64, f64, f64), terms: &mut [f64]) -> f64 {
+        let (y, inv2, lmax) = p;
         for ((t, &si), &wi) in terms.iter_mut().zip(s).zip(w) {
             let e = y - si;
             let q = -e * e * inv2 - lmax;
@@ -436,19 +417,6 @@ fn weighted_terms(
         }
         (acc[0] + acc[1]) + (acc[2] + acc[3])
     }
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn wide(s: &[f64], w: &[f64], p: (f64, f64, f64), terms: &mut [f64]) -> f64 {
-        kernel(s, w, p, terms)
-    }
-    terms.clear();
-    terms.resize(s.len(), 0.0);
-    #[cfg(target_arch = "x86_64")]
-    if crate::simd::has_avx2() {
-        // SAFETY: the processor has AVX2 (checked at run time), the only feature `wide` needs.
-        return unsafe { wide(s, w, (y, inv2, lmax), terms) };
-    }
-    kernel(s, w, (y, inv2, lmax), terms)
 }
 
 impl<S: Signal + ?Sized> SampleModel<'_, S> {
@@ -831,6 +799,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             }
             return f64::NEG_INFINITY;
         }
+        scratch.terms.clear();
+        scratch.terms.resize(scratch.s.len(), 0.0);
         let mut total = weighted_terms(&scratch.s, &scratch.w, (y, inv2, lmax), &mut scratch.terms);
         let mut shift = lmax;
         let mut use_logs = false;
