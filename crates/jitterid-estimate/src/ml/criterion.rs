@@ -2,7 +2,7 @@
 
 use super::cheb::PiecewiseCheb;
 use super::exact::{
-    signal_table, ExactMl, JitterPrep, RuleTooLarge, SampleModel, Scratch, SignalEval,
+    signal_table, ExactMl, SCREEN_RESOLUTION, SCREEN_WINDOW, JitterPrep, RuleTooLarge, SampleModel, Scratch, SignalEval,
     MAX_SAMPLE_NODES,
 };
 use super::MlError;
@@ -74,6 +74,17 @@ pub trait LikelihoodCriterion: fmt::Debug + Send + Sync {
         }
     }
 
+    /// A cheaper form of this criterion for screening: the loose first pass of
+    /// [`ml_profile`](super::ml_profile), which needs each value only to well within its cost
+    /// tolerance. It is evaluated on the data [`prepare`](Self::prepare) made for `self`.
+    /// `None` (the default): the criterion itself screens.
+    fn screening(&self) -> Option<Self>
+    where
+        Self: Sized,
+    {
+        None
+    }
+
     /// The criterion at `model` with measurement-noise level `noise_std`.
     ///
     /// # Errors
@@ -110,6 +121,16 @@ impl LikelihoodCriterion for ExactMl {
 
     fn supports_coloured_noise(&self) -> bool {
         false
+    }
+
+    /// The same quadrature with sub-intervals of [`SCREEN_RESOLUTION`] `σ_v` and a window
+    /// of [`SCREEN_WINDOW`] `σ_v`: about `1e-9` of every `log p(y_k)` instead of `1e-13`.
+    fn screening(&self) -> Option<Self> {
+        Some(ExactMl {
+            resolution: self.resolution.max(SCREEN_RESOLUTION),
+            window: self.window.min(SCREEN_WINDOW),
+            ..*self
+        })
     }
 
     fn prepare<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(

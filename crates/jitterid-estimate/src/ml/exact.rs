@@ -79,6 +79,17 @@ const HALF_LN_2PI: f64 = 0.918_938_533_204_672_8;
 /// Relative accuracy asked of the signal and density tables.
 const TABLE_TOL: f64 = 1e-13;
 
+/// [`ExactMl::resolution`] of the screening form ([`LikelihoodCriterion::screening`]): a
+/// 16-point rule over `8σ_v` of signal range integrates the Gaussian factor to `4e-10`
+/// relative (`1e-13` over `6σ_v`, `5e-16` over `4σ_v`).
+///
+/// [`LikelihoodCriterion::screening`]: super::LikelihoodCriterion::screening
+pub(crate) const SCREEN_RESOLUTION: f64 = 8.0;
+
+/// [`ExactMl::window`] of the screening form: runs of sub-intervals farther than `6.5σ_v`
+/// from `y_k` (at most `e^{−21} = 7e-10` of the peak) share one rule.
+pub(crate) const SCREEN_WINDOW: f64 = 6.5;
+
 /// The exact (non-Gaussian) maximum-likelihood criterion: the negative log-likelihood
 /// `−Σ_k log p(y_k)` of independent samples `y_k = s(t_k + τ_k) + v_k` with white Gaussian
 /// noise `v_k ~ N(0, σ_v²)`. The fields tune the quadrature (see the module docs); the

@@ -276,18 +276,21 @@ const COARSE_COST_TOLERANCE: f64 = 1e-3;
 /// function.
 const WARM_BRACKET_STEP: f64 = 0.03;
 
-/// Whether `solver` is the default likelihood solver (the profile's coarse-then-refine
-/// schedule replaces it for one-parameter fits).
-fn is_default_solver<V: Any>(solver: &V) -> bool {
+/// The tolerance of `solver`'s Brent stage if `solver` is the default likelihood solver up
+/// to that tolerance (the profile's coarse-then-refine schedule replaces it for
+/// one-parameter fits, and refines to that tolerance).
+fn staged_tolerance<V: Any>(solver: &V) -> Option<f64> {
     (solver as &dyn Any)
         .downcast_ref::<BrentOrBfgs>()
-        .is_some_and(|s| {
+        .filter(|s| {
             // A progress hook only observes: it does not make the solver another one.
-            let mut plain = s.clone();
+            let mut plain = (*s).clone();
             plain.brent.progress = None;
             plain.bfgs.progress = None;
+            plain.brent.tolerance = Brent::default().tolerance;
             plain == BrentOrBfgs::default()
         })
+        .map(|s| s.brent.tolerance)
 }
 
 /// The progress hook of the default solver's Brent stage, handed on to the staged profile's
@@ -303,11 +306,13 @@ fn brent_hook<V: Any>(solver: &V) -> Option<ProgressHook> {
 /// none converged). `build` makes the start jitter of a value (see
 /// [`profile`](crate::profile)). The covariance, if asked for, is computed for the winner only.
 ///
-/// With the default solver and a single free parameter (the jitter's), every value is first
-/// fitted loosely, in order, each value after the first started where the previous fit put
+/// With the default solver (whatever the tolerance of its Brent stage) and a single free
+/// parameter (the jitter's), every value is first fitted loosely, on the criterion's
+/// [`screening`](LikelihoodCriterion::screening) form if it has one, in order, each value after the first started where the previous fit put
 /// the jitter's standard deviation (its parameter scaled by the ratio of fitted to start
 /// standard deviations: exact for a scale parameter such as the uniform sum's `a`), and only
-/// those within [`PROFILE_MARGIN`] of the best are refined, in parallel; both stages run
+/// those within [`PROFILE_MARGIN`] of the best are refined, in parallel, on the criterion
+/// itself to the Brent stage's tolerance; both stages run
 /// Brent's iterations from their brackets' known values ([`Brent::from_bracket`]). With other
 /// solvers or more parameters every value is fitted once, in parallel. The likelihood's
 /// evaluations are themselves shared among threads.
@@ -335,7 +340,8 @@ where
     let layout = Layout::of(structure);
     // One parameter with the default solver: a coarse pass for every value, then the values
     // that can still win refined (see `PROFILE_MARGIN`).
-    let staged = layout.len() == 1 && layout.nj == 1 && is_default_solver(&options.solver);
+    let refine_tolerance = staged_tolerance(&options.solver);
+    let staged = layout.len() == 1 && layout.nj == 1 && refine_tolerance.is_some();
     let at = |v: i64| -> Result<ModelStructure<S, J, N>, MlError> {
         let mut s = structure.clone();
         s.jitter = build(v).map_err(Into::into)?;
@@ -367,11 +373,16 @@ where
         covariance: false,
         ..options.clone()
     };
+    // The first pass on the criterion's screening form, if it has one (its minima are only
+    // compared with the margin), the refinement on the criterion itself.
+    let screening = criterion.screening();
+    let screen = screening.as_ref().unwrap_or(criterion);
     let fit_with = |s: &ModelStructure<S, J, N>,
                     staged_solver: Option<&MlOptions<Brent>>,
-                    known: Option<(&[f64], f64)>| match staged_solver {
-        Some(o) => ml_estimate_with(s, record, data.as_ref(), known, criterion, o),
-        None => ml_estimate_with(s, record, data.as_ref(), known, criterion, &plain),
+                    known: Option<(&[f64], f64)>,
+                    by: &C| match staged_solver {
+        Some(o) => ml_estimate_with(s, record, data.as_ref(), known, by, o),
+        None => ml_estimate_with(s, record, data.as_ref(), known, by, &plain),
     };
     let mut fits: Vec<(i64, Result<Fit, MlError>)> = if staged {
         // In order, each value after the first started where the previous fit put the
@@ -394,8 +405,8 @@ where
                         .flatten()
                 });
                 match &started {
-                    Some(w) => fit_with(w, Some(&warm), None),
-                    None => fit_with(&s, Some(&coarse), None),
+                    Some(w) => fit_with(w, Some(&warm), None, screen),
+                    None => fit_with(&s, Some(&coarse), None, screen),
                 }
                 .map(|f| (f, s))
             });
@@ -412,7 +423,7 @@ where
     } else {
         values
             .par_iter()
-            .map(|&v| (v, at(v).and_then(|s| fit_with(&s, None, None))))
+            .map(|&v| (v, at(v).and_then(|s| fit_with(&s, None, None, criterion))))
             .collect()
     };
     if staged {
@@ -423,6 +434,7 @@ where
             .fold(f64::INFINITY, f64::min);
         let fine = options.with_solver(Brent {
             bracket_step: 0.01,
+            tolerance: refine_tolerance.unwrap_or(Brent::default().tolerance),
             progress: brent_hook(&options.solver),
             from_bracket: true,
             ..Brent::default()
@@ -438,11 +450,13 @@ where
             };
             if refine {
                 if let Ok(e) = fit {
-                    // Restart from the coarse minimum, whose value (on the same data) is known.
-                    let known = e.cost.is_finite().then_some((e.params.as_slice(), e.cost));
+                    // Restart from the coarse minimum, whose value is known if the first
+                    // pass was on the criterion itself.
+                    let known = (screening.is_none() && e.cost.is_finite())
+                        .then_some((e.params.as_slice(), e.cost));
                     let refined = at(*v).and_then(|s| {
                         let s = s.with_params(&e.params).map_err(MlError::from)?;
-                        fit_with(&s, Some(&fine), known)
+                        fit_with(&s, Some(&fine), known, criterion)
                     });
                     if let Ok(better) = refined {
                         *fit = Ok(better);
