@@ -17,43 +17,61 @@ use std::sync::OnceLock;
 /// Points per segment.
 pub(crate) const CHEB_POINTS: usize = 16;
 
-/// The basis of [`CHEB_POINTS`] points, computed once.
-pub(crate) fn basis() -> &'static ChebyshevBasis {
-    static B: OnceLock<ChebyshevBasis> = OnceLock::new();
-    B.get_or_init(|| ChebyshevBasis::new(CHEB_POINTS))
+/// A Chebyshev basis of `N` points with its transform from node values to coefficients as a
+/// fixed-size matrix, `dct[j][i]`, each entry computed by the formula of
+/// [`ChebyshevBasis::new`] (so the same to the bit; a test checks the coefficients against the
+/// basis').
+pub(crate) struct ChebTables<const N: usize> {
+    basis: ChebyshevBasis,
+    dct: [[f64; N]; N],
 }
 
-/// The basis' transform from node values to coefficients as a fixed-size matrix,
-/// `dct[j][i]`, each entry computed by the formula of [`ChebyshevBasis::new`] (so the same to
-/// the bit; a test checks the coefficients against the basis').
-fn dct() -> &'static [[f64; CHEB_POINTS]; CHEB_POINTS] {
-    static D: OnceLock<[[f64; CHEB_POINTS]; CHEB_POINTS]> = OnceLock::new();
-    D.get_or_init(|| {
-        let nf = CHEB_POINTS as f64;
-        std::array::from_fn(|j| {
-            let s = if j == 0 { 1.0 / nf } else { 2.0 / nf };
-            std::array::from_fn(|i| {
-                s * (std::f64::consts::PI * j as f64 * (i as f64 + 0.5) / nf).cos()
-            })
-        })
-    })
-}
-
-/// Chebyshev coefficients of the values at the 16 nodes: the sums of
-/// [`ChebyshevBasis::coefficients_into`] in the same order, on fixed-size arrays (this runs
-/// for every sample of every likelihood evaluation, where the slice version's loops over a
-/// run-time length cost about five times as much).
-#[inline]
-pub(crate) fn coefficients(values: &[f64; CHEB_POINTS]) -> [f64; CHEB_POINTS] {
-    let d = dct();
-    std::array::from_fn(|j| {
-        let row = &d[j];
-        let mut acc = 0.0;
-        for i in 0..CHEB_POINTS {
-            acc += values[i] * row[i];
+impl<const N: usize> ChebTables<N> {
+    fn new() -> Self {
+        let nf = N as f64;
+        ChebTables {
+            basis: ChebyshevBasis::new(N),
+            dct: std::array::from_fn(|j| {
+                let s = if j == 0 { 1.0 / nf } else { 2.0 / nf };
+                std::array::from_fn(|i| {
+                    s * (std::f64::consts::PI * j as f64 * (i as f64 + 0.5) / nf).cos()
+                })
+            }),
         }
-        acc
-    })
+    }
+
+    /// The basis.
+    pub(crate) fn basis(&self) -> &ChebyshevBasis {
+        &self.basis
+    }
+
+    /// Chebyshev coefficients of the values at the `N` nodes: the sums of
+    /// [`ChebyshevBasis::coefficients_into`] in the same order, on fixed-size arrays (this runs
+    /// for every sample of every likelihood evaluation, where the slice version's loops over a
+    /// run-time length cost about five times as much).
+    #[inline]
+    pub(crate) fn coefficients(&self, values: &[f64; N]) -> [f64; N] {
+        std::array::from_fn(|j| {
+            let row = &self.dct[j];
+            let mut acc = 0.0;
+            for i in 0..N {
+                acc += values[i] * row[i];
+            }
+            acc
+        })
+    }
+}
+
+/// The tables of [`CHEB_POINTS`] points, computed once.
+pub(crate) fn tables16() -> &'static ChebTables<CHEB_POINTS> {
+    static T: OnceLock<ChebTables<CHEB_POINTS>> = OnceLock::new();
+    T.get_or_init(ChebTables::new)
+}
+
+/// The tables of 32 points (the likelihood's wider shortcut), computed once.
+pub(crate) fn tables32() -> &'static ChebTables<32> {
+    static T: OnceLock<ChebTables<32>> = OnceLock::new();
+    T.get_or_init(ChebTables::new)
 }
 
 /// Monomial coefficients `a_k` with `Σ c_j T_j(x) = Σ a_k x^k`: [`to_monomial`]'s operations
@@ -372,7 +390,7 @@ mod tests {
 
     /// Deterministic values spanning signs and magnitudes (a fixed linear congruential
     /// sequence).
-    fn test_values(seed: u64) -> [f64; CHEB_POINTS] {
+    fn test_values<const N: usize>(seed: u64) -> [f64; N] {
         let mut state = seed;
         std::array::from_fn(|_| {
             state = state
@@ -385,25 +403,29 @@ mod tests {
 
     #[test]
     fn fixed_size_coefficients_equal_the_basis_to_the_bit() {
-        for seed in 0..200 {
-            let v = test_values(seed);
-            let mut reference = [0.0; CHEB_POINTS];
-            basis().coefficients_into(&v, &mut reference);
-            let fast = coefficients(&v);
-            for j in 0..CHEB_POINTS {
-                assert_eq!(
-                    fast[j].to_bits(),
-                    reference[j].to_bits(),
-                    "seed {seed}, c_{j}"
-                );
+        fn check<const N: usize>(tables: &ChebTables<N>) {
+            for seed in 0..200 {
+                let v = test_values::<N>(seed);
+                let mut reference = [0.0; N];
+                tables.basis().coefficients_into(&v, &mut reference);
+                let fast = tables.coefficients(&v);
+                for j in 0..N {
+                    assert_eq!(
+                        fast[j].to_bits(),
+                        reference[j].to_bits(),
+                        "{N} points, seed {seed}, c_{j}"
+                    );
+                }
             }
         }
+        check(tables16());
+        check(tables32());
     }
 
     #[test]
     fn fixed_size_monomials_equal_the_kernel_to_the_bit() {
         for seed in 0..200 {
-            let c = test_values(seed);
+            let c = test_values::<CHEB_POINTS>(seed);
             let reference = jitterid_jitter::kernels::chebyshev::to_monomial(&c);
             let fast = to_monomial16(&c);
             for k in 0..CHEB_POINTS {

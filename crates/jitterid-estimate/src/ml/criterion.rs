@@ -2,8 +2,8 @@
 
 use super::cheb::PiecewiseCheb;
 use super::exact::{
-    signal_table, ExactMl, SCREEN_RESOLUTION, SCREEN_WINDOW, JitterPrep, RuleTooLarge, SampleModel, Scratch, SignalEval,
-    MAX_SAMPLE_NODES,
+    signal_table, ExactMl, JitterPrep, RuleTooLarge, SampleModel, Scratch, SignalEval,
+    MAX_SAMPLE_NODES, SCREEN_RESOLUTION, SCREEN_WINDOW,
 };
 use super::MlError;
 use crate::data::Record;

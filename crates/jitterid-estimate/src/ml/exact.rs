@@ -30,7 +30,10 @@
 //!    the integrand is smooth on the reach: it is interpolated at 16 Chebyshev points and
 //!    integrated against the jitter's Chebyshev moments `E[T_j(x(τ))]` (computed once per
 //!    jitter parameter), provided the last Chebyshev coefficients are below `1e-13` of the
-//!    result; otherwise the general rule is used.
+//!    result. Where they are not and `s` moves by at most `6σ_v`, the same is tried at 32
+//!    points (the tails of step responses, where a 16-point interpolant of the Gaussian factor
+//!    falls short but a 32-point one converges: a third of the nodes of the general rule);
+//!    otherwise the general rule is used.
 //!
 //! With 16 nodes per `4σ_v` of signal range the Gaussian factor is integrated to about
 //! `1e-16` relative. The signal is tabulated once per signal parameter as a piecewise
@@ -64,11 +67,11 @@
 //! [`MAX_SAMPLE_NODES`] nodes as [`MlError::QuadratureTooLarge`] (a search treats all of them
 //! as points outside the model's domain and steps back).
 
-use super::cheb::{basis, coefficients, PiecewiseCheb, CHEB_POINTS};
+use super::cheb::{tables16, tables32, ChebTables, PiecewiseCheb, CHEB_POINTS};
 use super::fastexp::{exp_nonpositive, EXP_FLOOR};
 use super::MlError;
 use jitterid_jitter::kernels::gauss::{gl16, subdivisions};
-use jitterid_jitter::rule::MAX_SUBDIVISIONS;
+use jitterid_jitter::rule::{QuadratureRule, MAX_RATE_WIDTH, MAX_SUBDIVISIONS};
 use jitterid_jitter::{Atom, JitterModel};
 use jitterid_signal::{local_breaks, SampleGrid, Signal};
 use serde::{Deserialize, Serialize};
@@ -170,9 +173,49 @@ pub(crate) struct JitterPrep {
     coarse: Vec<Coarse>,
     atoms: Vec<Atom>,
     pdf: PiecewiseCheb,
-    /// `E[T_j((2τ − lo − hi)/(hi − lo))]`, `j < 16`, for the shortcut.
-    moments: Option<[f64; CHEB_POINTS]>,
+    /// The jitter's Chebyshev moments over its reach, for the shortcut.
+    moments: Option<Moments>,
 }
+
+/// `E[T_j((2τ − lo − hi)/(hi − lo))]` for `j < 16` and `j < 32`.
+#[derive(Debug, Clone)]
+struct Moments {
+    narrow: [f64; CHEB_POINTS],
+    wide: [f64; 32],
+}
+
+/// `E[T_j(x(τ))]`, `j < N`, over `rule`, `x` mapping `[lo, hi]` onto `[−1, 1]`.
+fn chebyshev_moments<const N: usize>(rule: &QuadratureRule, lo: f64, hi: f64) -> [f64; N] {
+    let mut mu = [0.0; N];
+    for (&t, &w) in rule.nodes.iter().zip(&rule.weights) {
+        let x = ((2.0 * t - lo - hi) / (hi - lo)).clamp(-1.0, 1.0);
+        let (mut t0, mut t1) = (1.0, x);
+        mu[0] += w;
+        mu[1] += w * x;
+        for m in mu.iter_mut().skip(2) {
+            let t2 = 2.0 * x * t1 - t0;
+            *m += w * t2;
+            t0 = t1;
+            t1 = t2;
+        }
+    }
+    mu
+}
+
+/// Largest total variation of the signal over the reach, in `σ_v`, at which the 16-point
+/// shortcut is tried: its Gaussian factor needs at most about `1σ_v` to converge to `1e-13`.
+const SHORTCUT_TV: f64 = 2.0;
+
+/// Largest total variation, in `σ_v`, at which the 32-point shortcut is tried after the
+/// 16-point one did not converge: at 32 points the Gaussian factor converges to `1e-13` up to
+/// about `5σ_v` of signal range (a linear signal: `c₃₀, c₃₁` are `6e-15` of the integral at
+/// `4σ_v`, `1e-12` at `6σ_v`).
+const WIDE_SHORTCUT_TV: f64 = 6.0;
+
+/// Sub-intervals across the reach of the rule for the 32 moments: `T₃₁` times a density piece
+/// of degree up to 9 has degree 40, beyond one 16-point rule's 31 on a piece as wide as the
+/// reach; eight panels make the error about `8⁻³²` of that.
+const WIDE_MOMENT_PANELS: f64 = 8.0;
 
 /// Appends the 16-point rule of `[a, b]` with density `pdf` (at `τ`) folded in.
 fn gl_interval(a: f64, b: f64, mut pdf: impl FnMut(f64) -> f64) -> Coarse {
@@ -208,25 +251,13 @@ impl JitterPrep {
         }
         let pdf = PiecewiseCheb::build(&pieces, 1, TABLE_TOL, |t, out| out[0] = jitter.pdf(t));
         let atoms = jitter.atoms();
-        let moments = if hi > lo && lo.is_finite() && hi.is_finite() {
-            let rule = jitter.rule(&[], 0.0);
-            let mut mu = [0.0; CHEB_POINTS];
-            for (&t, &w) in rule.nodes.iter().zip(&rule.weights) {
-                let x = ((2.0 * t - lo - hi) / (hi - lo)).clamp(-1.0, 1.0);
-                let (mut t0, mut t1) = (1.0, x);
-                mu[0] += w;
-                mu[1] += w * x;
-                for m in mu.iter_mut().skip(2) {
-                    let t2 = 2.0 * x * t1 - t0;
-                    *m += w * t2;
-                    t0 = t1;
-                    t1 = t2;
-                }
+        let moments = (hi > lo && lo.is_finite() && hi.is_finite()).then(|| {
+            let wide_rate = WIDE_MOMENT_PANELS * MAX_RATE_WIDTH / (hi - lo);
+            Moments {
+                narrow: chebyshev_moments(&jitter.rule(&[], 0.0), lo, hi),
+                wide: chebyshev_moments(&jitter.rule(&[], wide_rate), lo, hi),
             }
-            Some(mu)
-        } else {
-            None
-        };
+        });
         JitterPrep {
             lo,
             hi,
@@ -357,9 +388,12 @@ pub(crate) struct Scratch {
     /// `w_i e^{−(y − s_i)²/(2σ²) − max}` of the log-sum-exp, kept for the gradient.
     terms: Vec<f64>,
     /// `h e ∂s/∂θ_j` at the shortcut's 16 nodes, per parameter.
-    node_gradients: Vec<[f64; CHEB_POINTS]>,
+    node_gradients: Vec<f64>,
     sig_hint: usize,
     pdf_hint: usize,
+    /// Points of the shortcut last taken (for the tests' account of which was).
+    #[cfg(test)]
+    shortcut_points: usize,
 }
 
 #[derive(Debug, Clone)]
@@ -449,8 +483,18 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         let local = local_breaks(self.breaks, t, jp.lo, jp.hi);
         if self.opts.shortcut && local.is_empty() {
             if let Some(mu) = &jp.moments {
-                if let Some(v) = self.shortcut(t, y, mu, grad.as_deref().map(|g| g.len()), scratch)
-                {
+                let len = grad.as_deref().map(|g| g.len());
+                let tables = tables16();
+                let mut v = self.shortcut(t, y, tables, &mu.narrow, SHORTCUT_TV, len, scratch);
+                if let Err(tv) = v {
+                    if tv <= WIDE_SHORTCUT_TV {
+                        let wide = tables32();
+                        v = self.shortcut(t, y, wide, &mu.wide, WIDE_SHORTCUT_TV, len, scratch);
+                    }
+                }
+                if let Ok(v) = v {
+                    #[cfg(test)]
+                    tests::note_shortcut(scratch.shortcut_points);
                     if let Some(g) = grad {
                         g.copy_from_slice(&scratch.ch[..g.len()]);
                     }
@@ -483,60 +527,77 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         (lo, hi)
     }
 
-    fn shortcut(
+    /// The shortcut on `N` Chebyshev points over the reach (step 5 of the module docs): the
+    /// value, or `Err(tv)` with the signal's total variation over the points when the
+    /// interpolant of the Gaussian factor is not converged to `1e-13` (`tv` infinite when it
+    /// exceeds `max_tv` and the transform was not taken).
+    #[allow(clippy::too_many_arguments)]
+    fn shortcut<const N: usize>(
         &self,
         t: f64,
         y: f64,
-        mu: &[f64; CHEB_POINTS],
+        tables: &ChebTables<N>,
+        mu: &[f64; N],
+        max_tv: f64,
         grad_len: Option<usize>,
         scratch: &mut Scratch,
-    ) -> Option<f64> {
+    ) -> Result<f64, f64> {
         let jp = self.jitter;
-        let b = basis();
+        let nodes = tables.basis().nodes();
         let (mid, half) = (0.5 * (jp.lo + jp.hi), 0.5 * (jp.hi - jp.lo));
         let sigma = self.sigma;
         // The Chebyshev nodes in increasing order (the basis stores them decreasing).
-        let mut taus = [0.0; CHEB_POINTS];
-        for i in 0..CHEB_POINTS {
-            taus[i] = mid + half * b.nodes()[CHEB_POINTS - 1 - i];
+        let mut taus = [0.0; N];
+        for i in 0..N {
+            taus[i] = mid + half * nodes[N - 1 - i];
         }
-        let mut sv = [0.0; CHEB_POINTS];
-        self.signal
-            .values16(t, &taus, &mut sv, &mut scratch.sig_hint);
+        let mut sv = [0.0; N];
+        for (tc, sc) in taus.chunks_exact(16).zip(sv.chunks_exact_mut(16)) {
+            let (Ok(tc), Ok(sc)) = (<&[f64; 16]>::try_from(tc), <&mut [f64; 16]>::try_from(sc))
+            else {
+                return Err(f64::INFINITY);
+            };
+            self.signal.values16(t, tc, sc, &mut scratch.sig_hint);
+        }
         let tv: f64 = sv.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
-        if !(tv <= 2.0 * sigma) {
-            return None;
+        if !(tv <= max_tv * sigma) {
+            return Err(f64::INFINITY);
         }
         // Back to the basis' order.
-        let mut s = [0.0; CHEB_POINTS];
-        for i in 0..CHEB_POINTS {
-            s[i] = sv[CHEB_POINTS - 1 - i];
+        let mut s = [0.0; N];
+        for i in 0..N {
+            s[i] = sv[N - 1 - i];
         }
         let inv2 = 0.5 / (sigma * sigma);
-        let mut e = [0.0; CHEB_POINTS];
+        let mut e = [0.0; N];
         let mut d0 = f64::INFINITY;
         for (ei, si) in e.iter_mut().zip(&s) {
             *ei = y - si;
             d0 = d0.min(*ei * *ei);
         }
-        let mut h = [0.0; CHEB_POINTS];
+        let mut h = [0.0; N];
         for (hi, ei) in h.iter_mut().zip(&e) {
             let q = -(ei * ei - d0) * inv2;
             let v = exp_nonpositive(q);
             *hi = if q >= EXP_FLOOR { v } else { 0.0 };
         }
-        let c = coefficients(&h);
+        let c = tables.coefficients(&h);
         let total: f64 = c.iter().zip(mu).map(|(c, m)| c * m).sum();
-        if !(total > 0.0) || c[14].abs() + c[15].abs() > 1e-13 * total {
-            return None;
+        if !(total > 0.0) || c[N - 2].abs() + c[N - 1].abs() > 1e-13 * total {
+            return Err(tv / sigma);
         }
         let log_p = -d0 * inv2 + total.ln() - sigma.ln() - HALF_LN_2PI;
+        #[cfg(test)]
+        {
+            scratch.shortcut_points = N;
+        }
         if let Some(len) = grad_len {
             let ns = len - 1;
             scratch.ch.clear();
             scratch.ch.resize(len, 0.0);
-            let dot = |v: &[f64; CHEB_POINTS]| -> f64 {
-                coefficients(v)
+            let dot = |v: &[f64; N]| -> f64 {
+                tables
+                    .coefficients(v)
                     .iter()
                     .zip(mu)
                     .map(|(c, m)| c * m)
@@ -546,29 +607,32 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             if ns > 0 {
                 let mut chans = std::mem::take(&mut scratch.chans);
                 chans.resize(1 + self.signal.grad_channels, 0.0);
+                // `h e ∂s/∂θ_j` at the nodes, parameter-major.
                 let mut g = std::mem::take(&mut scratch.node_gradients);
                 g.clear();
-                g.resize(ns, [0.0; CHEB_POINTS]);
-                for (i, &x) in b.nodes().iter().enumerate() {
+                g.resize(ns * N, 0.0);
+                for (i, &x) in nodes.iter().enumerate() {
                     self.signal
                         .all(t + mid + half * x, &mut chans, &mut scratch.sig_hint);
                     for j in 0..ns {
-                        g[j][i] = h[i] * e[i] * chans[1 + j];
+                        g[j * N + i] = h[i] * e[i] * chans[1 + j];
                     }
                 }
                 for j in 0..ns {
-                    scratch.ch[j] = dot(&g[j]) / (sigma * sigma);
+                    let mut v = [0.0; N];
+                    v.copy_from_slice(&g[j * N..(j + 1) * N]);
+                    scratch.ch[j] = dot(&v) / (sigma * sigma);
                 }
                 scratch.chans = chans;
                 scratch.node_gradients = g;
             }
-            let mut q = [0.0; CHEB_POINTS];
-            for i in 0..CHEB_POINTS {
+            let mut q = [0.0; N];
+            for i in 0..N {
                 q[i] = h[i] * e[i] * e[i];
             }
             scratch.ch[ns] = dot(&q) / (sigma * sigma * sigma) - 1.0 / sigma;
         }
-        Some(log_p)
+        Ok(log_p)
     }
 
     /// Pushes a 16-point rule on `[a, b]` (density from the table) with the signal values.
@@ -862,5 +926,121 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             g[ns] = g[ns] / (s2 * sigma) - 1.0 / sigma;
         }
         log_p
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ModelStructure, Record};
+    use jitterid_jitter::{Gaussian, TwoPoint, UniformSum};
+    use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, Zpk};
+    use rand::rngs::StdRng;
+    use rand::SeedableRng;
+    use std::cell::Cell;
+
+    thread_local! {
+        /// Samples that took the 16- and the 32-point shortcut on this thread.
+        static TAKEN: Cell<[usize; 2]> = const { Cell::new([0; 2]) };
+    }
+
+    pub(super) fn note_shortcut(points: usize) {
+        TAKEN.with(|c| {
+            let mut v = c.get();
+            v[usize::from(points == 32)] += 1;
+            c.set(v);
+        });
+    }
+
+    #[test]
+    fn wide_moments_agree_with_a_rule_of_twice_the_panels() {
+        // The 32 moments from the rule of WIDE_MOMENT_PANELS panels against one of twice as
+        // many, and their first 16 against the narrow moments (a rule without panels).
+        let jitters: Vec<Box<dyn JitterModel>> = vec![
+            Box::new(UniformSum::new(0, 0.5).unwrap()),
+            Box::new(UniformSum::new(1, 0.5).unwrap()),
+            Box::new(UniformSum::new(3, 0.7).unwrap()),
+            Box::new(UniformSum::new(9, 1.2).unwrap()),
+            Box::new(Gaussian::new(0.17).unwrap()),
+            Box::new(TwoPoint::new(0.3).unwrap()),
+        ];
+        for j in &jitters {
+            let (lo, hi) = j.reach();
+            let rate = WIDE_MOMENT_PANELS * MAX_RATE_WIDTH / (hi - lo);
+            let wide: [f64; 32] = chebyshev_moments(&j.rule(&[], rate), lo, hi);
+            let finer: [f64; 32] = chebyshev_moments(&j.rule(&[], 2.0 * rate), lo, hi);
+            let narrow: [f64; CHEB_POINTS] = chebyshev_moments(&j.rule(&[], 0.0), lo, hi);
+            for k in 0..32 {
+                assert!(
+                    (wide[k] - finer[k]).abs() <= 1e-14,
+                    "{j:?}: μ_{k} {} vs {}",
+                    wide[k],
+                    finer[k]
+                );
+            }
+            for k in 0..CHEB_POINTS {
+                assert!(
+                    (wide[k] - narrow[k]).abs() <= 1e-14,
+                    "{j:?}: μ_{k} {} vs {}",
+                    wide[k],
+                    narrow[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn both_shortcuts_agree_with_the_general_rule() {
+        // The Table 1 system: long flat stretches (the 16-point shortcut), the tails of its
+        // step responses (the 32-point one) and steps inside the reach (the general rule).
+        let g = Zpk::new(1.0, vec![], vec![Root::Real(-2.0)]).unwrap();
+        let n = 200;
+        let grid = jitterid_signal::SampleGrid::new(0.0, 1.0, n).unwrap();
+        let mut rng = StdRng::seed_from_u64(11);
+        let u = RandomBinary::paper()
+            .generate(0.0, n as f64 + 1.0, &mut rng)
+            .unwrap();
+        let signal = LtiResponse::new(g, u);
+        check(UniformSum::new(0, 0.5).unwrap(), &signal, grid, &mut rng);
+        check(UniformSum::new(3, 0.6).unwrap(), &signal, grid, &mut rng);
+        check(Gaussian::new(0.17).unwrap(), &signal, grid, &mut rng);
+    }
+
+    /// The per-sample `log p` with and without the shortcuts, which must agree, and the
+    /// shortcuts must both have been taken.
+    fn check<J: JitterModel + Clone>(
+        j: J,
+        signal: &LtiResponse<Zpk>,
+        grid: jitterid_signal::SampleGrid,
+        rng: &mut StdRng,
+    ) {
+        let sigma = 0.01;
+        let serial = |shortcut| ExactMl {
+            shortcut,
+            parallel: false,
+            ..ExactMl::default()
+        };
+        let data = simulate(signal, &j, &grid, sigma, rng).unwrap();
+        let record = Record::new(grid, data.y).unwrap();
+        let structure = ModelStructure::oe(signal.clone(), j)
+            .with_noise_std(sigma)
+            .unwrap();
+        TAKEN.with(|c| c.set([0; 2]));
+        let fast = serial(true)
+            .log_likelihoods(&structure, &record, sigma)
+            .unwrap();
+        let taken = TAKEN.with(Cell::get);
+        let general = serial(false)
+            .log_likelihoods(&structure, &record, sigma)
+            .unwrap();
+        let name = format!("{:?}", structure.jitter);
+        // Both are accurate to about 1e-13 of p(y_k).
+        for (k, (a, b)) in fast.iter().zip(&general).enumerate() {
+            assert!((a - b).abs() <= 1e-11, "{name}, sample {k}: {a} vs {b}");
+        }
+        assert!(
+            taken[0] > 0 && taken[1] > 0,
+            "{name}: shortcuts taken (16, 32 points): {taken:?}"
+        );
     }
 }
