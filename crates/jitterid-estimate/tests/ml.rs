@@ -546,6 +546,15 @@ fn staged_profile_equals_full_refinement() {
         // quadratic error, far below 1e-4 in −log L.
         let (a, b) = (staged.estimate.cost, every.estimate.cost);
         assert!((a - b).abs() < 1e-4, "record {r}: {a} vs {b}");
+        // The margin's premise: every value's loose (first-pass, screening) minimum is within
+        // 1e-2 of its minimum, a tenth of PROFILE_MARGIN.
+        for ((n, loose), (_, min)) in staged.costs.iter().zip(&every.costs) {
+            let (loose, min) = (loose.unwrap(), min.unwrap());
+            assert!(
+                loose - min > -1e-4 && loose - min < 0.1 * PROFILE_MARGIN,
+                "record {r}, n = {n}: {loose} vs {min}"
+            );
+        }
     }
 }
 

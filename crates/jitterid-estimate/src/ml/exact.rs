@@ -93,6 +93,9 @@ pub(crate) const SCREEN_RESOLUTION: f64 = 8.0;
 /// from `y_k` (at most `e^{−21} = 7e-10` of the peak) share one rule.
 pub(crate) const SCREEN_WINDOW: f64 = 6.5;
 
+/// [`ExactMl::shortcut_tolerance`] of the screening form.
+pub(crate) const SCREEN_SHORTCUT_TOLERANCE: f64 = 1e-8;
+
 /// The exact (non-Gaussian) maximum-likelihood criterion: the negative log-likelihood
 /// `−Σ_k log p(y_k)` of independent samples `y_k = s(t_k + τ_k) + v_k` with white Gaussian
 /// noise `v_k ~ N(0, σ_v²)`. The fields tune the quadrature (see the module docs); the
@@ -107,6 +110,11 @@ pub struct ExactMl {
     /// Whether samples where the signal barely moves use the Chebyshev-moment shortcut
     /// (default true).
     pub shortcut: bool,
+    /// Largest `|c_{N−2}| + |c_{N−1}|` of the shortcut's interpolant of the Gaussian factor,
+    /// relative to the result, at which the shortcut is taken (default `1e-13`, about the
+    /// relative error it leaves in `p(y_k)`).
+    #[serde(default = "default_shortcut_tolerance")]
+    pub shortcut_tolerance: f64,
     /// Whether samples are evaluated in parallel (rayon) for records of 64 samples or more
     /// (default true; results do not depend on it).
     pub parallel: bool,
@@ -118,9 +126,14 @@ impl Default for ExactMl {
             resolution: 4.0,
             window: 8.5,
             shortcut: true,
+            shortcut_tolerance: default_shortcut_tolerance(),
             parallel: true,
         }
     }
+}
+
+fn default_shortcut_tolerance() -> f64 {
+    1e-13
 }
 
 impl ExactMl {
@@ -137,7 +150,8 @@ impl ExactMl {
             }
         };
         pos("resolution", self.resolution)?;
-        pos("window", self.window)
+        pos("window", self.window)?;
+        pos("shortcut_tolerance", self.shortcut_tolerance)
     }
 }
 
@@ -322,10 +336,11 @@ pub(crate) fn signal_table<S: Signal + ?Sized>(
     let p = signal.num_params();
     let channels = if gradient { 1 + p } else { 1 };
     PiecewiseCheb::build(&intervals, channels, TABLE_TOL, |t, out| {
-        out[0] = signal.value(t);
-        if gradient {
-            signal.value_gradient(t, &mut out[1..]);
-        }
+        out[0] = if gradient {
+            signal.value_and_gradient(t, &mut out[1..])
+        } else {
+            signal.value(t)
+        };
     })
 }
 
@@ -529,7 +544,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
 
     /// The shortcut on `N` Chebyshev points over the reach (step 5 of the module docs): the
     /// value, or `Err(tv)` with the signal's total variation over the points when the
-    /// interpolant of the Gaussian factor is not converged to `1e-13` (`tv` infinite when it
+    /// interpolant of the Gaussian factor is not converged ([`ExactMl::shortcut_tolerance`];
+    /// `tv` infinite when it
     /// exceeds `max_tv` and the transform was not taken).
     #[allow(clippy::too_many_arguments)]
     fn shortcut<const N: usize>(
@@ -583,7 +599,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         }
         let c = tables.coefficients(&h);
         let total: f64 = c.iter().zip(mu).map(|(c, m)| c * m).sum();
-        if !(total > 0.0) || c[N - 2].abs() + c[N - 1].abs() > 1e-13 * total {
+        if !(total > 0.0) || c[N - 2].abs() + c[N - 1].abs() > self.opts.shortcut_tolerance * total
+        {
             return Err(tv / sigma);
         }
         let log_p = -d0 * inv2 + total.ln() - sigma.ln() - HALF_LN_2PI;
