@@ -178,6 +178,9 @@ impl Signal for AnySignal {
     fn value_gradient(&self, t: f64, grad: &mut [f64]) {
         self.model().value_gradient(t, grad)
     }
+    fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
+        self.model().value_and_gradient(t, grad)
+    }
     fn breakpoints(&self) -> Vec<f64> {
         self.model().breakpoints()
     }

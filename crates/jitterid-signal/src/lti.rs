@@ -756,6 +756,17 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
         }
     }
 
+    /// Without a modal form (the realisation's route), one state serves both; otherwise as
+    /// provided.
+    fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
+        if let (Input::Piecewise(_), None) = (&self.input, self.modal()) {
+            let (cf, prefix) = self.confluent_prefix();
+            return cf.value_at(&self.steps, prefix, t, Some(grad));
+        }
+        self.value_gradient(t, grad);
+        self.value(t)
+    }
+
     fn breakpoints(&self) -> Vec<f64> {
         self.steps.iter().map(|s| s.0).collect()
     }

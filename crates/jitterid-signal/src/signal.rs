@@ -38,6 +38,14 @@ pub trait Signal: fmt::Debug + Send + Sync {
     /// `∂s(t)/∂θ_j` for every parameter, into `grad`.
     fn value_gradient(&self, t: f64, grad: &mut [f64]);
 
+    /// `s(t)`, with `∂s(t)/∂θ_j` into `grad`: what a table of the signal and its gradient
+    /// needs at each point. Provided: [`value_gradient`](Self::value_gradient) then
+    /// [`value`](Self::value); a model whose two share their work overrides it.
+    fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
+        self.value_gradient(t, grad);
+        self.value(t)
+    }
+
     /// Times where `s` is not analytic (input switches, start and end of the response), in
     /// increasing order.
     fn breakpoints(&self) -> Vec<f64> {
