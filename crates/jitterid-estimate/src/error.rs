@@ -93,6 +93,18 @@ pub enum EstimateError {
         /// Length given.
         got: usize,
     },
+    /// The jitter's reach is wider than the record: the expectations would read the input
+    /// where no sample constrains it (a search that creeps towards an ever wider jitter is
+    /// stopped at this edge of the domain).
+    #[error("the jitter's reach [{lo}, {hi}] is wider than the record ({duration} s)")]
+    ReachExceedsRecord {
+        /// Start of the reach.
+        lo: f64,
+        /// End of the reach.
+        hi: f64,
+        /// The record's duration.
+        duration: f64,
+    },
     /// An argument of a validation or export helper is out of its range.
     #[error("{name} = {value}: {reason}")]
     BadArgument {

@@ -117,6 +117,26 @@ impl<'a, S, J, N, C: ?Sized, W> FitProblem<'a, S, J, N, C, W> {
     }
 }
 
+impl<S, J, N, C, W> FitProblem<'_, S, J, N, C, W>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: ?Sized,
+    W: Window,
+{
+    /// The structure at `theta` if it lies in the model's domain: parameters that its
+    /// constructors accept and a jitter whose reach fits in the record
+    /// ([`reach_fits`]). Outside it the residuals are NaN, which a solver treats as a point to
+    /// step back from.
+    fn model_at(&self, theta: &[f64]) -> Option<ModelStructure<S, J, N>> {
+        self.structure
+            .with_params(theta)
+            .ok()
+            .filter(|m| reach_fits(m, self.data.record()).is_ok())
+    }
+}
+
 impl<S, J, N, C, W> LeastSquares for FitProblem<'_, S, J, N, C, W>
 where
     S: Signal + Clone,
@@ -137,7 +157,7 @@ where
         if let Some(r) = self.memo.residuals(theta) {
             return Ok(r);
         }
-        let Ok(m) = self.structure.with_params(theta) else {
+        let Some(m) = self.model_at(theta) else {
             return Ok(vec![f64::NAN; self.num_residuals()]);
         };
         if self.data.record().y().len() > MEMO_MAX_SAMPLES {
@@ -157,9 +177,9 @@ where
     }
 
     fn jacobian(&self, theta: &[f64]) -> Result<Mat<f64>, SolverError> {
-        Ok(match self.structure.with_params(theta) {
-            Ok(m) => self.data.jacobian(self.criterion, &m),
-            Err(_) => Mat::from_fn(self.num_residuals(), self.num_params(), |_, _| f64::NAN),
+        Ok(match self.model_at(theta) {
+            Some(m) => self.data.jacobian(self.criterion, &m),
+            None => Mat::from_fn(self.num_residuals(), self.num_params(), |_, _| f64::NAN),
         })
     }
 
@@ -170,20 +190,34 @@ where
     ) -> Result<NormalEquations, SolverError> {
         // The model the residuals just built at this point, when they did.
         let model = match self.memo.take_model(theta) {
-            Some(m) => Ok(m),
-            None => self.structure.with_params(theta),
+            Some(m) => Some(m),
+            None => self.model_at(theta),
         };
         Ok(match model {
-            Ok(m) => crate::parseval::criterion_normal_equations(
+            Some(m) => crate::parseval::criterion_normal_equations(
                 self.criterion,
                 self.data,
                 &m,
                 residuals,
                 self.memo.sensitivities(theta),
             ),
-            Err(_) => NormalEquations::not_finite(self.num_params()),
+            None => NormalEquations::not_finite(self.num_params()),
         })
     }
+}
+
+/// Whether the jitter's reach of `structure` fits in `record` (as the likelihood criteria
+/// require too): otherwise [`EstimateError::ReachExceedsRecord`].
+pub(crate) fn reach_fits<S, J: JitterModel, N>(
+    structure: &ModelStructure<S, J, N>,
+    record: &Record,
+) -> Result<(), EstimateError> {
+    let (lo, hi) = structure.jitter.reach();
+    let duration = record.grid().duration();
+    if hi - lo > duration {
+        return Err(EstimateError::ReachExceedsRecord { lo, hi, duration });
+    }
+    Ok(())
 }
 
 /// Estimates the free parameters of `structure` from `record` by minimising `criterion` with
@@ -192,7 +226,7 @@ where
 /// # Errors
 ///
 /// No free parameter; a criterion that ignores jitter asked to estimate it; fewer samples or
-/// residuals than parameters; an invalid frequency set or weights; a criterion not finite at
+/// residuals than parameters; a jitter whose reach is wider than the record; an invalid frequency set or weights; a criterion not finite at
 /// the start; invalid solver options. A search that stops without converging is not an error:
 /// see [`Fit::converged`] and [`Fit::termination`].
 ///
@@ -238,6 +272,7 @@ where
             params: p,
         });
     }
+    reach_fits(structure, record)?;
     let problem = FitProblem::new(structure, criterion, &data);
     let start = structure.params();
     // Through the problem, so that the solver's first evaluation at the start is memoised.
