@@ -106,8 +106,8 @@ const BOOT: u64 = 32;
 
 /// Brent's tolerance in `ln a` of the bootstrap's fits: their mean `σ̂*` has a Monte Carlo
 /// standard error of `std(σ̂*)/√BOOT`, about `3e-3` of `σ`, so `σ̂*` to `1e-6` changes
-/// nothing; the replicates also use the likelihood's screening form (`log p(y_k)` to about
-/// `1e-9`).
+/// nothing; the replicates also use the likelihood's screening form (`p(y_k)` to about
+/// `1e-8`).
 const BOOT_TOLERANCE: f64 = 1e-6;
 
 /// The parametric-bootstrap mean of `σ̂`: records simulated from the fitted model
@@ -356,7 +356,8 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
         md,
         "{} realisations; efficiency = (std of σ̂ / CRB std)². Hessian std: mean inverse-Hessian std of σ̂ at n̂. \
          Bias-corrected: `σ̂ − (mean of the bootstrap σ̂* − σ̂)`, from {BOOT} records simulated from the fitted \
-         `(n̂, â)` with the record's input, each put through the whole estimator (the `n` profile included); \
+         `(n̂, â)` with the record's input, each put through the whole estimator (the `n` profile included; \
+         each replicate's fit to `1e-6` in `ln a` on the likelihood's screening quadrature); \
          `â = σ̂ √(3(n̂+1))`. Two biases make it necessary: the half-width of a uniform is a support \
          parameter, whose MLE is biased low by O(1/m) for m informative samples (about the size of its std \
          here), and the profile's choice of `n` errs only upwards when the truth is `n = 0`, and a larger \
