@@ -123,9 +123,9 @@ impl LikelihoodCriterion for ExactMl {
         false
     }
 
-    /// The same quadrature with sub-intervals of [`SCREEN_RESOLUTION`] `σ_v`, a window of
-    /// [`SCREEN_WINDOW`] `σ_v` and the shortcut taken where its interpolant is converged to
-    /// [`SCREEN_SHORTCUT_TOLERANCE`]: about `1e-8` of every `p(y_k)` instead of `1e-13`, so
+    /// The same quadrature with sub-intervals of `8σ_v` (at least), a window of `6.5σ_v` (at
+    /// most) and the shortcut taken where its interpolant is converged to `1e-8` (at least):
+    /// about `1e-8` of every `p(y_k)` instead of `1e-13`, so
     /// `1e-8 N` of `−log L` (`2e-6` for 200 samples, next to the first pass's `1e-3`).
     fn screening(&self) -> Option<Self> {
         Some(ExactMl {
