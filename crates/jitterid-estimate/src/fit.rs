@@ -16,7 +16,7 @@ use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
 use jitterid_jitter::JitterModel;
-use jitterid_signal::Signal;
+use jitterid_signal::{SampleGrid, Signal};
 use jitterid_window::{DirichletWindow, FrequencySet, Window};
 
 /// Which frequencies a criterion uses.
@@ -127,13 +127,13 @@ where
 {
     /// The structure at `theta` if it lies in the model's domain: parameters that its
     /// constructors accept and a jitter whose reach fits in the record
-    /// ([`reach_fits`]). Outside it the residuals are NaN, which a solver treats as a point to
+    /// ([`reach_beyond`]). Outside it the residuals are NaN, which a solver treats as a point to
     /// step back from.
     fn model_at(&self, theta: &[f64]) -> Option<ModelStructure<S, J, N>> {
         self.structure
             .with_params(theta)
             .ok()
-            .filter(|m| reach_fits(m, self.data.record()).is_ok())
+            .filter(|m| reach_beyond(&m.jitter, self.data.record().grid()).is_none())
     }
 }
 
@@ -206,18 +206,16 @@ where
     }
 }
 
-/// Whether the jitter's reach of `structure` fits in `record` (as the likelihood criteria
-/// require too): otherwise [`EstimateError::ReachExceedsRecord`].
-pub(crate) fn reach_fits<S, J: JitterModel, N>(
-    structure: &ModelStructure<S, J, N>,
-    record: &Record,
-) -> Result<(), EstimateError> {
-    let (lo, hi) = structure.jitter.reach();
-    let duration = record.grid().duration();
-    if hi - lo > duration {
-        return Err(EstimateError::ReachExceedsRecord { lo, hi, duration });
-    }
-    Ok(())
+/// The jitter's reach `(lo, hi)` and the grid's duration when the reach does not fit in the
+/// record (not finite, or wider than the duration): outside the model's domain for every
+/// criterion ([`EstimateError::ReachExceedsRecord`], `MlError::ReachExceedsRecord`).
+pub(crate) fn reach_beyond<J: JitterModel + ?Sized>(
+    jitter: &J,
+    grid: &SampleGrid,
+) -> Option<(f64, f64, f64)> {
+    let (lo, hi) = jitter.reach();
+    let duration = grid.duration();
+    (!(lo.is_finite() && hi.is_finite()) || hi - lo > duration).then_some((lo, hi, duration))
 }
 
 /// Estimates the free parameters of `structure` from `record` by minimising `criterion` with
@@ -226,8 +224,8 @@ pub(crate) fn reach_fits<S, J: JitterModel, N>(
 /// # Errors
 ///
 /// No free parameter; a criterion that ignores jitter asked to estimate it; fewer samples or
-/// residuals than parameters; a jitter whose reach is wider than the record; an invalid frequency set or weights; a criterion not finite at
-/// the start; invalid solver options. A search that stops without converging is not an error:
+/// residuals than parameters; a jitter whose reach is wider than the record; an invalid
+/// frequency set or weights; a criterion not finite at the start; invalid solver options. A search that stops without converging is not an error:
 /// see [`Fit::converged`] and [`Fit::termination`].
 ///
 /// `criterion` may be a trait object (`&dyn Criterion`, `Box<dyn Criterion>`); `options.solver`
@@ -272,7 +270,9 @@ where
             params: p,
         });
     }
-    reach_fits(structure, record)?;
+    if let Some((lo, hi, duration)) = reach_beyond(&structure.jitter, record.grid()) {
+        return Err(EstimateError::ReachExceedsRecord { lo, hi, duration });
+    }
     let problem = FitProblem::new(structure, criterion, &data);
     let start = structure.params();
     // Through the problem, so that the solver's first evaluation at the start is memoised.

@@ -7,10 +7,11 @@ use super::exact::{
 };
 use super::MlError;
 use crate::data::Record;
+use crate::fit::reach_beyond;
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
-use jitterid_signal::Signal;
+use jitterid_signal::{SampleGrid, Signal};
 use rayon::prelude::*;
 use std::fmt;
 
@@ -101,17 +102,15 @@ pub trait LikelihoodCriterion: fmt::Debug + Send + Sync {
     ) -> Result<Evaluation, MlError>;
 }
 
-/// Checks that the jitter's reach fits in the record.
+/// Checks that the jitter's reach fits in a record on `grid` ([`reach_beyond`]).
 pub(crate) fn check_reach<J: JitterModel + ?Sized>(
     jitter: &J,
-    record: &Record,
+    grid: &SampleGrid,
 ) -> Result<(), MlError> {
-    let (lo, hi) = jitter.reach();
-    let duration = record.grid().duration();
-    if !(lo.is_finite() && hi.is_finite()) || hi - lo > duration {
-        return Err(MlError::ReachExceedsRecord { lo, hi, duration });
+    match reach_beyond(jitter, grid) {
+        Some((lo, hi, duration)) => Err(MlError::ReachExceedsRecord { lo, hi, duration }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 impl LikelihoodCriterion for ExactMl {
@@ -206,7 +205,7 @@ impl ExactMl {
             return Err(MlError::NoNoise { value: sigma });
         }
         let record = &data.record;
-        check_reach(&model.jitter, record)?;
+        check_reach(&model.jitter, record.grid())?;
         let grid = record.grid();
         let rate = model.signal.rate();
         let prep = JitterPrep::new(&model.jitter, rate);

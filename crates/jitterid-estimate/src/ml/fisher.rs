@@ -205,14 +205,8 @@ where
     if !(sigma.is_finite() && sigma > 0.0) {
         return Err(MlError::NoNoise { value: sigma });
     }
+    super::criterion::check_reach(&structure.jitter, grid)?;
     let (lo, hi) = structure.jitter.reach();
-    if !(lo.is_finite() && hi.is_finite()) || hi - lo > grid.duration() {
-        return Err(MlError::ReachExceedsRecord {
-            lo,
-            hi,
-            duration: grid.duration(),
-        });
-    }
     let layout = Layout::of(structure);
     let names = likelihood_param_names(structure);
     let p = layout.len();

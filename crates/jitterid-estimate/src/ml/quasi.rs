@@ -117,7 +117,7 @@ impl LikelihoodCriterion for QuasiMl {
             return Err(crate::EstimateError::BadNoiseStd { value: sigma }.into());
         }
         let record = &data.record;
-        super::criterion::check_reach(&model.jitter, record)?;
+        super::criterion::check_reach(&model.jitter, record.grid())?;
         let grid = record.grid();
         let (m, jv, grads) = moments(&model.signal, &model.jitter, grid, gradient.signal);
         let y = record.y();
