@@ -78,6 +78,16 @@ impl<M: RationalModel> LtiResponse<M> {
         })
     }
 
+    /// `s(t)` with its gradient into `grad` from one state of the realisation, for a
+    /// piecewise-constant input and a model without a modal form; `None` otherwise.
+    fn realised_value_and_gradient(&self, t: f64, grad: &mut [f64]) -> Option<f64> {
+        let (Input::Piecewise(_), None) = (&self.input, self.modal()) else {
+            return None;
+        };
+        let (cf, prefix) = self.confluent_prefix();
+        Some(cf.value_at(&self.steps, prefix, t, Some(grad)))
+    }
+
     fn prefix_states(&self) -> Prefix {
         let poles: Vec<Complex64> = self
             .representatives()
@@ -161,9 +171,8 @@ impl<M: RationalModel> LtiResponse<M> {
     /// piecewise-constant input: what a composite model (a static nonlinearity of this response)
     /// needs at each instant.
     pub fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
-        if let (Input::Piecewise(_), None) = (&self.input, self.modal()) {
-            let (cf, prefix) = self.confluent_prefix();
-            return cf.value_at(&self.steps, prefix, t, Some(grad));
+        if let Some(s) = self.realised_value_and_gradient(t, grad) {
+            return s;
         }
         let Some(state) = self.state(t) else {
             self.value_gradient(t, grad);
@@ -759,9 +768,8 @@ impl<M: RationalModel> Signal for LtiResponse<M> {
     /// Without a modal form (the realisation's route), one state serves both; otherwise as
     /// provided.
     fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
-        if let (Input::Piecewise(_), None) = (&self.input, self.modal()) {
-            let (cf, prefix) = self.confluent_prefix();
-            return cf.value_at(&self.steps, prefix, t, Some(grad));
+        if let Some(s) = self.realised_value_and_gradient(t, grad) {
+            return s;
         }
         self.value_gradient(t, grad);
         self.value(t)
