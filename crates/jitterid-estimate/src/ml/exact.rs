@@ -406,9 +406,6 @@ pub(crate) struct Scratch {
     node_gradients: Vec<f64>,
     sig_hint: usize,
     pdf_hint: usize,
-    /// Points of the shortcut last taken (for the tests' account of which was).
-    #[cfg(test)]
-    shortcut_points: usize,
 }
 
 #[derive(Debug, Clone)]
@@ -499,17 +496,19 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         if self.opts.shortcut && local.is_empty() {
             if let Some(mu) = &jp.moments {
                 let len = grad.as_deref().map(|g| g.len());
-                let tables = tables16();
-                let mut v = self.shortcut(t, y, tables, &mu.narrow, SHORTCUT_TV, len, scratch);
-                if let Err(tv) = v {
-                    if tv <= WIDE_SHORTCUT_TV {
+                let narrow = tables16();
+                // The value and the number of points that gave it.
+                let v = match self.shortcut(t, y, narrow, &mu.narrow, SHORTCUT_TV, len, scratch) {
+                    Err(tv) if tv <= WIDE_SHORTCUT_TV => {
                         let wide = tables32();
-                        v = self.shortcut(t, y, wide, &mu.wide, WIDE_SHORTCUT_TV, len, scratch);
+                        self.shortcut(t, y, wide, &mu.wide, WIDE_SHORTCUT_TV, len, scratch)
+                            .map(|v| (v, 32))
                     }
-                }
-                if let Ok(v) = v {
+                    r => r.map(|v| (v, CHEB_POINTS)),
+                };
+                if let Ok((v, _points)) = v {
                     #[cfg(test)]
-                    tests::note_shortcut(scratch.shortcut_points);
+                    tests::note_shortcut(_points);
                     if let Some(g) = grad {
                         g.copy_from_slice(&scratch.ch[..g.len()]);
                     }
@@ -569,6 +568,8 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         }
         let mut sv = [0.0; N];
         for (tc, sc) in taus.chunks_exact(16).zip(sv.chunks_exact_mut(16)) {
+            // N is 16 or 32, so every chunk has 16 points (the rust-version predates
+            // `as_chunks`).
             let (Ok(tc), Ok(sc)) = (<&[f64; 16]>::try_from(tc), <&mut [f64; 16]>::try_from(sc))
             else {
                 return Err(f64::INFINITY);
@@ -604,10 +605,6 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             return Err(tv / sigma);
         }
         let log_p = -d0 * inv2 + total.ln() - sigma.ln() - HALF_LN_2PI;
-        #[cfg(test)]
-        {
-            scratch.shortcut_points = N;
-        }
         if let Some(len) = grad_len {
             let ns = len - 1;
             scratch.ch.clear();
