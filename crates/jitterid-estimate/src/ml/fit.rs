@@ -343,8 +343,8 @@ where
     let layout = Layout::of(structure);
     // One parameter with the default solver: a coarse pass for every value, then the values
     // that can still win refined (see `PROFILE_MARGIN`).
-    let refine_tolerance = staged_tolerance(&options.solver);
-    let staged = layout.len() == 1 && layout.nj == 1 && refine_tolerance.is_some();
+    // The refinement's tolerance when the profile is staged.
+    let staged = staged_tolerance(&options.solver).filter(|_| layout.len() == 1 && layout.nj == 1);
     let at = |v: i64| -> Result<ModelStructure<S, J, N>, MlError> {
         let mut s = structure.clone();
         s.jitter = build(v).map_err(Into::into)?;
@@ -387,7 +387,7 @@ where
         Some(o) => ml_estimate_with(s, record, data.as_ref(), known, by, o),
         None => ml_estimate_with(s, record, data.as_ref(), known, by, &plain),
     };
-    let mut fits: Vec<(i64, Result<Fit, MlError>)> = if staged {
+    let mut fits: Vec<(i64, Result<Fit, MlError>)> = if staged.is_some() {
         // In order, each value after the first started where the previous fit put the
         // jitter's standard deviation, with a narrower bracket.
         let warm = MlOptions {
@@ -429,7 +429,7 @@ where
             .map(|&v| (v, at(v).and_then(|s| fit_with(&s, None, None, criterion))))
             .collect()
     };
-    if staged {
+    if let Some(tolerance) = staged {
         let best = fits
             .iter()
             .filter_map(|(_, f)| f.as_ref().ok().filter(|e| e.converged))
@@ -437,7 +437,7 @@ where
             .fold(f64::INFINITY, f64::min);
         let fine = options.with_solver(Brent {
             bracket_step: 0.01,
-            tolerance: refine_tolerance.unwrap_or(Brent::default().tolerance),
+            tolerance,
             progress: brent_hook(&options.solver),
             from_bracket: true,
             ..Brent::default()
