@@ -3,9 +3,11 @@
 //!
 //! `cargo run -p jitterid-python --example fit_timing [--release] -- [repeats]`
 
-use jitterid_cli::commands::{fit_values, simulate_data, DEFAULT_SEED};
-use jitterid_cli::experiment::{self, Purpose};
-use jitterid_cli::fitting::signal_of;
+use jitterid_study::experiment::{self, Purpose};
+use jitterid_study::fit::fit_values;
+use jitterid_study::fit::signal_of;
+use jitterid_study::montecarlo::DEFAULT_SEED;
+use jitterid_study::simulate::simulate_data;
 use std::path::Path;
 use std::time::Instant;
 
@@ -18,7 +20,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..repeats {
         let t0 = Instant::now();
         let signal = signal_of(&exp.system.kind, data.input.as_ref())?;
-        let fit = fit_values(&exp, signal, data.y.clone(), "y")?;
+        let fit = fit_values(
+            &exp,
+            signal,
+            data.y.clone(),
+            "y",
+            &jitterid_study::Watch::none(),
+        )?;
         times.push(t0.elapsed().as_secs_f64());
         assert!(fit.converged, "the Table 2 fit converges");
     }

@@ -6,11 +6,12 @@ use crate::errors::{json_text, spec_table, value_error};
 use crate::toml_text;
 use jitterid::signal::Input;
 use jitterid::signal::{PiecewiseConstant, SampleGrid};
-use jitterid_cli::commands::{self, DEFAULT_SEED};
-use jitterid_cli::csvio;
-use jitterid_cli::experiment::{self, InputSpec, Method, Purpose};
-use jitterid_cli::fingerprint::experiment_fingerprint;
-use jitterid_cli::{fitting, inputs};
+use jitterid_study::csvio;
+use jitterid_study::experiment::{self, InputSpec, Method, Purpose};
+use jitterid_study::fingerprint::experiment_fingerprint;
+use jitterid_study::inputs;
+use jitterid_study::montecarlo::DEFAULT_SEED;
+use jitterid_study::{fit as fitting, records, simulate};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
@@ -177,7 +178,7 @@ impl Experiment {
         truth: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let data = py
-            .detach(|| commands::simulate_data(&self.exp, seed, run))
+            .detach(|| simulate::simulate_data(&self.exp, seed, run))
             .map_err(value_error)?;
         let out = PyDict::new(py);
         out.set_item("t", data.t.into_pyarray(py))?;
@@ -236,7 +237,7 @@ impl Experiment {
         };
         let fit = py.detach(|| {
             let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
-            commands::fit_values(&exp, signal, y, "y")
+            fitting::fit_values(&exp, signal, y, "y", &jitterid_study::Watch::none())
         });
         fit.map(|fit| Fit { fit }).map_err(value_error)
     }
@@ -344,7 +345,7 @@ impl Fit {
     fn json(&self) -> PyResult<String> {
         let fit = &self.fit;
         json_text(&FitOut {
-            cli: commands::fit_json(fit),
+            cli: fitting::fit_json(fit),
             fitted_model: Model::of(&fit.fitted),
             estimated: &fit.estimated,
             estimator_covariance: fit.estimator_covariance.as_deref(),
@@ -356,7 +357,7 @@ impl Fit {
 #[derive(Serialize)]
 struct FitOut<'a> {
     #[serde(flatten)]
-    cli: commands::FitJson<'a>,
+    cli: fitting::FitJson<'a>,
     /// The fitted parts as spec tables (the command line's `model` holds its export forms).
     fitted_model: Model,
     estimated: &'a [String],
@@ -410,7 +411,7 @@ pub fn read_record<'py>(
     for (name, values) in table.columns.iter().zip(table.values) {
         out.set_item(name, values.into_pyarray(py))?;
     }
-    let side = input.unwrap_or_else(|| commands::input_side_file(&path));
+    let side = input.unwrap_or_else(|| records::input_side_file(&path));
     if side.exists() {
         let t = csvio::read(&side).map_err(value_error)?;
         out.set_item(

@@ -3,8 +3,8 @@
 
 use crate::errors::{json_text, value_error};
 use crate::experiment::Experiment;
-use jitterid_cli::commands::{self, McJson, Shard, DEFAULT_SEED};
-use jitterid_cli::merge::merge_values;
+use jitterid_study::merge::merge_values;
+use jitterid_study::montecarlo::{montecarlo_values, McJson, Shard, DEFAULT_SEED};
 use pyo3::prelude::*;
 
 /// Runs `runs` realisations of `experiment` with `method` (the file's if `None`) under master
@@ -34,7 +34,7 @@ pub fn montecarlo(
         })
         .transpose()?;
     let j = py
-        .detach(|| commands::montecarlo_values(&exp, runs, seed, shard, threads))
+        .detach(|| montecarlo_values(&exp, runs, seed, shard, threads))
         .map_err(value_error)?;
     json_text(&j)
 }

@@ -8,7 +8,7 @@ use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{TfForm, ZpkForm};
 use jitterid::signal::registry::{SignalRegistry, Spec};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
-use jitterid_cli::export::{delay_of, tf_of};
+use jitterid_study::export::{delay_of, tf_of};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;

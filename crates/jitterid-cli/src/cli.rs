@@ -4,11 +4,13 @@
 // `[estimate]`), not rustdoc markup.
 #![allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 
-use crate::commands::{self, FitOptions, MonteCarloOptions, Shard, SimulateOptions, DEFAULT_SEED};
-use crate::error::CliResult;
+use crate::commands::{self, FitOptions, MonteCarloOptions, SimulateOptions};
 use crate::exit::{Outcome, BAD_INPUT};
-use crate::experiment::Method;
 use clap::{Args, Parser, Subcommand};
+use jitterid_study::error::StudyResult;
+use jitterid_study::experiment::Method;
+use jitterid_study::montecarlo::{Shard, DEFAULT_SEED};
+use jitterid_study::select::InitChoice;
 use std::ffi::OsString;
 use std::io::Write;
 use std::path::PathBuf;
@@ -134,8 +136,8 @@ pub struct FitArgs {
     pub plot: Option<PathBuf>,
     /// The start: `experiment` (the experiment's values) or `auto` (the system from the
     /// data-driven initializer, as `select` starts each candidate).
-    #[arg(long, value_name = "START", default_value = "experiment", value_parser = crate::select::InitChoice::parse)]
-    pub init: crate::select::InitChoice,
+    #[arg(long, value_name = "START", default_value = "experiment", value_parser = InitChoice::parse)]
+    pub init: InitChoice,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub budget: BudgetArgs,
@@ -212,7 +214,7 @@ pub struct MergeArgs {
     pub accept_unconverged: bool,
 }
 
-fn dispatch(cli: Cli) -> CliResult<Outcome> {
+fn dispatch(cli: Cli) -> StudyResult<Outcome> {
     match cli.command {
         Command::Simulate(a) => commands::simulate(&SimulateOptions {
             experiment: a.experiment,
@@ -248,7 +250,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             max_iterations: a.budget.max_iterations,
             time_limit: a.budget.time_limit,
         }),
-        Command::Validate(a) => crate::validate::validate(&crate::validate::ValidateOptions {
+        Command::Validate(a) => commands::validate(&commands::ValidateOptions {
             experiment: a.experiment,
             data: a.data,
             validation: a.validation,
@@ -257,7 +259,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             out: a.out,
             plot: a.plot,
         }),
-        Command::Select(a) => crate::select::select(&crate::select::SelectOptions {
+        Command::Select(a) => commands::select(&commands::SelectOptions {
             experiment: a.experiment,
             data: a.data,
             validation: a.validation,
@@ -265,7 +267,7 @@ fn dispatch(cli: Cli) -> CliResult<Outcome> {
             out: a.out,
         }),
         Command::Merge(a) => {
-            crate::merge::merge(&a.shards, a.json, a.out.as_deref(), a.accept_unconverged)
+            commands::merge(&a.shards, a.json, a.out.as_deref(), a.accept_unconverged)
         }
     }
 }
@@ -306,7 +308,7 @@ where
             let first = first.strip_prefix("error: ").unwrap_or(&first).to_string();
             eprintln!(
                 "{}",
-                commands::report(&crate::error::CliError::new(format!(
+                commands::report(&jitterid_study::error::StudyError::new(format!(
                     "{first} (see jitterid --help)"
                 )))
             );

@@ -14,8 +14,8 @@
 //!   (these cannot be rolled back, so they are written after every rename has succeeded);
 //! - anything else (a directory, a block device, a socket, a link to nothing): refused.
 
-use crate::cli_err;
-use crate::error::CliResult;
+use jitterid_study::error::StudyResult;
+use jitterid_study::study_err;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -31,17 +31,17 @@ enum Target {
 }
 
 /// What is at `path` now, and so how it is written; refuses what must not be written.
-fn target_of(path: &Path, name: &str) -> CliResult<Target> {
+fn target_of(path: &Path, name: &str) -> StudyResult<Target> {
     let meta = match std::fs::symlink_metadata(path) {
         Ok(m) => m,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             return Ok(Target::Replace(path.to_path_buf()))
         }
-        Err(e) => return Err(cli_err!("{name}: cannot write: {e}")),
+        Err(e) => return Err(study_err!("{name}: cannot write: {e}")),
     };
     if meta.file_type().is_symlink() {
         let resolved = std::fs::canonicalize(path).map_err(|_| {
-            cli_err!("{name}: cannot write: a symbolic link to a file that does not exist")
+            study_err!("{name}: cannot write: a symbolic link to a file that does not exist")
         })?;
         return match target_of(&resolved, name)? {
             Target::Replace(_) => Ok(Target::Replace(resolved)),
@@ -53,7 +53,7 @@ fn target_of(path: &Path, name: &str) -> CliResult<Target> {
         return Ok(Target::Replace(path.to_path_buf()));
     }
     if kind.is_dir() {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: cannot write: is a directory; expected a file name"
         ));
     }
@@ -64,12 +64,12 @@ fn target_of(path: &Path, name: &str) -> CliResult<Target> {
             return Ok(Target::Stream(path.to_path_buf()));
         }
         if kind.is_block_device() {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{name}: cannot write: is a block device; refusing to write over a disk"
             ));
         }
     }
-    Err(cli_err!(
+    Err(study_err!(
         "{name}: cannot write: not a regular file, character device or FIFO"
     ))
 }
@@ -113,7 +113,7 @@ impl OutputSet {
 
     /// Checks every destination, then writes every file; on failure nothing is changed (no new
     /// file, no temporary, no directory created, previous files as they were).
-    pub fn commit(self) -> CliResult<()> {
+    pub fn commit(self) -> StudyResult<()> {
         for d in &self.dirs {
             check_dir(d)?;
         }
@@ -124,14 +124,14 @@ impl OutputSet {
             if let Target::Replace(p) = &target {
                 let dir = dir_of(p);
                 if !self.dirs.iter().any(|d| d == dir) && !dir.is_dir() {
-                    return Err(cli_err!(
+                    return Err(study_err!(
                         "{name}: cannot write: the directory {} does not exist",
                         dir.display()
                     ));
                 }
             }
             if targets.contains(&target) {
-                return Err(cli_err!(
+                return Err(study_err!(
                     "{name}: cannot write: the command would write this file twice (check --out against --plot)"
                 ));
             }
@@ -149,14 +149,14 @@ impl OutputSet {
 }
 
 /// A directory to create must be one already, or be creatable under an existing directory.
-fn check_dir(dir: &Path) -> CliResult<()> {
+fn check_dir(dir: &Path) -> StudyResult<()> {
     let name = dir.display();
     let mut p = dir;
     loop {
         match std::fs::metadata(p) {
             Ok(m) if m.is_dir() => return Ok(()),
             Ok(_) => {
-                return Err(cli_err!(
+                return Err(study_err!(
                     "{name}: cannot create directory: {} is not a directory",
                     p.display()
                 ))
@@ -170,7 +170,7 @@ fn check_dir(dir: &Path) -> CliResult<()> {
 }
 
 /// Creates the missing directories; returns those created, outermost first.
-fn create_dirs(dirs: &[PathBuf]) -> CliResult<Vec<PathBuf>> {
+fn create_dirs(dirs: &[PathBuf]) -> StudyResult<Vec<PathBuf>> {
     let mut created = Vec::new();
     for dir in dirs {
         let mut missing: Vec<&Path> = dir.ancestors().take_while(|p| !p.exists()).collect();
@@ -183,7 +183,10 @@ fn create_dirs(dirs: &[PathBuf]) -> CliResult<Vec<PathBuf>> {
                 for c in created.iter().rev() {
                     let _ = std::fs::remove_dir(c);
                 }
-                return Err(cli_err!("{}: cannot create directory: {e}", dir.display()));
+                return Err(study_err!(
+                    "{}: cannot create directory: {e}",
+                    dir.display()
+                ));
             }
             created.push(p.to_path_buf());
         }
@@ -191,7 +194,7 @@ fn create_dirs(dirs: &[PathBuf]) -> CliResult<Vec<PathBuf>> {
     Ok(created)
 }
 
-fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> CliResult<()> {
+fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> StudyResult<()> {
     let mut staged: Vec<(NamedTempFile, &Path, &Path)> = Vec::new();
     for ((path, contents), target) in files.iter().zip(targets) {
         if let Target::Replace(p) = target {
@@ -204,7 +207,7 @@ fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> CliResult<()> 
             Ok(p) => placed.push(p),
             Err(e) => {
                 roll_back(placed);
-                return Err(cli_err!("{}: cannot write: {e}", path.display()));
+                return Err(study_err!("{}: cannot write: {e}", path.display()));
             }
         }
     }
@@ -212,7 +215,7 @@ fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> CliResult<()> 
         if let Target::Stream(p) = target {
             if let Err(e) = stream(p, contents) {
                 roll_back(placed);
-                return Err(cli_err!("{}: cannot write: {e}", path.display()));
+                return Err(study_err!("{}: cannot write: {e}", path.display()));
             }
         }
     }
@@ -220,7 +223,7 @@ fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> CliResult<()> 
 }
 
 /// Writes `contents` to a temporary beside `target`.
-fn stage(target: &Path, contents: &[u8], path: &Path) -> CliResult<NamedTempFile> {
+fn stage(target: &Path, contents: &[u8], path: &Path) -> StudyResult<NamedTempFile> {
     let name = target
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -244,7 +247,7 @@ fn stage(target: &Path, contents: &[u8], path: &Path) -> CliResult<NamedTempFile
         tmp.as_file().sync_all()?;
         Ok(tmp)
     })();
-    result.map_err(|e| cli_err!("{}: cannot write: {e}", path.display()))
+    result.map_err(|e| study_err!("{}: cannot write: {e}", path.display()))
 }
 
 /// Renames the temporary over `target`, keeping what was there as a backup.

@@ -1,9 +1,5 @@
 //! The figures of `fit --plot`, `montecarlo --plot` and `validate --plot`.
 
-use crate::error::CliResult;
-use crate::experiment::Experiment;
-use crate::export;
-use crate::fitting::Structure;
 use crate::svg::{self, figure, Panel, Series, Style, BLACK, BLUE, GREEN, GREY, ORANGE, RED};
 use jitterid::estimate::validation::{BodePoint, CorrelationTest, StepPoint};
 use jitterid::jitter::AnyJitter;
@@ -11,6 +7,10 @@ use jitterid::jitter::{JitterModel, NoJitter};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::{AnySignal, Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
+use jitterid_study::error::StudyResult;
+use jitterid_study::experiment::Experiment;
+use jitterid_study::export;
+use jitterid_study::fit::Structure;
 
 /// `|X(f)|` of a sequence on the grid at the DFT frequencies (zero excluded).
 fn spectrum(grid: &SampleGrid, x: &[f64]) -> Vec<(f64, Complex64)> {
@@ -167,7 +167,7 @@ pub struct FitPlots<'a> {
 }
 
 /// Writes the `fit` figures; returns (file name, SVG text) pairs.
-pub fn fit_figures(p: &FitPlots<'_>) -> CliResult<Vec<(String, String)>> {
+pub fn fit_figures(p: &FitPlots<'_>) -> StudyResult<Vec<(String, String)>> {
     let exp = p.exp;
     let grid = &exp.grid;
     let (main_label, main) = p.main;

@@ -7,8 +7,8 @@
 mod common;
 
 use common::{example, example_with, jitterid, scratch_in, simulate_text};
-use jitterid_cli::commands::{montecarlo_realizations, DEFAULT_SEED};
-use jitterid_cli::experiment::{self, Purpose};
+use jitterid_study::experiment::{self, Purpose};
+use jitterid_study::montecarlo::{montecarlo_realizations, DEFAULT_SEED};
 use std::path::Path;
 
 /// Runs `simulate` on the experiment `text` (in a fresh directory `name`); asserts exit status

@@ -26,7 +26,7 @@ pub enum InputSpec {
 pub struct SystemSpec {
     /// The signal registry's spec table (`kind` and that kind's keys, checked at the door): the
     /// truth in `simulate`/`montecarlo`, the start in `fit`. Built with
-    /// [`crate::fitting::signal_of`].
+    /// [`crate::fit::signal_of`].
     pub kind: Spec,
     /// Whether its parameters are estimated.
     pub estimate: bool,

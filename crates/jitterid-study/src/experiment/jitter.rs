@@ -10,7 +10,7 @@ use super::diagnostics::{unknown_key, Source};
 use super::range;
 use super::raw::RawTable;
 use super::spec::JitterSpec;
-use crate::error::{CliError, CliResult};
+use crate::error::{StudyError, StudyResult};
 use jitterid::jitter::registry::{Family, JitterRegistry, Spec, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, NoJitter, UniformSum};
 use jitterid::signal::SampleGrid;
@@ -21,7 +21,11 @@ const S: &str = "jitter";
 /// The keys of `[jitter]` that belong to the command line, not to the spec table.
 const OWN_KEYS: &[&str] = &["estimate", "fit_family", "n_range"];
 
-pub(super) fn parse_jitter(cx: &Source, r: &RawTable, grid: &SampleGrid) -> CliResult<JitterSpec> {
+pub(super) fn parse_jitter(
+    cx: &Source,
+    r: &RawTable,
+    grid: &SampleGrid,
+) -> StudyResult<JitterSpec> {
     let registry = JitterRegistry::builtin();
     let fam = r.get(FAMILY_KEY).ok_or_else(|| {
         cx.err_section(
@@ -96,7 +100,7 @@ pub(super) fn profiled(model: &AnyJitter) -> bool {
 }
 
 /// Every key is the command line's or the family's; a typo gets a suggestion.
-fn check_keys(cx: &Source, r: &RawTable, entry: &Family) -> CliResult<()> {
+fn check_keys(cx: &Source, r: &RawTable, entry: &Family) -> StudyResult<()> {
     let mut allowed: Vec<&str> = entry.keys();
     allowed.extend_from_slice(OWN_KEYS);
     let Some((key, v)) = r.iter().find(|(k, _)| !allowed.contains(&k.as_str())) else {
@@ -121,13 +125,13 @@ fn check_keys(cx: &Source, r: &RawTable, entry: &Family) -> CliResult<()> {
 }
 
 /// The section as the registry's spec table (the command line's own keys left out).
-fn spec_table(r: &RawTable) -> CliResult<Spec> {
+fn spec_table(r: &RawTable) -> StudyResult<Spec> {
     r.iter()
         .filter(|(k, _)| !OWN_KEYS.contains(&k.as_str()))
         .map(|(k, v)| {
             serde_json::to_value(v.get_ref())
                 .map(|v| (k.clone(), v))
-                .map_err(|e| crate::cli_err!("[jitter] {k}: {e}"))
+                .map_err(|e| crate::study_err!("[jitter] {k}: {e}"))
         })
         .collect()
 }
@@ -140,7 +144,7 @@ fn check_ranges(
     spec: &Spec,
     path: &str,
     grid: &SampleGrid,
-) -> CliResult<()> {
+) -> StudyResult<()> {
     let registry = JitterRegistry::builtin();
     let entry = spec
         .get(FAMILY_KEY)
@@ -171,7 +175,7 @@ fn check_ranges(
 
 /// An error about the key `path` of the section: `key`, or `terms.<i>.key` for a term's key
 /// (located in the `i`-th `[[jitter.terms]]` table).
-fn located(cx: &Source, r: &RawTable, path: &str, msg: impl std::fmt::Display) -> CliError {
+fn located(cx: &Source, r: &RawTable, path: &str, msg: impl std::fmt::Display) -> StudyError {
     let term = path
         .strip_prefix("terms.")
         .and_then(|rest| rest.split_once('.'))
@@ -188,7 +192,7 @@ fn located(cx: &Source, r: &RawTable, path: &str, msg: impl std::fmt::Display) -
 }
 
 /// A registry error, located at the key it names.
-fn jitter_error(cx: &Source, r: &RawTable, e: JitterError) -> CliError {
+fn jitter_error(cx: &Source, r: &RawTable, e: JitterError) -> StudyError {
     match e.key() {
         Some(key) => {
             let key = key.to_string();
@@ -205,10 +209,10 @@ fn fitted_family(
     ff: &Spanned<toml::Value>,
     truth: &AnyJitter,
     spec: &Spec,
-) -> CliResult<AnyJitter> {
+) -> StudyResult<AnyJitter> {
     let registry = JitterRegistry::builtin();
     let name = cx.string_value(S, "fit_family", ff)?;
-    let fail = |m: String| -> CliError { cx.err(S, "fit_family", &ff.span(), m) };
+    let fail = |m: String| -> StudyError { cx.err(S, "fit_family", &ff.span(), m) };
     let entry = registry.family(name).ok_or_else(|| {
         fail(format!(
             "unknown jitter family \"{name}\"; expected {}",
@@ -242,7 +246,7 @@ fn n_range(
     cx: &Source,
     v: Option<&Spanned<toml::Value>>,
     profiled: bool,
-) -> CliResult<Option<(u32, u32)>> {
+) -> StudyResult<Option<(u32, u32)>> {
     let max = i64::from(UniformSum::MAX_N);
     let expected = format!("expected [min, max] with 0 <= min <= max <= {max}");
     match (v, profiled) {

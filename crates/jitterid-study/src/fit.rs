@@ -1,10 +1,10 @@
 //! From an experiment to signals, model structures and estimates.
 
-use crate::cli_err;
-use crate::error::CliResult;
-use crate::experiment::{name_table, Experiment, InputSpec, Method};
-use crate::export::{reported_covariance, CovarianceSource};
-use crate::inputs::input_span;
+use crate::error::StudyResult;
+use crate::experiment::{name_table, Experiment, Method};
+use crate::export::{self, reported_covariance, CovarianceSource};
+use crate::study_err;
+use crate::Watch;
 use jitterid::estimate::solver::{AnySolver, SolverRegistry};
 use jitterid::estimate::{
     AnyCriterion, AnyNoise, EstimateError, Fit as Estimate, FitOptions, ModelStructure, NoiseModel,
@@ -15,7 +15,8 @@ use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
 use jitterid::signal::registry::{SignalRegistry, Spec, KIND_KEY};
-use jitterid::signal::{simulate, AnySignal, Input, SampleGrid, Signal};
+use jitterid::signal::{AnySignal, Input, SampleGrid, Signal};
+use serde::Serialize;
 use serde_json::Map;
 
 /// The uniform-sum jitter with `n + 1` terms and standard deviation `sigma`, through the
@@ -33,7 +34,7 @@ pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
 
 /// The signal of a system's spec table driven by `input` (a kind that needs one, such as a
 /// rational system, fails without it), built through the signal registry.
-pub fn signal_of(spec: &Spec, input: Option<&Input>) -> CliResult<AnySignal> {
+pub fn signal_of(spec: &Spec, input: Option<&Input>) -> StudyResult<AnySignal> {
     let registry = SignalRegistry::builtin();
     let needs_input = spec
         .get(KIND_KEY)
@@ -41,114 +42,15 @@ pub fn signal_of(spec: &Spec, input: Option<&Input>) -> CliResult<AnySignal> {
         .and_then(|name| registry.kind(name))
         .is_some_and(|k| k.needs_input());
     if needs_input && input.is_none() {
-        return Err(cli_err!("a rational system needs an input"));
+        return Err(study_err!("a rational system needs an input"));
     }
     registry
         .build(spec, input)
-        .map_err(|e| cli_err!("[system]: {e}"))
-}
-
-/// The true input of one realisation: a random binary input is drawn from `rng` (from
-/// `history` seconds before `t0`), others are fixed.
-pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> CliResult<Option<Input>> {
-    Ok(match &exp.input {
-        InputSpec::None => None,
-        InputSpec::Known(i) => Some(i.clone()),
-        InputSpec::RandomBinary(rb) => {
-            let (a, b) = input_span(&exp.grid);
-            Some(Input::Piecewise(
-                rb.generate(a - exp.history, b, rng)
-                    .map_err(|e| cli_err!("{}: [input] random-binary: {e}", exp.file))?,
-            ))
-        }
-    })
-}
-
-/// The input as a fit sees it: the true input from the record's first instant `t0` on (what
-/// `simulate` writes beside the record), as a measurement of it would.
-pub fn seen_input(exp: &Experiment, truth: Option<&Input>) -> CliResult<Option<Input>> {
-    Ok(match truth {
-        Some(Input::Piecewise(p)) if exp.history > 0.0 => Some(Input::Piecewise(
-            crate::inputs::from_start(p, exp.grid.start())
-                .map_err(|e| cli_err!("{}: [input] history: {e}", exp.file))?,
-        )),
-        other => other.cloned(),
-    })
-}
-
-/// One simulated record: `y`, and the drawn `τ` and `v`.
-pub struct Simulated {
-    /// Samples.
-    pub y: Vec<f64>,
-    /// Jitter of each sample.
-    pub tau: Vec<f64>,
-    /// Measurement noise of each sample (after the noise filter).
-    pub v: Vec<f64>,
-}
-
-/// Simulates the experiment's truth with `signal`; coloured noise is white noise filtered by
-/// the `[noise]` model with zero initial conditions.
-pub fn simulate_record(
-    exp: &Experiment,
-    signal: &AnySignal,
-    rng: &mut StdRng,
-) -> CliResult<Simulated> {
-    let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
-        .map_err(|e| cli_err!("{}: simulation: {e}", exp.file))?;
-    let shape = &exp.noise.shape;
-    let v = if shape.is_white() {
-        sim.noise.clone()
-    } else {
-        // The ARMA model's parameters are `c1…` then `d1…`.
-        let p = shape.params();
-        let nc = shape
-            .param_names()
-            .iter()
-            .filter(|n| n.starts_with('c'))
-            .count();
-        arma_filter(&p[..nc], &p[nc..], &sim.noise)
-    };
-    let y = sim
-        .y
-        .iter()
-        .zip(&sim.noise)
-        .zip(&v)
-        .map(|((y, e), v)| y - e + v)
-        .collect::<Vec<f64>>();
-    // The door refuses values outside the representable range; this catches a combination of
-    // values inside it that still overflows, rather than writing NaN samples.
-    if let Some(k) = y.iter().position(|x| !x.is_finite()) {
-        return Err(cli_err!(
-            "{}: sample {k} of the simulated record is {}: the experiment's values are beyond what double precision can simulate",
-            exp.file,
-            y[k]
-        ));
-    }
-    Ok(Simulated { y, tau: sim.tau, v })
-}
-
-/// `v = (C(q)/D(q)) e` with `C = 1 + c_1 q^{-1} + …`, `D = 1 + d_1 q^{-1} + …`, at rest before.
-pub fn arma_filter(c: &[f64], d: &[f64], e: &[f64]) -> Vec<f64> {
-    let mut v: Vec<f64> = Vec::with_capacity(e.len());
-    for k in 0..e.len() {
-        let mut x = e[k];
-        for (i, ci) in c.iter().enumerate() {
-            if k > i {
-                x += ci * e[k - i - 1];
-            }
-        }
-        for (i, di) in d.iter().enumerate() {
-            if k > i {
-                x -= di * v[k - i - 1];
-            }
-        }
-        v.push(x);
-    }
-    v
+        .map_err(|e| study_err!("[system]: {e}"))
 }
 
 /// The model structure for `signal` as the experiment says (free parts, noise, method).
-pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResult<Structure> {
+pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> StudyResult<Structure> {
     let shape_free = exp.noise.estimate
         && (method.as_str() == "bj" || method.is_likelihood())
         && !exp.noise.shape.is_white();
@@ -158,16 +60,16 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> CliResu
         Ok(s)
     } else {
         s.with_noise_std(exp.noise.std)
-            .map_err(|e| cli_err!("{}: [noise] std: {e}", exp.file))
+            .map_err(|e| study_err!("{}: [noise] std: {e}", exp.file))
     }
 }
 
 /// The solver of the experiment, built through the solver registry; `seed` seeds multistart
 /// perturbations. The command line's iteration and wall-clock budgets go to the entry's
 /// `max_iters` and `max_seconds` keys where it takes them (a solver without a wall-clock
-/// budget runs to its iteration limit), and the progress bar, when one is shown, to the
-/// solver itself.
-pub fn solver(exp: &Experiment, seed: u64) -> CliResult<AnySolver> {
+/// budget runs to its iteration limit), and the watcher of iterations, when there is one, to
+/// the solver itself.
+pub fn solver(exp: &Experiment, seed: u64, watch: &Watch) -> StudyResult<AnySolver> {
     let e = &exp.estimate;
     let registry = SolverRegistry::builtin();
     let mut table = name_table(registry.key(), e.solver.as_str());
@@ -188,14 +90,14 @@ pub fn solver(exp: &Experiment, seed: u64) -> CliResult<AnySolver> {
         table.insert("seed".into(), seed.into());
     }
     let solver = registry.build(&table).map_err(|err| {
-        cli_err!(
+        study_err!(
             "{}: [estimate] solver \"{}\": {err}",
             exp.file,
             e.solver.as_str()
         )
     })?;
-    Ok(match crate::progress::active_fit_hook() {
-        Some(hook) => solver.with_progress(hook),
+    Ok(match &watch.iterations {
+        Some(hook) => solver.with_progress(hook.clone()),
         None => solver,
     })
 }
@@ -242,7 +144,11 @@ pub struct Fit {
 }
 
 /// Names of the reported parameters, in order, for an experiment fitted with `method`.
-pub fn param_names(exp: &Experiment, signal: &AnySignal, method: Method) -> CliResult<Vec<String>> {
+pub fn param_names(
+    exp: &Experiment,
+    signal: &AnySignal,
+    method: Method,
+) -> StudyResult<Vec<String>> {
     let s = structure(exp, signal.clone(), method)?;
     Ok(report_names(exp, &s))
 }
@@ -278,7 +184,7 @@ pub fn truth_values(
     exp: &Experiment,
     signal_truth: &AnySignal,
     method: Method,
-) -> CliResult<Vec<Option<f64>>> {
+) -> StudyResult<Vec<Option<f64>>> {
     let s = structure(exp, signal_truth.clone(), method)?;
     let names = report_names(exp, &s);
     let mut out = Vec::with_capacity(names.len());
@@ -321,10 +227,15 @@ pub fn truth_values(
     Ok(out)
 }
 
-fn options(exp: &Experiment, seed: u64, covariance: bool) -> CliResult<FitOptions> {
+fn options(
+    exp: &Experiment,
+    seed: u64,
+    covariance: bool,
+    watch: &Watch,
+) -> StudyResult<FitOptions> {
     Ok(FitOptions {
         frequencies: exp.estimate.frequencies.clone(),
-        solver: Some(solver(exp, seed)?),
+        solver: Some(solver(exp, seed, watch)?),
         covariance,
         noise_std_start: None,
     })
@@ -400,8 +311,9 @@ pub fn fit(
     method: Method,
     seed: u64,
     covariance: bool,
+    watch: &Watch,
 ) -> Result<Fit, String> {
-    let opts = options(exp, seed, covariance).map_err(|e| e.to_string())?;
+    let opts = options(exp, seed, covariance, watch).map_err(|e| e.to_string())?;
     let raw =
         |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
             let (e, fitted, n) = r.map_err(|e| e.to_string())?;
@@ -421,7 +333,7 @@ pub fn fit(
         };
     let criterion = method.criterion();
     let e = if criterion.is_likelihood() {
-        fit_ml(exp, s, record, method, covariance)?
+        fit_ml(exp, s, record, method, covariance, watch)?
     } else {
         raw(run_criterion(exp, s, record, &criterion, &opts))?
     };
@@ -495,7 +407,14 @@ pub fn fit(
 }
 
 #[cfg(not(feature = "ml"))]
-fn fit_ml(_: &Experiment, _: &Structure, _: &Record, _: Method, _: bool) -> Result<Raw, String> {
+fn fit_ml(
+    _: &Experiment,
+    _: &Structure,
+    _: &Record,
+    _: Method,
+    _: bool,
+    _: &Watch,
+) -> Result<Raw, String> {
     Err("maximum likelihood is not available in this build of jitterid".into())
 }
 
@@ -508,6 +427,7 @@ fn fit_ml(
     record: &Record,
     method: Method,
     covariance: bool,
+    watch: &Watch,
 ) -> Result<Raw, String> {
     use jitterid::estimate::ml::{
         ml_estimate, ml_profile, ExactMl, LikelihoodCriterion, MlOptions, QuasiMl,
@@ -544,9 +464,9 @@ fn fit_ml(
     if let Some(max_seconds) = exp.estimate.max_seconds {
         opts.solver.bfgs.max_seconds = max_seconds;
     }
-    if let Some(hook) = crate::progress::active_fit_hook() {
+    if let Some(hook) = &watch.iterations {
         opts.solver.bfgs.progress = Some(hook.clone());
-        opts.solver.brent.progress = Some(hook);
+        opts.solver.brent.progress = Some(hook.clone());
     }
     let (e, n, base) = if s.noise.is_white() && method.as_str() == "ml" {
         go(exp, s, record, &ExactMl::default(), &opts)?
@@ -584,4 +504,59 @@ pub fn perturb(theta: &[f64], r: f64, rng: &mut StdRng) -> Vec<f64> {
 /// A record from samples on the experiment's grid.
 pub fn record(grid: &SampleGrid, y: Vec<f64>) -> Result<Record, EstimateError> {
     Record::new(*grid, y)
+}
+
+/// The JSON of `jitterid fit --json`, borrowed from a [`Fit`].
+#[derive(Debug, Serialize)]
+pub struct FitJson<'a> {
+    method: &'a str,
+    converged: bool,
+    cost: f64,
+    iterations: u64,
+    termination: &'a str,
+    noise_std: f64,
+    parameters: &'a [Param],
+    /// Covariance of `parameters`, in their order (`null` where undefined).
+    covariance: Option<&'a [Vec<Option<f64>>]>,
+    /// The fitted system in zpk, tf and state-space form (rational systems only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    model: Option<export::ModelForms>,
+}
+
+/// Fits the experiment's model with its method to the samples `y` of a record whose input
+/// `signal` holds; `data` names the record in messages.
+///
+/// `watch.iterations` follows the solver's iterations.
+pub fn fit_values(
+    exp: &Experiment,
+    signal: AnySignal,
+    y: Vec<f64>,
+    data: &str,
+    watch: &Watch,
+) -> StudyResult<Fit> {
+    let method = exp.estimate.method;
+    let record = record(&exp.grid, y).map_err(|e| study_err!("{data}: {e}"))?;
+    let s = structure(exp, signal, method)?;
+    fit(exp, &s, &record, method, 0, true, watch).map_err(|e| {
+        study_err!(
+            "{}: fit with method {} failed: {e}",
+            exp.file,
+            method.as_str()
+        )
+    })
+}
+
+/// The JSON of `jitterid fit --json`.
+pub fn fit_json(f: &Fit) -> FitJson<'_> {
+    FitJson {
+        method: f.method.as_str(),
+        converged: f.converged,
+        cost: f.cost,
+        iterations: f.iterations,
+        termination: &f.termination,
+        noise_std: f.noise_std,
+        parameters: &f.params,
+        covariance: f.covariance.as_deref(),
+        model: export::model_forms(&f.fitted.signal),
+    }
 }

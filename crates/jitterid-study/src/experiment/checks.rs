@@ -3,7 +3,7 @@
 
 use super::diagnostics::Source;
 use super::range;
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use std::ops::Range;
 use toml::Spanned;
 
@@ -16,7 +16,7 @@ impl Source<'_> {
         selector: &str,
         allowed: &[&str],
         what: &str,
-    ) -> CliResult<()> {
+    ) -> StudyResult<()> {
         for (k, span) in present {
             if !allowed.contains(k) {
                 return Err(self.err(
@@ -39,12 +39,12 @@ impl Source<'_> {
         key: &str,
         v: &'v Option<Spanned<T>>,
         why: &str,
-    ) -> CliResult<&'v Spanned<T>> {
+    ) -> StudyResult<&'v Spanned<T>> {
         v.as_ref()
             .ok_or_else(|| self.err_section(section, key, format!("missing; {why}")))
     }
 
-    pub(super) fn finite(&self, section: &str, key: &str, v: &Spanned<f64>) -> CliResult<f64> {
+    pub(super) fn finite(&self, section: &str, key: &str, v: &Spanned<f64>) -> StudyResult<f64> {
         self.checked(section, key, v, Ok)
     }
 
@@ -55,7 +55,7 @@ impl Source<'_> {
         key: &str,
         v: &Spanned<f64>,
         check: impl FnOnce(f64) -> Result<f64, String>,
-    ) -> CliResult<f64> {
+    ) -> StudyResult<f64> {
         finite_value(*v.get_ref())
             .and_then(check)
             .map_err(|m| self.err(section, key, &v.span(), m))
@@ -69,7 +69,7 @@ impl Source<'_> {
         v: &Option<Spanned<f64>>,
         default: f64,
         check: impl FnOnce(f64) -> Result<f64, String>,
-    ) -> CliResult<f64> {
+    ) -> StudyResult<f64> {
         v.as_ref()
             .map_or(Ok(default), |v| self.checked(section, key, v, check))
     }
@@ -81,7 +81,7 @@ impl Source<'_> {
         key: &str,
         v: &Spanned<Vec<f64>>,
         check: impl Fn(f64) -> Result<f64, String>,
-    ) -> CliResult<Vec<f64>> {
+    ) -> StudyResult<Vec<f64>> {
         v.get_ref()
             .iter()
             .enumerate()
@@ -99,11 +99,11 @@ impl Source<'_> {
         section: &str,
         key: &str,
         v: &Spanned<Vec<f64>>,
-    ) -> CliResult<Vec<f64>> {
+    ) -> StudyResult<Vec<f64>> {
         self.checked_list(section, key, v, |x| finite_value(x).and_then(range::level))
     }
 
-    pub(super) fn positive(&self, section: &str, key: &str, v: &Spanned<f64>) -> CliResult<f64> {
+    pub(super) fn positive(&self, section: &str, key: &str, v: &Spanned<f64>) -> StudyResult<f64> {
         let x = self.finite(section, key, v)?;
         if x > 0.0 {
             Ok(x)
@@ -123,7 +123,7 @@ impl Source<'_> {
         key: &str,
         v: &Option<Spanned<f64>>,
         default: f64,
-    ) -> CliResult<f64> {
+    ) -> StudyResult<f64> {
         self.opt_checked(section, key, v, default, Ok)
     }
 
@@ -132,7 +132,7 @@ impl Source<'_> {
         section: &str,
         key: &str,
         v: &Spanned<Vec<f64>>,
-    ) -> CliResult<Vec<f64>> {
+    ) -> StudyResult<Vec<f64>> {
         self.checked_list(section, key, v, finite_value)
     }
 }
@@ -175,7 +175,7 @@ impl Source<'_> {
         key: &str,
         v: &Spanned<toml::Value>,
         what: &str,
-    ) -> crate::error::CliError {
+    ) -> crate::error::StudyError {
         self.err(
             section,
             key,
@@ -190,7 +190,7 @@ impl Source<'_> {
         section: &str,
         key: &str,
         v: &Spanned<toml::Value>,
-    ) -> CliResult<bool> {
+    ) -> StudyResult<bool> {
         match v.get_ref() {
             toml::Value::Boolean(b) => Ok(*b),
             _ => Err(self.wrong_type(section, key, v, "true or false")),
@@ -203,7 +203,7 @@ impl Source<'_> {
         section: &str,
         key: &str,
         v: &'v Spanned<toml::Value>,
-    ) -> CliResult<&'v str> {
+    ) -> StudyResult<&'v str> {
         match v.get_ref() {
             toml::Value::String(s) => Ok(s),
             _ => Err(self.wrong_type(section, key, v, "a string")),

@@ -1,4 +1,4 @@
-//! `jitterid merge`: shard files of one study, checked to belong together and to be whole, into
+//! Merging: shard files of one study, checked to belong together and to be whole, into
 //! the result of the unsharded study.
 //!
 //! A shard belongs to the study of the first shard when its program version, experiment
@@ -7,12 +7,10 @@
 //! realisation has one value per parameter, and its summaries, convergence count and termination
 //! counts are what its realisations give (so a hand-edited value is caught).
 
-use crate::cli_err;
-use crate::commands::{emit, summarize, terminations, McJson, Realization, ShardInfo, MAX_RUNS};
 use crate::csvio;
-use crate::error::CliResult;
-use crate::exit::{Outcome, Status};
-use crate::output::OutputSet;
+use crate::error::StudyResult;
+use crate::montecarlo::{summarize, terminations, McJson, Realization, ShardInfo, MAX_RUNS};
+use crate::study_err;
 use std::path::{Path, PathBuf};
 
 /// Largest number of shards of one study.
@@ -26,13 +24,13 @@ struct Part {
     runs: Vec<Realization>,
 }
 
-fn read_part(path: &Path) -> CliResult<Part> {
+fn read_part(path: &Path) -> StudyResult<Part> {
     let name = path.display().to_string();
     csvio::check_regular_file(path, &name)?;
     let text = std::fs::read_to_string(path)
-        .map_err(|e| cli_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
+        .map_err(|e| study_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
     let json: McJson = serde_json::from_str(&text).map_err(|e| {
-        cli_err!(
+        study_err!(
             "{name}:{}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}",
             e.line(),
             e.column()
@@ -42,12 +40,12 @@ fn read_part(path: &Path) -> CliResult<Part> {
 }
 
 /// A shard result called `name` in messages, checked to be a shard.
-fn part_of(name: String, json: McJson) -> CliResult<Part> {
+fn part_of(name: String, json: McJson) -> StudyResult<Part> {
     let (Some(shard), Some(runs)) = (json.shard.clone(), json.realizations.clone()) else {
-        return Err(cli_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json"));
+        return Err(study_err!("{name}: not a shard file (no `shard` and `realizations`); write shards with montecarlo --shard i/n --json"));
     };
     if json.fingerprint.is_empty() || json.program.is_empty() {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: has no `fingerprint` and `program` (written by an older jitterid?); its study cannot be identified, so run the shard again"
         ));
     }
@@ -91,13 +89,13 @@ fn identity_mismatch(p: &Part, first: &Part) -> Option<(&'static str, String, St
 }
 
 /// Checks that `p` is whole: its runs, value counts, and stored summaries agree.
-fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<()> {
+fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> StudyResult<()> {
     let name = &p.name;
     let s = &p.shard;
     let first = s.runs_total * s.index / s.count;
     let end = s.runs_total * (s.index + 1) / s.count;
     if s.first != first || s.end != end {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: shard {}/{} of {} runs covers runs {first}..{end}, but the file says {}..{}",
             s.index,
             s.count,
@@ -107,7 +105,7 @@ fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<(
         ));
     }
     if p.runs.len() as u64 != end - first || p.json.runs != end - first {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: expected {} realisations (runs {first}..{end}), found {} (`runs` says {})",
             end - first,
             p.runs.len(),
@@ -116,14 +114,14 @@ fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<(
     }
     for (i, r) in p.runs.iter().enumerate() {
         if r.run != first + i as u64 {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{name}: realisation {i} is run {}, expected run {} (runs in order, each once)",
                 r.run,
                 first + i as u64
             ));
         }
         if r.values.len() != names.len() {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{name}: run {}: expected {} values (one per parameter), found {}",
                 r.run,
                 names.len(),
@@ -133,13 +131,13 @@ fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<(
     }
     let converged = p.runs.iter().filter(|r| r.converged).count() as u64;
     if converged != p.json.converged {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: `converged` says {}, but {converged} of its realisations converged",
             p.json.converged
         ));
     }
     if terminations(&p.runs) != p.json.terminations {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: `terminations` do not count its realisations' terminations"
         ));
     }
@@ -151,7 +149,7 @@ fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<(
         .zip(&recomputed)
         .find(|(a, b)| a != b)
     {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: the summary of `{}` is not that of its realisations (mean {:?} stored, {:?} computed): was the file edited?",
             stored.name,
             stored.mean,
@@ -161,41 +159,33 @@ fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> CliResult<(
     Ok(())
 }
 
-/// `jitterid merge`: combines shard files into the result of the unsharded study; exit status
-/// [`Status::NotConverged`] when no fit of the study converged (unless `accept_unconverged`).
-pub fn merge(
-    files: &[PathBuf],
-    json: bool,
-    out: Option<&Path>,
-    accept_unconverged: bool,
-) -> CliResult<Outcome> {
+/// Reads shard files and combines them into the result of the unsharded study (what
+/// `jitterid merge --json` prints).
+pub fn merge_files(files: &[PathBuf]) -> StudyResult<McJson> {
     let parts = files
         .iter()
         .map(|f| read_part(f))
-        .collect::<CliResult<Vec<Part>>>()?;
-    let merged = merge_parts(&parts)?;
-    let status = Status::of_convergence(merged.converged > 0, accept_unconverged);
-    let text = emit(&merged, json, out, OutputSet::new())?;
-    Ok(Outcome { text, status })
+        .collect::<StudyResult<Vec<Part>>>()?;
+    merge_parts(&parts)
 }
 
 /// Combines shard results, each with the name that messages call it by, into the result of
 /// the unsharded study (what `jitterid merge --json` prints).
-pub fn merge_values(shards: Vec<(String, McJson)>) -> CliResult<McJson> {
+pub fn merge_values(shards: Vec<(String, McJson)>) -> StudyResult<McJson> {
     let parts = shards
         .into_iter()
         .map(|(name, json)| part_of(name, json))
-        .collect::<CliResult<Vec<Part>>>()?;
+        .collect::<StudyResult<Vec<Part>>>()?;
     merge_parts(&parts)
 }
 
-fn merge_parts(parts: &[Part]) -> CliResult<McJson> {
+fn merge_parts(parts: &[Part]) -> StudyResult<McJson> {
     let Some(first) = parts.first() else {
-        return Err(cli_err!("merge: expected at least one shard file"));
+        return Err(study_err!("merge: expected at least one shard file"));
     };
     let s0 = &first.shard;
     if !(1..=MAX_SHARDS).contains(&s0.count) || !(1..=MAX_RUNS).contains(&s0.runs_total) {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{}: shard count {} or run total {} out of range (1 to {MAX_SHARDS} shards, 1 to {MAX_RUNS} runs)",
             first.name,
             s0.count,
@@ -212,14 +202,14 @@ fn merge_parts(parts: &[Part]) -> CliResult<McJson> {
     let mut seen = vec![false; s0.count as usize];
     for p in parts {
         if let Some((what, this, theirs)) = identity_mismatch(p, first) {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{}: belongs to another study than {}: its {what} is {this:?}, not {theirs:?}",
                 p.name,
                 first.name
             ));
         }
         if p.json.parameters.iter().map(|q| &q.name).ne(names.iter()) {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{}: its parameters differ from those of {}",
                 p.name,
                 first.name
@@ -232,7 +222,7 @@ fn merge_parts(parts: &[Part]) -> CliResult<McJson> {
             .zip(&truth)
             .find(|(q, t)| q.truth.map(f64::to_bits) != t.map(f64::to_bits))
         {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{}: the true value of `{}` is {:?}, not {:?} as in {}",
                 p.name,
                 q.0.name,
@@ -243,9 +233,9 @@ fn merge_parts(parts: &[Part]) -> CliResult<McJson> {
         }
         let slot = seen
             .get_mut(p.shard.index as usize)
-            .ok_or_else(|| cli_err!("{}: shard index {} out of range", p.name, p.shard.index))?;
+            .ok_or_else(|| study_err!("{}: shard index {} out of range", p.name, p.shard.index))?;
         if *slot {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{}: shard {}/{} given twice",
                 p.name,
                 p.shard.index,
@@ -256,7 +246,7 @@ fn merge_parts(parts: &[Part]) -> CliResult<McJson> {
         check_whole(p, &names, &truth)?;
     }
     if let Some(missing) = seen.iter().position(|s| !s) {
-        return Err(cli_err!("merge: shard {missing}/{} is missing", s0.count));
+        return Err(study_err!("merge: shard {missing}/{} is missing", s0.count));
     }
     let mut all: Vec<Realization> = parts.iter().flat_map(|p| p.runs.clone()).collect();
     all.sort_by_key(|r| r.run);

@@ -2,14 +2,14 @@
 
 use super::diagnostics::Source;
 use super::raw::RawSelect;
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use jitterid::estimate::selection::{SelectionError, SelectionGrid};
 use jitterid::jitter::registry::JitterRegistry;
 use toml::Spanned;
 
 const S: &str = "select";
 
-fn range(cx: &Source, key: &str, v: &Spanned<Vec<i64>>) -> CliResult<(usize, usize)> {
+fn range(cx: &Source, key: &str, v: &Spanned<Vec<i64>>) -> StudyResult<(usize, usize)> {
     match v.get_ref().as_slice() {
         &[lo, hi] if lo >= 0 && hi >= 0 => Ok((lo as usize, hi as usize)),
         other => Err(cx.err(
@@ -23,7 +23,7 @@ fn range(cx: &Source, key: &str, v: &Spanned<Vec<i64>>) -> CliResult<(usize, usi
 
 /// The selection grid of `[select]` (defaults: 1–2 poles, 0–1 zeros, families `none` and
 /// `gaussian`), checked against the registry and the record length `len`.
-pub(super) fn parse_select(cx: &Source, r: &RawSelect, len: usize) -> CliResult<SelectionGrid> {
+pub(super) fn parse_select(cx: &Source, r: &RawSelect, len: usize) -> StudyResult<SelectionGrid> {
     let poles = match &r.poles {
         Some(v) => range(cx, "poles", v)?,
         None => (1, 2),
@@ -54,6 +54,6 @@ pub(super) fn parse_select(cx: &Source, r: &RawSelect, len: usize) -> CliResult<
                 None => cx.err_section(S, key, message),
             })
         }
-        Err(e) => Err(crate::cli_err!("{}: [select] {e}", cx.file)),
+        Err(e) => Err(crate::study_err!("{}: [select] {e}", cx.file)),
     }
 }

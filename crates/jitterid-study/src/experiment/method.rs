@@ -4,8 +4,8 @@
 use super::diagnostics::Source;
 use super::raw::RawExperiment;
 use super::spec::{JitterSpec, Method, NoiseSpec, SystemSpec};
-use crate::cli_err;
-use crate::error::{CliError, CliResult};
+use crate::error::{StudyError, StudyResult};
+use crate::study_err;
 
 /// The parts of an experiment that decide which methods apply.
 pub(super) struct Estimated<'a> {
@@ -22,10 +22,10 @@ pub(super) fn check_method(
     parts: &Estimated,
     method: Method,
     from_command_line: bool,
-) -> CliResult<()> {
-    let blame = |msg: &str| -> CliError {
+) -> StudyResult<()> {
+    let blame = |msg: &str| -> StudyError {
         if from_command_line {
-            cli_err!("--method {}: {msg}", method.as_str())
+            study_err!("--method {}: {msg}", method.as_str())
         } else {
             let key = raw.estimate.as_ref().and_then(|e| e.method.as_ref());
             cx.err_at("estimate", "method", key, msg)

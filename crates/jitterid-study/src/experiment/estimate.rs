@@ -4,7 +4,7 @@ use super::checks::{describe, number};
 use super::diagnostics::Source;
 use super::raw::RawEstimate;
 use super::spec::{EstimateSpec, Method, SolverName};
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use jitterid::estimate::Frequencies;
 use jitterid::signal::SampleGrid;
 use toml::Spanned;
@@ -15,7 +15,7 @@ pub(super) fn parse_estimate(
     cx: &Source,
     r: &RawEstimate,
     grid: &SampleGrid,
-) -> CliResult<EstimateSpec> {
+) -> StudyResult<EstimateSpec> {
     let method = match &r.method {
         None => Method::BCLS,
         Some(m) => Method::parse(m.get_ref()).ok_or_else(|| {
@@ -72,7 +72,7 @@ pub(super) fn parse_estimate(
     })
 }
 
-fn parse_solver(cx: &Source, s: &Spanned<String>) -> CliResult<SolverName> {
+fn parse_solver(cx: &Source, s: &Spanned<String>) -> StudyResult<SolverName> {
     SolverName::parse(s.get_ref()).ok_or_else(|| {
         cx.err(
             S,
@@ -95,7 +95,7 @@ fn whole_number(
     min: i64,
     max: i64,
     what: &str,
-) -> CliResult<Option<u64>> {
+) -> StudyResult<Option<u64>> {
     let Some(v) = v else { return Ok(None) };
     let n = *v.get_ref();
     if !(min..=max).contains(&n) {
@@ -110,7 +110,12 @@ fn whole_number(
 }
 
 /// A relative size in `[0, 10]`, or `default`.
-fn relative_size(cx: &Source, key: &str, v: Option<&Spanned<f64>>, default: f64) -> CliResult<f64> {
+fn relative_size(
+    cx: &Source,
+    key: &str,
+    v: Option<&Spanned<f64>>,
+    default: f64,
+) -> StudyResult<f64> {
     let Some(v) = v else { return Ok(default) };
     let x = cx.finite(S, key, v)?;
     if (0.0..=10.0).contains(&x) {
@@ -129,7 +134,7 @@ fn parse_frequencies(
     cx: &Source,
     v: &Spanned<toml::Value>,
     grid: &SampleGrid,
-) -> CliResult<Frequencies> {
+) -> StudyResult<Frequencies> {
     const K: &str = "frequencies";
     let expected = "expected \"dft\", { min = …, max = … } (Hz) or a list of frequencies in Hz";
     let nyquist_period = 1.0 / grid.interval();
@@ -144,7 +149,7 @@ fn parse_frequencies(
                     format!("unknown key `{k}` in the band; expected min and max"),
                 ));
             }
-            let get = |k: &str| -> CliResult<f64> {
+            let get = |k: &str| -> StudyResult<f64> {
                 let x = t.get(k).ok_or_else(|| {
                     cx.err(S, K, &v.span(), format!("the band needs `{k}`; {expected}"))
                 })?;

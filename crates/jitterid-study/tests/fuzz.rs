@@ -1,7 +1,7 @@
 //! Property tests ("fuzzing") of the readers: the TOML experiment parser and the CSV parser
 //! must never panic, and every error must be one line that starts with the file's name.
 
-use jitterid_cli::{csvio, experiment};
+use jitterid_study::{csvio, experiment};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,7 @@ fn example_texts() -> Vec<String> {
 
 /// An empty directory: `kind = "csv"` inputs resolve against it and find nothing.
 fn empty_dir() -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("jitterid-cli-fuzz-empty");
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("jitterid-study-fuzz-empty");
     let _ = std::fs::create_dir_all(&d);
     d
 }

@@ -5,7 +5,7 @@ use super::diagnostics::Source;
 use super::range;
 use super::raw::RawSystem;
 use super::spec::{quoted_list, SystemSpec};
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use jitterid::signal::registry::{roots_json, SignalKind, SignalRegistry, Spec, KIND_KEY};
 use jitterid::signal::{Root, SampleGrid, Sinusoid, TransferFunction, Zpk};
 use serde_json::{json, Value};
@@ -53,7 +53,11 @@ pub(super) fn kinds() -> String {
     quoted_list(&names)
 }
 
-pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<SystemSpec> {
+pub(super) fn parse_system(
+    cx: &Source,
+    r: &RawSystem,
+    grid: &SampleGrid,
+) -> StudyResult<SystemSpec> {
     let kinds = kinds();
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {kinds}"))?;
     let name = kind.get_ref().as_str();
@@ -101,7 +105,7 @@ pub(super) fn parse_system(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> Cli
     Ok(SystemSpec { kind, estimate })
 }
 
-fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
+fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
     let why = "kind = \"zpk\" needs gain, poles and optionally zeros";
     let g = cx.required(S, "gain", &r.gain, why)?;
     let gain = cx.checked(S, "gain", g, range::gain)?;
@@ -137,7 +141,7 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
     ))
 }
 
-fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
+fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
     let why = "kind = \"tf\" needs num and den (highest power first)";
     let n = cx.required(S, "num", &r.num, why)?;
     let d = cx.required(S, "den", &r.den, why)?;
@@ -165,7 +169,7 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
     ))
 }
 
-fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
+fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
     let why = "kind = \"sinusoid\" needs amplitude, frequency and optionally phase";
     let a = cx.required(S, "amplitude", &r.amplitude, why)?;
     let f = cx.required(S, "frequency", &r.frequency, why)?;
@@ -187,7 +191,12 @@ fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> CliResult<Spec> {
 /// `initial` and `delay` written into a rational system's spec table as the signal registry
 /// reads them: a free response from the record's first instant `t0` (started at rest, one
 /// coefficient per pole) and an input delay. A kind without them refused the keys already.
-fn response_keys(cx: &Source, r: &RawSystem, grid: &SampleGrid, mut kind: Spec) -> CliResult<Spec> {
+fn response_keys(
+    cx: &Source,
+    r: &RawSystem,
+    grid: &SampleGrid,
+    mut kind: Spec,
+) -> StudyResult<Spec> {
     if let Some(d) = &r.delay {
         let d = cx.checked(S, "delay", d, |d| range::delay(d, grid))?;
         kind.insert("delay".into(), json!(d));
@@ -241,7 +250,7 @@ fn spec<const N: usize>(kind: &str, keys: [(&str, Value); N]) -> Spec {
     spec
 }
 
-fn parse_roots(cx: &Source, key: &str, v: &Spanned<Vec<toml::Value>>) -> CliResult<Vec<Root>> {
+fn parse_roots(cx: &Source, key: &str, v: &Spanned<Vec<toml::Value>>) -> StudyResult<Vec<Root>> {
     let mut out = Vec::new();
     for (i, e) in v.get_ref().iter().enumerate() {
         let bad = |what: String| {

@@ -1,50 +1,29 @@
-//! `jitterid validate`: fit percent, residual whiteness and input cross-correlation, flatness,
-//! the frequency-response CSV of a fitted model (given as `fit --json` or fitted here), and
-//! its figures.
+//! Validation of a fitted model: fit percent, residual whiteness and input cross-correlation,
+//! flatness of the residual spectrum, on the estimation record and on a validation record; the
+//! frequency and step responses of the fitted system with their bands.
 
-use crate::cli_err;
-use crate::commands::{self, input_side_file, read_data};
 use crate::csvio;
-use crate::error::CliResult;
-use crate::exit::Outcome;
-use crate::experiment::{self, Experiment, InputSpec, Purpose};
+use crate::error::StudyResult;
+use crate::experiment::{Experiment, InputSpec};
 use crate::export;
-use crate::fitting::{self, Structure};
+use crate::fit::{self, Structure};
 use crate::inputs;
-use crate::output::OutputSet;
-use crate::plots::{self, RecordPlot, ValidatePlots};
+use crate::records::{input_side_file, read_data};
+use crate::study_err;
 use crate::whiten;
+use crate::Watch;
 use jitterid::estimate::validation::{self, BodePoint, CorrelationTest, StepPoint};
 use jitterid::estimate::{residual_flatness, NoiseModel};
 use jitterid::signal::{Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Fewest samples of a validation record (enough for lags up to `N/4`).
 pub const MIN_VALIDATION_SAMPLES: usize = 16;
 
-/// Options of `validate`.
-#[derive(Debug, Clone)]
-pub struct ValidateOptions {
-    /// The experiment file.
-    pub experiment: PathBuf,
-    /// The estimation record.
-    pub data: PathBuf,
-    /// A validation record (same `T`, its own input side file).
-    pub validation: Option<PathBuf>,
-    /// A `fit --json` output to validate instead of fitting.
-    pub model: Option<PathBuf>,
-    /// Write the frequency-response CSV here.
-    pub bode: Option<PathBuf>,
-    /// Write the JSON here instead of standard output.
-    pub out: Option<PathBuf>,
-    /// Write the SVG figures into this directory.
-    pub plot: Option<PathBuf>,
-}
-
 /// The checks of one record.
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct RecordReport {
     /// The record's file.
     pub record: String,
@@ -64,15 +43,15 @@ pub struct RecordReport {
     pub initial_state: Option<Vec<f64>>,
 }
 
-/// The JSON of `validate`.
+/// The JSON of `validate`, borrowed from a [`Validation`].
 #[derive(Debug, Serialize)]
-struct ValidateJson {
+pub struct ValidateJson<'a> {
     fit_percent: FitPercent,
-    whiteness: CorrelationTest,
-    cross_correlation: Option<CorrelationTest>,
+    whiteness: &'a CorrelationTest,
+    cross_correlation: Option<&'a CorrelationTest>,
     flatness: Option<f64>,
-    estimation: RecordReport,
-    validation: Option<RecordReport>,
+    estimation: &'a RecordReport,
+    validation: Option<&'a RecordReport>,
 }
 
 #[derive(Debug, Serialize)]
@@ -97,7 +76,7 @@ struct FitParam {
 }
 
 /// The input of a record: the experiment's, or a random-binary realisation's side file.
-fn record_input(exp: &Experiment, data: &Path, grid: &SampleGrid) -> CliResult<Option<Input>> {
+fn record_input(exp: &Experiment, data: &Path, grid: &SampleGrid) -> StudyResult<Option<Input>> {
     Ok(match &exp.input {
         InputSpec::None => None,
         InputSpec::Known(i) => Some(i.clone()),
@@ -114,21 +93,21 @@ fn record_input(exp: &Experiment, data: &Path, grid: &SampleGrid) -> CliResult<O
 /// The fitted structure, its noise level and the covariance of its signal parameters.
 type Model = (Structure, f64, Option<Vec<Vec<f64>>>);
 
-fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> CliResult<Model> {
+fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> StudyResult<Model> {
     let name = path.display();
     csvio::check_regular_file(path, &name.to_string())?;
-    let text = std::fs::read_to_string(path).map_err(|e| cli_err!("{name}: cannot read: {e}"))?;
+    let text = std::fs::read_to_string(path).map_err(|e| study_err!("{name}: cannot read: {e}"))?;
     let f: FitFile = serde_json::from_str(&text)
-        .map_err(|e| cli_err!("{name}: not the JSON of `jitterid fit --json`: {e}"))?;
+        .map_err(|e| study_err!("{name}: not the JSON of `jitterid fit --json`: {e}"))?;
     if exp.jitter.estimate && exp.jitter.n_range.is_some() {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: --model: a profiled jitter (`[jitter] n_range`) is not supported; validate without --model"
         ));
     }
-    let want = fitting::param_names(exp, &s.signal, exp.estimate.method)?;
+    let want = fit::param_names(exp, &s.signal, exp.estimate.method)?;
     let got: Vec<&str> = f.parameters.iter().map(|p| p.name.as_str()).collect();
     if want != got {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: parameters [{}] do not match the experiment's [{}] ({} with method {})",
             got.join(", "),
             want.join(", "),
@@ -137,7 +116,7 @@ fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> CliResult<Mod
         ));
     }
     if let Some(p) = f.parameters.iter().find(|p| !p.estimate.is_finite()) {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: parameter {}: not a finite estimate",
             p.name
         ));
@@ -150,7 +129,7 @@ fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> CliResult<Mod
     let fitted = s
         .with_params(&theta)
         .and_then(|s| s.with_noise_std(f.noise_std))
-        .map_err(|e| cli_err!("{name}: the model's parameters: {e}"))?;
+        .map_err(|e| study_err!("{name}: the model's parameters: {e}"))?;
     Ok((
         fitted,
         f.noise_std,
@@ -179,8 +158,8 @@ fn check_record(
     noise_std: f64,
     input: Option<&Input>,
     name: &str,
-) -> CliResult<(RecordReport, Vec<f64>)> {
-    let e = |e: jitterid::estimate::EstimateError| cli_err!("{name}: validation: {e}");
+) -> StudyResult<(RecordReport, Vec<f64>)> {
+    let e = |e: jitterid::estimate::EstimateError| study_err!("{name}: validation: {e}");
     let cmp = validation::compare(s, grid, y).map_err(e)?;
     let r = validation::standardized_residuals(s, grid, y, noise_std).map_err(e)?;
     let raw: Vec<f64> = y.iter().zip(&cmp.expected).map(|(y, m)| y - m).collect();
@@ -220,7 +199,7 @@ fn tested_residuals(
     raw: &[f64],
     standardized: Vec<f64>,
     name: &str,
-) -> CliResult<Vec<f64>> {
+) -> StudyResult<Vec<f64>> {
     if s.noise.is_white() {
         return Ok(standardized);
     }
@@ -230,7 +209,7 @@ fn tested_residuals(
         s.noise.shape(f, grid.interval()) + floor
     })
     .ok_or_else(|| {
-        cli_err!("{name}: validation: the noise model's spectrum is not positive and finite")
+        study_err!("{name}: validation: the noise model's spectrum is not positive and finite")
     })
 }
 
@@ -244,9 +223,9 @@ fn for_validation_record(
     y: &[f64],
     input: Option<&Input>,
     name: &str,
-) -> CliResult<Structure> {
+) -> StudyResult<Structure> {
     validation::on_record(fitted, grid, y, input)
-        .map_err(|e| cli_err!("{name}: the model on the validation record: {e}"))
+        .map_err(|e| study_err!("{name}: the model on the validation record: {e}"))
 }
 
 /// The free response's coefficients of a signal that has them.
@@ -263,12 +242,12 @@ fn initial_state(signal: &jitterid::signal::AnySignal) -> Option<Vec<f64>> {
 }
 
 /// A validation record: its grid (the experiment's `T`, its own length and start) and samples.
-fn read_validation(exp: &Experiment, path: &Path) -> CliResult<(SampleGrid, Vec<f64>, String)> {
+fn read_validation(exp: &Experiment, path: &Path) -> StudyResult<(SampleGrid, Vec<f64>, String)> {
     let table = csvio::read(path)?;
     let y = table.column("y")?.to_vec();
     let name = table.name.clone();
     if y.len() < MIN_VALIDATION_SAMPLES {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{name}: --validation: {} samples, too short: at least {MIN_VALIDATION_SAMPLES} are needed",
             y.len()
         ));
@@ -278,7 +257,7 @@ fn read_validation(exp: &Experiment, path: &Path) -> CliResult<(SampleGrid, Vec<
         Some(t) => {
             let tv = t[1] - t[0];
             if (tv - interval).abs() > 1e-6 * interval {
-                return Err(cli_err!(
+                return Err(study_err!(
                     "{name}: --validation: column `t` has interval T = {tv}, the experiment's [sampling] interval is {interval}"
                 ));
             }
@@ -286,7 +265,7 @@ fn read_validation(exp: &Experiment, path: &Path) -> CliResult<(SampleGrid, Vec<
         }
         None => exp.grid.time(0),
     };
-    let grid = SampleGrid::new(t0, interval, y.len()).map_err(|e| cli_err!("{name}: {e}"))?;
+    let grid = SampleGrid::new(t0, interval, y.len()).map_err(|e| study_err!("{name}: {e}"))?;
     Ok((grid, y, name))
 }
 
@@ -308,29 +287,29 @@ fn system_covariance(s: &Structure, cov: Option<&[Vec<f64>]>) -> Option<Vec<Vec<
 /// The frequency response on 200 frequencies log-spaced from `1/(NT)` to the Nyquist
 /// frequency `1/(2T)`, with the delay's phase for a delayed system; `None` for a system that
 /// is not rational. `flag` names the option.
-fn frequency_response(
+pub fn frequency_response(
     s: &Structure,
     grid: &SampleGrid,
     cov: Option<&[Vec<f64>]>,
     flag: &str,
-) -> CliResult<Option<Vec<BodePoint>>> {
+) -> StudyResult<Option<Vec<BodePoint>>> {
     let cov = system_covariance(s, cov);
     let freqs = validation::log_spaced(1.0 / grid.duration(), 0.5 / grid.interval(), 200)
-        .map_err(|e| cli_err!("{flag}: {e}"))?;
+        .map_err(|e| study_err!("{flag}: {e}"))?;
     export::bode_of(&s.signal, &freqs, cov.as_deref())
         .transpose()
-        .map_err(|e| cli_err!("{flag}: {e}"))
+        .map_err(|e| study_err!("{flag}: {e}"))
 }
 
 /// The unit-step response on 200 times from the step to 8 time constants of the slowest pole
 /// (where its mode has decayed to e⁻⁸), at most the record's duration, plus the input delay of
 /// a delayed system (its response is zero until then); `None` for a system that is not
 /// rational.
-fn step(
+pub fn step(
     s: &Structure,
     grid: &SampleGrid,
     cov: Option<&[Vec<f64>]>,
-) -> CliResult<Option<Vec<StepPoint>>> {
+) -> StudyResult<Option<Vec<StepPoint>>> {
     let cov = system_covariance(s, cov);
     let slowest = export::tf_of(&s.signal)
         .and_then(|tf| tf.to_zpk().ok())
@@ -348,11 +327,11 @@ fn step(
     let times: Vec<f64> = (0..200).map(|i| horizon * i as f64 / 199.0).collect();
     export::step_of(&s.signal, &times, cov.as_deref())
         .transpose()
-        .map_err(|e| cli_err!("--plot: step response: {e}"))
+        .map_err(|e| study_err!("--plot: step response: {e}"))
 }
 
 /// The frequency-response CSV of `points`.
-fn bode_csv(points: &[BodePoint]) -> String {
+pub fn bode_csv(points: &[BodePoint]) -> String {
     let o = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     let mut out = String::from(
         "f_hz,omega_rad_s,magnitude_db,phase_deg,magnitude_db_lo,magnitude_db_hi,phase_deg_lo,phase_deg_hi\n",
@@ -373,74 +352,81 @@ fn bode_csv(points: &[BodePoint]) -> String {
     out
 }
 
-/// What the figures draw of one record.
-fn record_plot<'a>(
-    role: &'a str,
-    r: &'a RecordReport,
-    grid: &'a SampleGrid,
-    y: &'a [f64],
-    expected: &'a [f64],
-) -> RecordPlot<'a> {
-    RecordPlot {
-        role,
-        name: &r.record,
-        grid,
-        y,
-        expected,
-        fit_percent: r.fit_percent,
-        whiteness: &r.whiteness,
-        cross: r.cross_correlation.as_ref(),
+/// One record as validated: its checks, its grid and samples, and the model's expected
+/// samples `m_k` on it.
+#[derive(Debug, Clone)]
+pub struct ValidatedRecord {
+    /// The checks.
+    pub report: RecordReport,
+    /// The record's grid.
+    pub grid: SampleGrid,
+    /// Its samples.
+    pub y: Vec<f64>,
+    /// The model's expected samples.
+    pub expected: Vec<f64>,
+}
+
+/// A validated model: the fitted structure and the checks of the estimation record and, when
+/// given, of a validation record.
+#[derive(Debug, Clone)]
+pub struct Validation {
+    /// The fitted structure (on the estimation record).
+    pub fitted: Structure,
+    /// Its measurement-noise standard deviation.
+    pub noise_std: f64,
+    /// The covariance of its signal parameters, where known.
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// The estimation record's checks.
+    pub estimation: ValidatedRecord,
+    /// The validation record's checks.
+    pub validation: Option<ValidatedRecord>,
+}
+
+impl Validation {
+    /// The JSON of `jitterid validate`.
+    pub fn json(&self) -> ValidateJson<'_> {
+        let e = &self.estimation.report;
+        let v = self.validation.as_ref().map(|v| &v.report);
+        ValidateJson {
+            fit_percent: FitPercent {
+                estimation: e.fit_percent,
+                validation: v.map(|v| v.fit_percent),
+            },
+            whiteness: &e.whiteness,
+            cross_correlation: e.cross_correlation.as_ref(),
+            flatness: e.flatness,
+            estimation: e,
+            validation: v,
+        }
     }
 }
 
-/// Adds the figures of `--plot DIR` to the outputs (the Bode diagram on the `--bode` CSV's
-/// frequencies; it and the step response only for a rational system).
-fn stage_figures(
-    dir: &Path,
-    outputs: &mut OutputSet,
+/// Validates the experiment's model on the record in `data` and, when given, on the record in
+/// `validation`: the model is read from `model` (a `fit --json` output) or fitted here.
+pub fn validate(
     exp: &Experiment,
-    fitted: &Structure,
-    cov: Option<&[Vec<f64>]>,
-    estimation: RecordPlot<'_>,
-    validation: Option<RecordPlot<'_>>,
-) -> CliResult<()> {
-    let bode = frequency_response(fitted, &exp.grid, cov, "--plot")?;
-    let step = step(fitted, &exp.grid, cov)?;
-    let figs = plots::validate_figures(&ValidatePlots {
-        title: exp.title.clone().unwrap_or_else(|| exp.file.clone()),
-        estimation,
-        validation,
-        bode: bode.as_deref(),
-        step: step.as_deref(),
-    });
-    outputs.dir(dir);
-    for (name, svg) in figs {
-        outputs.file(&dir.join(name), svg);
-    }
-    Ok(())
-}
-
-/// `jitterid validate`: the JSON, printed or written to `--out` with the CSV and the figures,
-/// all at once.
-pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
-    let exp = experiment::read(&o.experiment, Purpose::Estimate(None))?;
-    let table = read_data(&exp, &o.data)?;
+    data: &Path,
+    validation: Option<&Path>,
+    model: Option<&Path>,
+    watch: &Watch,
+) -> StudyResult<Validation> {
+    let table = read_data(exp, data)?;
     let y = table.column("y")?.to_vec();
-    let input = record_input(&exp, &o.data, &exp.grid)?;
-    let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
-    let (fitted, noise_std, cov) = match &o.model {
+    let input = record_input(exp, data, &exp.grid)?;
+    let signal = fit::signal_of(&exp.system.kind, input.as_ref())?;
+    let (fitted, noise_std, covariance) = match model {
         Some(path) => {
-            let s = fitting::structure(&exp, signal, exp.estimate.method)?;
-            model_from_file(&exp, s, path)?
+            let s = fit::structure(exp, signal, exp.estimate.method)?;
+            model_from_file(exp, s, path)?
         }
         None => {
-            let f = commands::fit_values(&exp, signal, y.clone(), &table.name)?;
+            let f = fit::fit_values(exp, signal, y.clone(), &table.name, watch)?;
             let ns = f.fitted.blocks().0;
             let cov = signal_block(f.covariance.as_deref(), ns);
             (f.fitted, f.noise_std, cov)
         }
     };
-    let (estimation, expected) = check_record(
+    let (report, expected) = check_record(
         &fitted,
         &exp.grid,
         &y,
@@ -448,59 +434,33 @@ pub fn validate(o: &ValidateOptions) -> CliResult<Outcome> {
         input.as_ref(),
         &table.name,
     )?;
-    let validation = match &o.validation {
+    let estimation = ValidatedRecord {
+        report,
+        grid: exp.grid,
+        y,
+        expected,
+    };
+    let validation = match validation {
         Some(path) => {
-            let (grid, yv, name) = read_validation(&exp, path)?;
-            let u = record_input(&exp, path, &grid)?;
-            let s = for_validation_record(&fitted, &grid, &yv, u.as_ref(), &name)?;
-            let (mut report, expected) =
-                check_record(&s, &grid, &yv, noise_std, u.as_ref(), &name)?;
+            let (grid, y, name) = read_validation(exp, path)?;
+            let u = record_input(exp, path, &grid)?;
+            let s = for_validation_record(&fitted, &grid, &y, u.as_ref(), &name)?;
+            let (mut report, expected) = check_record(&s, &grid, &y, noise_std, u.as_ref(), &name)?;
             report.initial_state = initial_state(&s.signal);
-            Some((report, expected, grid, yv))
+            Some(ValidatedRecord {
+                report,
+                grid,
+                y,
+                expected,
+            })
         }
         None => None,
     };
-    let mut outputs = OutputSet::new();
-    if let Some(path) = &o.bode {
-        let points = frequency_response(&fitted, &exp.grid, cov.as_deref(), "--bode")?
-            .ok_or_else(|| cli_err!("--bode: the system is not a rational transfer function"))?;
-        outputs.file(path, bode_csv(&points));
-    }
-    if let Some(dir) = &o.plot {
-        let validation = validation
-            .as_ref()
-            .map(|(r, e, g, yv)| record_plot("validation", r, g, yv, e));
-        let estimation = record_plot("estimation", &estimation, &exp.grid, &y, &expected);
-        stage_figures(
-            dir,
-            &mut outputs,
-            &exp,
-            &fitted,
-            cov.as_deref(),
-            estimation,
-            validation,
-        )?;
-    }
-    let validation = validation.map(|v| v.0);
-    let j = ValidateJson {
-        fit_percent: FitPercent {
-            estimation: estimation.fit_percent,
-            validation: validation.as_ref().map(|v| v.fit_percent),
-        },
-        whiteness: estimation.whiteness.clone(),
-        cross_correlation: estimation.cross_correlation.clone(),
-        flatness: estimation.flatness,
+    Ok(Validation {
+        fitted,
+        noise_std,
+        covariance,
         estimation,
         validation,
-    };
-    let text = serde_json::to_string_pretty(&j).map_err(|e| cli_err!("JSON: {e}"))? + "\n";
-    let printed = match &o.out {
-        Some(path) => {
-            outputs.file(path, text);
-            String::new()
-        }
-        None => text,
-    };
-    outputs.commit()?;
-    Ok(Outcome::success(printed))
+    })
 }

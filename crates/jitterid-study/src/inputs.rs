@@ -2,7 +2,7 @@
 //! CSV table (read by the library), and the span on which a random binary input is drawn.
 
 use crate::csvio;
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use jitterid::estimate::csv;
 use jitterid::signal::{PiecewiseConstant, SampleGrid, SignalError};
 
@@ -28,7 +28,7 @@ pub fn piecewise_from_table(
     time_column: &str,
     value_column: &str,
     grid: &SampleGrid,
-) -> CliResult<PiecewiseConstant> {
+) -> StudyResult<PiecewiseConstant> {
     Ok(csv::input_from_table(
         table,
         time_column,

@@ -5,10 +5,10 @@ use super::diagnostics::Source;
 use super::range;
 use super::raw::RawInput;
 use super::spec::{InputSpec, SystemSpec};
-use crate::cli_err;
 use crate::csvio;
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use crate::inputs::{input_span, piecewise, piecewise_from_table};
+use crate::study_err;
 use jitterid::signal::registry::{SignalRegistry, KIND_KEY};
 use jitterid::signal::{Input, Multisine, RandomBinary, SampleGrid, Tone};
 use toml::Spanned;
@@ -27,7 +27,7 @@ pub(super) fn parse_input_section(
     r: Option<&RawInput>,
     system: &SystemSpec,
     grid: &SampleGrid,
-) -> CliResult<(InputSpec, f64)> {
+) -> StudyResult<(InputSpec, f64)> {
     let name = system
         .kind
         .get(KIND_KEY)
@@ -40,7 +40,7 @@ pub(super) fn parse_input_section(
     match (needs_input, r) {
         (false, None) => Ok((InputSpec::None, 0.0)),
         (false, Some(r)) => Err(cx.err_at(S, "kind", r.kind.as_ref(), why)),
-        (true, None) => Err(cli_err!(
+        (true, None) => Err(study_err!(
             "{}: missing section [input]; a {name} system needs an input (kind = {KINDS})",
             cx.file,
         )),
@@ -52,7 +52,12 @@ pub(super) fn parse_input_section(
     }
 }
 
-fn parse_input(cx: &Source, r: &RawInput, grid: &SampleGrid, history: f64) -> CliResult<InputSpec> {
+fn parse_input(
+    cx: &Source,
+    r: &RawInput,
+    grid: &SampleGrid,
+    history: f64,
+) -> StudyResult<InputSpec> {
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
     let name = kind.get_ref().as_str();
     let allowed: &[&str] = match name {
@@ -86,7 +91,7 @@ fn random_binary(
     r: &RawInput,
     grid: &SampleGrid,
     history: f64,
-) -> CliResult<InputSpec> {
+) -> StudyResult<InputSpec> {
     let dwell = cx.required(
         S,
         "mean_dwell",
@@ -114,7 +119,7 @@ fn random_binary(
     Ok(InputSpec::RandomBinary(rb))
 }
 
-fn sine(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
+fn sine(cx: &Source, r: &RawInput, grid: &SampleGrid) -> StudyResult<InputSpec> {
     let f = cx.required(S, "frequency", &r.frequency, "expected the frequency in Hz")?;
     let frequency = cx.checked(S, "frequency", f, |f| range::frequency(f, grid))?;
     if frequency < 0.0 {
@@ -132,7 +137,7 @@ fn sine(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
     Ok(InputSpec::Known(Input::Tones(m)))
 }
 
-fn multisine(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
+fn multisine(cx: &Source, r: &RawInput, grid: &SampleGrid) -> StudyResult<InputSpec> {
     let fs = cx.required(
         S,
         "frequencies",
@@ -184,7 +189,7 @@ fn per_tone(
     v: &Option<Spanned<Vec<f64>>>,
     tones: usize,
     default: f64,
-) -> CliResult<Vec<f64>> {
+) -> StudyResult<Vec<f64>> {
     let Some(v) = v else {
         return Ok(vec![default; tones]);
     };
@@ -203,7 +208,7 @@ fn per_tone(
     Ok(l)
 }
 
-fn piecewise_levels(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
+fn piecewise_levels(cx: &Source, r: &RawInput, grid: &SampleGrid) -> StudyResult<InputSpec> {
     let ts = cx.required(S, "times", &r.times, "expected the switch times in seconds")?;
     let vs = cx.required(
         S,
@@ -217,7 +222,7 @@ fn piecewise_levels(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<I
     Ok(InputSpec::Known(Input::Piecewise(p)))
 }
 
-fn csv_file(cx: &Source, r: &RawInput, grid: &SampleGrid) -> CliResult<InputSpec> {
+fn csv_file(cx: &Source, r: &RawInput, grid: &SampleGrid) -> StudyResult<InputSpec> {
     let p = cx.required(
         S,
         "path",

@@ -1,4 +1,5 @@
-//! `jitterid select`: fit the `[select]` grid of model orders × jitter families and rank them.
+//! Selection: fit the `[select]` grid of model orders × jitter families and rank them; and the
+//! data-driven start of a fit (`init = auto`).
 //!
 //! Candidates are ranked by an information criterion (see `docs/method.md`): the best of each
 //! family by the BIC of its exact maximum-likelihood refit, the others by the BIC of their BCLS
@@ -6,14 +7,11 @@
 //! percent on it is reported beside the criterion, and `best_validation` names the candidate
 //! that fits it best.
 
-use crate::cli_err;
-use crate::commands::{read_data, read_experiment, read_input};
-use crate::error::CliResult;
-use crate::exit::{Outcome, Status};
+use crate::error::StudyResult;
 use crate::experiment::Experiment;
-use crate::experiment::Purpose;
-use crate::fitting;
-use crate::output::OutputSet;
+use crate::fit;
+use crate::records::{read_data, read_input};
+use crate::study_err;
 use jitterid::estimate::selection::{select as run_select, Candidate, SelectionOptions};
 use jitterid::estimate::{initial_model, InitError, InitOptions};
 use jitterid::jitter::registry::JitterRegistry;
@@ -21,26 +19,10 @@ use jitterid::jitter::JitterModel;
 use jitterid::signal::registry::{roots_json, SignalRegistry, Spec};
 use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
-use std::fmt::Write as _;
-use std::path::PathBuf;
-
-/// Options of `select`.
-#[derive(Debug, Clone)]
-pub struct SelectOptions {
-    /// The experiment file (its `[sampling]`, `[input]` and `[select]` are used).
-    pub experiment: PathBuf,
-    /// The estimation record.
-    pub data: PathBuf,
-    /// An optional validation record (same experiment grid; input from its side file).
-    pub validation: Option<PathBuf>,
-    /// Print JSON instead of a table.
-    pub json: bool,
-    /// Write the JSON to this file instead of standard output.
-    pub out: Option<PathBuf>,
-}
+use std::path::Path;
 
 /// Which criterion ranks `c`.
-fn ranked_by(c: &Candidate) -> &'static str {
+pub fn ranked_by(c: &Candidate) -> &'static str {
     if c.ranked_by_likelihood {
         "exact-ml-bic"
     } else {
@@ -48,7 +30,8 @@ fn ranked_by(c: &Candidate) -> &'static str {
     }
 }
 
-fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
+/// The JSON of one candidate, with its fit percent on the validation record.
+pub fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
     let estimates: serde_json::Map<String, Value> = c
         .parameters
         .iter()
@@ -71,50 +54,81 @@ fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
     })
 }
 
-/// `jitterid select`.
-pub fn select(o: &SelectOptions) -> CliResult<Outcome> {
-    let exp = read_experiment(&o.experiment, Purpose::Simulate, None, None)?;
+/// A finished selection: the candidates ranked, best first.
+#[derive(Debug, Clone)]
+pub struct Selection {
+    /// The estimation record's name (its file).
+    pub data: String,
+    /// The candidates, best first.
+    pub ranked: Vec<Candidate>,
+    /// Each candidate's fit percent on the validation record, in the order of `ranked`.
+    pub validation_fits: Vec<Option<f64>>,
+    /// The candidate that fits the validation record best.
+    pub best_validation: Option<usize>,
+}
+
+impl Selection {
+    /// The JSON of `jitterid select --json`.
+    pub fn to_json(&self) -> Value {
+        let candidates: Vec<Value> = self
+            .ranked
+            .iter()
+            .zip(&self.validation_fits)
+            .map(|(c, f)| candidate_json(c, *f))
+            .collect();
+        let mut doc = json!({ "best": candidates.first(), "candidates": candidates });
+        if let Some(i) = self.best_validation {
+            doc["best_validation"] = candidate_json(&self.ranked[i], self.validation_fits[i]);
+        }
+        doc
+    }
+}
+
+/// Selects among the experiment's `[select]` grid on the record in `data` (its input from the
+/// experiment or its side file), with the fit percent of each candidate on the record in
+/// `validation` when given.
+pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> StudyResult<Selection> {
     let grid = exp.select.clone().ok_or_else(|| {
-        cli_err!(
+        study_err!(
             "{}: missing section [select]; expected keys poles = [min, max], zeros = [min, max], families = [...]",
             exp.file
         )
     })?;
-    let table = read_data(&exp, &o.data)?;
-    let input: Input = read_input(&exp, &o.data, None)?.ok_or_else(|| {
-        cli_err!(
+    let table = read_data(exp, data)?;
+    let input: Input = read_input(exp, data, None)?.ok_or_else(|| {
+        study_err!(
             "{}: [input]: selection needs an input to identify a system",
             exp.file
         )
     })?;
-    let record = fitting::record(&exp.grid, table.column("y")?.to_vec())
-        .map_err(|e| cli_err!("{}: {e}", table.name))?;
+    let record = fit::record(&exp.grid, table.column("y")?.to_vec())
+        .map_err(|e| study_err!("{}: {e}", table.name))?;
     // The candidates carry the system's delay (a parameter when the system is estimated,
     // else the input is delayed by it) and, with `initial = "estimate"`, a free response.
     let delay = exp.system.kind.get("delay").and_then(Value::as_f64);
     let known_delay = delay.filter(|_| !exp.system.estimate);
-    let delay_err = |e: String| cli_err!("{}: [system] delay: {e}", exp.file);
+    let delay_err = |e: String| study_err!("{}: [system] delay: {e}", exp.file);
     let input = delayed_input(&input, known_delay).map_err(delay_err)?;
     let options = SelectionOptions {
         delay: delay.filter(|_| exp.system.estimate),
         initial_state: exp.system.kind.contains_key("initial"),
         ..SelectionOptions::default()
     };
-    let validation = match &o.validation {
+    let validation = match validation {
         Some(path) => {
-            let t = read_data(&exp, path)?;
-            let vi = match read_input(&exp, path, None)? {
+            let t = read_data(exp, path)?;
+            let vi = match read_input(exp, path, None)? {
                 Some(vi) => delayed_input(&vi, known_delay).map_err(delay_err)?,
                 None => input.clone(),
             };
-            let r = fitting::record(&exp.grid, t.column("y")?.to_vec())
-                .map_err(|e| cli_err!("{}: {e}", t.name))?;
+            let r = fit::record(&exp.grid, t.column("y")?.to_vec())
+                .map_err(|e| study_err!("{}: {e}", t.name))?;
             Some((r, vi))
         }
         None => None,
     };
     let ranked = run_select(&record, &input, &grid, JitterRegistry::builtin(), &options)
-        .map_err(|e| cli_err!("{}: {e}", exp.file))?;
+        .map_err(|e| study_err!("{}: {e}", exp.file))?;
     let fits: Vec<Option<f64>> = ranked
         .iter()
         .map(|c| {
@@ -123,7 +137,6 @@ pub fn select(o: &SelectOptions) -> CliResult<Outcome> {
                 .and_then(|(r, i)| c.validation_fit(r, i))
         })
         .collect();
-    let status = Status::of_convergence(ranked.first().is_some_and(|c| c.converged), false);
     let best_validation = (0..ranked.len())
         .filter(|&i| fits[i].is_some())
         .max_by(|&a, &b| {
@@ -131,49 +144,12 @@ pub fn select(o: &SelectOptions) -> CliResult<Outcome> {
                 .unwrap_or(f64::NAN)
                 .total_cmp(&fits[b].unwrap_or(f64::NAN))
         });
-    if o.json || o.out.is_some() {
-        let candidates: Vec<Value> = ranked
-            .iter()
-            .zip(&fits)
-            .map(|(c, f)| candidate_json(c, *f))
-            .collect();
-        let mut doc = json!({ "best": candidates.first(), "candidates": candidates });
-        if let Some(i) = best_validation {
-            doc["best_validation"] = candidate_json(&ranked[i], fits[i]);
-        }
-        let text = serde_json::to_string_pretty(&doc).map_err(|e| cli_err!("JSON: {e}"))? + "\n";
-        if let Some(path) = &o.out {
-            let mut outputs = OutputSet::new();
-            outputs.file(path, text);
-            outputs.commit()?;
-            return Ok(Outcome {
-                text: format!("wrote {}\n", path.display()),
-                status,
-            });
-        }
-        return Ok(Outcome { text, status });
-    }
-    let mut out = format!("selection on {} ({})\n", table.name, exp.file);
-    let _ = writeln!(
-        out,
-        "{:>5}  {:>5}  {:<14}  {:>14}  {:<12}  {:>14}  {:>9}  {:>14}",
-        "poles", "zeros", "family", "BIC", "ranked by", "BCLS BIC", "converged", "validation fit"
-    );
-    for (c, f) in ranked.iter().zip(&fits) {
-        let _ = writeln!(
-            out,
-            "{:>5}  {:>5}  {:<14}  {:>14.4}  {:<12}  {:>14.4}  {:>9}  {:>14}",
-            c.poles,
-            c.zeros,
-            c.family,
-            c.criterion,
-            ranked_by(c),
-            c.bcls_criterion,
-            if c.converged { "yes" } else { "no" },
-            f.map_or("–".into(), |v| format!("{v:.2} %"))
-        );
-    }
-    Ok(Outcome { text: out, status })
+    Ok(Selection {
+        data: table.name,
+        ranked,
+        validation_fits: fits,
+        best_validation,
+    })
 }
 
 /// Where `jitterid fit` starts.
@@ -249,27 +225,27 @@ pub fn auto_start(
     input: Option<&Input>,
     y: &[f64],
     data: &str,
-) -> CliResult<AnySignal> {
+) -> StudyResult<AnySignal> {
     let input = input.ok_or_else(|| {
-        cli_err!(
+        study_err!(
             "{}: --init auto fits the system's frequency response to the input's, but the experiment has no [input]",
             exp.file
         )
     })?;
-    let record = fitting::record(&exp.grid, y.to_vec()).map_err(|e| cli_err!("{data}: {e}"))?;
+    let record = fit::record(&exp.grid, y.to_vec()).map_err(|e| study_err!("{data}: {e}"))?;
     let jitter: &dyn JitterModel = &exp.jitter.model;
     let opts = InitOptions::default();
-    let init_err = |e: InitError| cli_err!("{data}: --init auto: the initializer failed: {e}");
+    let init_err = |e: InitError| study_err!("{data}: --init auto: the initializer failed: {e}");
     let mut spec = signal.spec();
     let driven = delayed_input(input, spec.get("delay").and_then(Value::as_f64))
-        .map_err(|e| cli_err!("{}: [system] delay: {e}", exp.file))?;
+        .map_err(|e| study_err!("{}: [system] delay: {e}", exp.file))?;
     match signal.kind() {
         "tf" => {
             let (num, den) = f64s(&spec, "num")
                 .zip(f64s(&spec, "den"))
-                .ok_or_else(|| cli_err!("{}: [system] num, den: not numbers", exp.file))?;
+                .ok_or_else(|| study_err!("{}: [system] num, den: not numbers", exp.file))?;
             let tf = TransferFunction::new(&num, &den)
-                .map_err(|e| cli_err!("{}: [system]: {e}", exp.file))?;
+                .map_err(|e| study_err!("{}: [system]: {e}", exp.file))?;
             let g = initial_model(&tf, &record, &driven, Some(jitter), &opts).map_err(init_err)?;
             spec.insert("num".into(), json!(g.num()));
             spec.insert("den".into(), json!(g.den()));
@@ -277,16 +253,16 @@ pub fn auto_start(
         "zpk" => {
             let (zeros, poles) = roots_of(&spec, "zeros")
                 .zip(roots_of(&spec, "poles"))
-                .ok_or_else(|| cli_err!("{}: [system] zeros, poles: not roots", exp.file))?;
+                .ok_or_else(|| study_err!("{}: [system] zeros, poles: not roots", exp.file))?;
             let zpk =
-                Zpk::new(1.0, zeros, poles).map_err(|e| cli_err!("{}: [system]: {e}", exp.file))?;
+                Zpk::new(1.0, zeros, poles).map_err(|e| study_err!("{}: [system]: {e}", exp.file))?;
             let g = initial_model(&zpk, &record, &driven, Some(jitter), &opts).map_err(init_err)?;
             spec.insert("gain".into(), json!(g.gain()));
             spec.insert("zeros".into(), roots_json(g.zeros()));
             spec.insert("poles".into(), roots_json(g.poles()));
         }
         other => {
-            return Err(cli_err!(
+            return Err(study_err!(
                 "{}: --init auto: the initializer fits rational systems (kind tf or zpk), not `{other}`",
                 exp.file
             ))
@@ -294,5 +270,5 @@ pub fn auto_start(
     }
     SignalRegistry::builtin()
         .build(&spec, Some(input))
-        .map_err(|e| cli_err!("{data}: --init auto: the initializer's model: {e}"))
+        .map_err(|e| study_err!("{data}: --init auto: the initializer's model: {e}"))
 }

@@ -1,4 +1,6 @@
-//! The command line's one error type: a single line of text for the user, exit status 2.
+//! The study layer's one error type: a single line of text for the user that names the file,
+//! the line, the key or the option at fault. The command line prints it as `error: …` and exits
+//! with status 2; Python raises it as `ValueError`.
 
 use std::fmt;
 
@@ -23,13 +25,13 @@ fn capped(message: String) -> String {
     format!("{start} … [{left_out} characters left out] … {end}")
 }
 
-/// An error reported to the user as one line on stderr (`error: …`), with exit status 2.
+/// An error reported to the user as one line (`error: …` on the command line's stderr).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct CliError {
+pub struct StudyError {
     message: String,
 }
 
-impl CliError {
+impl StudyError {
     /// An error with this message (newlines are folded into spaces, so the report is one line,
     /// and a message longer than [`MAX_MESSAGE_CHARS`] is shortened in the middle).
     pub fn new(message: impl Into<String>) -> Self {
@@ -56,22 +58,22 @@ impl CliError {
     }
 }
 
-impl fmt::Display for CliError {
+impl fmt::Display for StudyError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.message)
     }
 }
 
-impl std::error::Error for CliError {}
+impl std::error::Error for StudyError {}
 
-/// Result with a [`CliError`].
-pub type CliResult<T> = Result<T, CliError>;
+/// Result with a [`StudyError`].
+pub type StudyResult<T> = Result<T, StudyError>;
 
-/// Builds a [`CliError`] with `format!` syntax.
+/// Builds a [`StudyError`] with `format!` syntax.
 #[macro_export]
-macro_rules! cli_err {
+macro_rules! study_err {
     ($($arg:tt)*) => {
-        $crate::error::CliError::new(format!($($arg)*))
+        $crate::error::StudyError::new(format!($($arg)*))
     };
 }
 
@@ -82,13 +84,13 @@ mod tests {
     #[test]
     fn long_messages_keep_start_and_end() {
         let long = format!("start {} end", "x".repeat(1_000_000));
-        let e = CliError::new(long);
+        let e = StudyError::new(long);
         let m = e.message();
         assert!(m.chars().count() <= MAX_MESSAGE_CHARS, "{}", m.len());
         assert!(m.starts_with("start xxx"), "{m}");
         assert!(m.ends_with("xxx end"), "{m}");
         assert!(m.contains("characters left out"), "{m}");
-        let short = CliError::new("a\nb");
+        let short = StudyError::new("a\nb");
         assert_eq!(short.message(), "a b");
     }
 }

@@ -2,27 +2,27 @@
 //! ([`jitterid::estimate::csv`], which documents the format); this module turns the library's
 //! typed errors into the command line's one-line messages.
 
-use crate::error::{CliError, CliResult};
+use crate::error::{StudyError, StudyResult};
 pub use jitterid::estimate::csv::{format, io_reason, Column, CsvError, Table, MAX_FILE_BYTES};
 use std::path::Path;
 
-impl From<CsvError> for CliError {
+impl From<CsvError> for StudyError {
     fn from(e: CsvError) -> Self {
-        CliError::new(e.to_string())
+        StudyError::new(e.to_string())
     }
 }
 
 /// Parses CSV text; `name` is used in messages.
-pub fn parse(name: &str, text: &str) -> CliResult<Table> {
+pub fn parse(name: &str, text: &str) -> StudyResult<Table> {
     Ok(jitterid::estimate::csv::parse(name, text)?)
 }
 
 /// Reads and parses a CSV file.
-pub fn read(path: &Path) -> CliResult<Table> {
+pub fn read(path: &Path) -> StudyResult<Table> {
     Ok(jitterid::estimate::csv::read(path)?)
 }
 
 /// Fails unless `path` is a regular file of at most [`MAX_FILE_BYTES`].
-pub fn check_regular_file(path: &Path, name: &str) -> CliResult<()> {
+pub fn check_regular_file(path: &Path, name: &str) -> StudyResult<()> {
     Ok(jitterid::estimate::csv::check_regular_file(path, name)?)
 }

@@ -2,8 +2,8 @@
 //! `file:line: [section] key: what was expected`.
 
 use super::raw::keys_of;
-use crate::cli_err;
-use crate::error::CliError;
+use crate::error::StudyError;
+use crate::study_err;
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -45,8 +45,8 @@ impl<'a> Source<'a> {
         key: &str,
         span: &Range<usize>,
         msg: impl std::fmt::Display,
-    ) -> CliError {
-        cli_err!(
+    ) -> StudyError {
+        study_err!(
             "{}:{}: [{section}] {key}: {msg}",
             self.file,
             line_of(self.text, span.start)
@@ -59,15 +59,15 @@ impl<'a> Source<'a> {
         section: &str,
         key: &str,
         msg: impl std::fmt::Display,
-    ) -> CliError {
+    ) -> StudyError {
         let line = self
             .section_lines
             .iter()
             .find(|(s, _)| *s == section)
             .map(|x| x.1);
         match line {
-            Some(l) => cli_err!("{}:{l}: [{section}] {key}: {msg}", self.file),
-            None => cli_err!("{}: [{section}] {key}: {msg}", self.file),
+            Some(l) => study_err!("{}:{l}: [{section}] {key}: {msg}", self.file),
+            None => study_err!("{}: [{section}] {key}: {msg}", self.file),
         }
     }
 
@@ -78,9 +78,9 @@ impl<'a> Source<'a> {
         key: &str,
         line: Option<usize>,
         msg: impl std::fmt::Display,
-    ) -> CliError {
+    ) -> StudyError {
         match line {
-            Some(l) => cli_err!("{}:{l}: [{section}] {key}: {msg}", self.file),
+            Some(l) => study_err!("{}:{l}: [{section}] {key}: {msg}", self.file),
             None => self.err_section(section, key, msg),
         }
     }
@@ -124,7 +124,7 @@ impl<'a> Source<'a> {
         key: &str,
         value: Option<&toml::Spanned<T>>,
         msg: impl std::fmt::Display,
-    ) -> CliError {
+    ) -> StudyError {
         match value {
             Some(v) => self.err(section, key, &v.span(), msg),
             None => self.err_section(section, key, msg),
@@ -198,7 +198,7 @@ pub(super) fn unknown_key(name: &str, known: &[&str], list: &str) -> String {
 }
 
 /// Turns a TOML/serde error into one located line.
-pub(super) fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> CliError {
+pub(super) fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> StudyError {
     let line = e.span().map(|s| line_of(text, s.start));
     let section = line.and_then(|l| section_at(text, l));
     let mut msg = e.message().trim().to_string();
@@ -232,8 +232,8 @@ pub(super) fn toml_error(file: &str, text: &str, e: &toml::de::Error) -> CliErro
     let section = section.map(|s| format!("[{s}] ")).unwrap_or_default();
     let key = key.map(|k| format!("{k}: ")).unwrap_or_default();
     match line {
-        Some(l) => cli_err!("{file}:{l}: {section}{key}{msg}"),
-        None => cli_err!("{file}: {section}{key}{msg}"),
+        Some(l) => study_err!("{file}:{l}: {section}{key}{msg}"),
+        None => study_err!("{file}: {section}{key}{msg}"),
     }
 }
 
@@ -270,11 +270,11 @@ fn array_header_line(text: &str, section: &str) -> Option<usize> {
 /// of tables (`[[sampling]]`), and a date where a number or a string is expected (a TOML date
 /// reads as a table). `None` when the file has neither, or does not parse as TOML at all (the
 /// typed parse then says why).
-pub(super) fn shape_error(file: &str, text: &str) -> Option<CliError> {
+pub(super) fn shape_error(file: &str, text: &str) -> Option<StudyError> {
     let doc: toml::Table = text.parse().ok()?;
     let at = |line: Option<usize>, msg: String| match line {
-        Some(l) => cli_err!("{file}:{l}: {msg}"),
-        None => cli_err!("{file}: {msg}"),
+        Some(l) => study_err!("{file}:{l}: {msg}"),
+        None => study_err!("{file}: {msg}"),
     };
     for &name in super::raw::SECTIONS.iter().filter(|s| **s != "title") {
         match doc.get(name) {

@@ -3,7 +3,7 @@
 use super::diagnostics::Source;
 use super::range::{MAX_INTERVAL, MIN_INTERVAL};
 use super::raw::RawSampling;
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use jitterid::signal::SampleGrid;
 
 /// Largest number of samples accepted.
@@ -11,7 +11,7 @@ pub const MAX_SAMPLES: i64 = 10_000_000;
 
 const S: &str = "sampling";
 
-pub(super) fn parse_sampling(cx: &Source, r: &RawSampling) -> CliResult<SampleGrid> {
+pub(super) fn parse_sampling(cx: &Source, r: &RawSampling) -> StudyResult<SampleGrid> {
     let interval = cx.required(
         S,
         "interval",

@@ -4,7 +4,7 @@ use super::diagnostics::Source;
 use super::range;
 use super::raw::RawNoise;
 use super::spec::{quoted_list, NoiseSpec};
-use crate::error::CliResult;
+use crate::error::StudyResult;
 use jitterid::estimate::{AnyNoise, ArmaNoise, NoiseRegistry, WhiteNoise};
 
 const S: &str = "noise";
@@ -12,7 +12,7 @@ const S: &str = "noise";
 /// Keys of `[noise]` the command line reads itself, whatever the model.
 const OWN_KEYS: &[&str] = &["std", "model", "estimate"];
 
-pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> CliResult<NoiseSpec> {
+pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> StudyResult<NoiseSpec> {
     let present = r.present();
     let std = match &r.std {
         Some(v) => {

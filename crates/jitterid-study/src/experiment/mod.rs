@@ -28,9 +28,9 @@ pub use spec::{
     SystemSpec,
 };
 
-use crate::cli_err;
 use crate::csvio;
-use crate::error::CliResult;
+use crate::error::StudyResult;
+use crate::study_err;
 use diagnostics::{shape_error, toml_error, Source};
 use jitterid::estimate::{AnyNoise, Frequencies};
 use jitterid::signal::Input;
@@ -47,13 +47,13 @@ pub enum Purpose {
 }
 
 /// Reads and validates an experiment file for `purpose`.
-pub fn read(path: &Path, purpose: Purpose) -> CliResult<Experiment> {
+pub fn read(path: &Path, purpose: Purpose) -> StudyResult<Experiment> {
     let file = path.display().to_string();
     csvio::check_regular_file(path, &file)?;
     let bytes = std::fs::read(path)
-        .map_err(|e| cli_err!("{file}: cannot read: {}", csvio::io_reason(&e)))?;
+        .map_err(|e| study_err!("{file}: cannot read: {}", csvio::io_reason(&e)))?;
     let text = String::from_utf8(bytes).map_err(|e| {
-        cli_err!(
+        study_err!(
             "{file}: not UTF-8 text (invalid byte at offset {}); expected a TOML experiment file",
             e.utf8_error().valid_up_to()
         )
@@ -67,11 +67,11 @@ pub fn read(path: &Path, purpose: Purpose) -> CliResult<Experiment> {
 
 /// Parses and validates experiment text for `purpose`; `file` names it in messages, `dir`
 /// resolves relative paths.
-pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<Experiment> {
+pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> StudyResult<Experiment> {
     // TOML knows LF and CRLF only; a lone CR would be reported as a stray character on line 1.
     let bytes = text.as_bytes();
     if (0..bytes.len()).any(|i| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
-        return Err(cli_err!(
+        return Err(study_err!(
             "{file}: line endings are CR only; expected LF or CRLF line endings (a TOML file)"
         ));
     }
@@ -81,10 +81,10 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> CliResult<
     let raw: RawExperiment = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
     let cx = Source::new(file, text, dir.to_path_buf());
     let r_sampling = raw.sampling.as_ref().ok_or_else(|| {
-        cli_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
+        study_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
     })?;
     let r_system = raw.system.as_ref().ok_or_else(|| {
-        cli_err!(
+        study_err!(
             "{file}: missing section [system]; expected kind = {} and its keys",
             system::kinds()
         )

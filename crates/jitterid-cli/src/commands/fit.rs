@@ -1,0 +1,223 @@
+//! `jitterid fit`: the study layer's fit of one record, printed as a table or JSON, with its
+//! figures.
+
+use super::fmt_num;
+use crate::exit::{Outcome, Status};
+use crate::output::OutputSet;
+use crate::plots;
+use crate::progress::Ticker;
+use jitterid::signal::{AnySignal, Input};
+use jitterid_study::csvio;
+use jitterid_study::error::StudyResult;
+use jitterid_study::experiment::{Experiment, Method, Purpose};
+use jitterid_study::export;
+use jitterid_study::fit::{self, fit_json, fit_values, Fit};
+use jitterid_study::records::{read_data, read_experiment, read_input};
+use jitterid_study::select::{auto_start, InitChoice};
+use jitterid_study::study_err;
+use jitterid_study::Watch;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Options of `fit`.
+#[derive(Debug, Clone)]
+pub struct FitOptions {
+    /// The experiment file.
+    pub experiment: PathBuf,
+    /// The data file.
+    pub data: PathBuf,
+    /// The input file (for a random-binary experiment), default `<data>.input.csv`.
+    pub input: Option<PathBuf>,
+    /// Method override.
+    pub method: Option<Method>,
+    /// JSON output.
+    pub json: bool,
+    /// Plot directory.
+    pub plot: Option<PathBuf>,
+    /// The start: the experiment's values or the data-driven initializer's.
+    pub init: InitChoice,
+    /// Exit 0 even when the fit did not converge.
+    pub accept_unconverged: bool,
+    /// Iteration limit (overrides `[estimate] max_iterations`).
+    pub max_iterations: Option<u64>,
+    /// Wall-clock budget of the fit in seconds.
+    pub time_limit: Option<f64>,
+}
+
+/// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
+/// not converge (unless `accept_unconverged`).
+pub fn fit(o: &FitOptions) -> StudyResult<Outcome> {
+    let exp = read_experiment(
+        &o.experiment,
+        Purpose::Estimate(o.method),
+        o.max_iterations,
+        o.time_limit,
+    )?;
+    let method = exp.estimate.method;
+    let table = read_data(&exp, &o.data)?;
+    let y = table.column("y")?.to_vec();
+    let input = read_input(&exp, &o.data, o.input.as_deref())?;
+    let mut signal = fit::signal_of(&exp.system.kind, input.as_ref())?;
+    if o.init == InitChoice::Auto {
+        signal = auto_start(&exp, &signal, input.as_ref(), &y, &table.name)?;
+    }
+    let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
+    let watch = Watch {
+        iterations: crate::progress::active_fit_hook(),
+        runs: None,
+    };
+    let f = fit_values(&exp, signal.clone(), y.clone(), &table.name, &watch)?;
+    drop(ticker);
+
+    let status = Status::of_convergence(f.converged, o.accept_unconverged);
+    if let Some(dir) = &o.plot {
+        write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &y, &table)?;
+    }
+
+    if o.json {
+        return serde_json::to_string_pretty(&fit_json(&f))
+            .map(|text| Outcome {
+                text: text + "\n",
+                status,
+            })
+            .map_err(|e| study_err!("JSON: {e}"));
+    }
+    let out = fit_text(&exp, &f, &table.name, o.plot.as_deref());
+    Ok(Outcome { text: out, status })
+}
+
+/// The figures of `fit --plot DIR`, written as one set (the naive LS fit beside the method's).
+fn write_fit_figures(
+    dir: &Path,
+    exp: &Experiment,
+    f: &Fit,
+    signal: &AnySignal,
+    input: Option<&Input>,
+    y: &[f64],
+    table: &csvio::Table,
+) -> StudyResult<()> {
+    let method = exp.estimate.method;
+    // The naive LS fit of the system for comparison (when the system is estimated).
+    let ls = if exp.system.estimate && method != Method::LS {
+        let record =
+            fit::record(&exp.grid, y.to_vec()).map_err(|e| study_err!("{}: {e}", table.name))?;
+        let mut ls_exp = exp.clone();
+        ls_exp.jitter.estimate = false;
+        ls_exp.noise.estimate = false;
+        fit::structure(&ls_exp, signal.clone(), Method::LS)
+            .ok()
+            .and_then(|ls_s| {
+                fit::fit(
+                    &ls_exp,
+                    &ls_s,
+                    &record,
+                    Method::LS,
+                    0,
+                    false,
+                    &Watch::none(),
+                )
+                .ok()
+            })
+            .map(|f| f.fitted)
+    } else if method == Method::LS {
+        Some(f.fitted.clone())
+    } else {
+        None
+    };
+    let main_label = if method == Method::LS {
+        "naive LS"
+    } else {
+        method.as_str()
+    };
+    let figs = plots::fit_figures(&plots::FitPlots {
+        exp,
+        y,
+        input,
+        file_model: signal,
+        ls: if method == Method::LS {
+            None
+        } else {
+            ls.as_ref()
+        },
+        main: (main_label, &f.fitted),
+        tau: table.optional("tau"),
+    })?;
+    let mut outputs = OutputSet::new();
+    outputs.dir(dir);
+    for (name, svg) in figs {
+        outputs.file(&dir.join(name), svg);
+    }
+    outputs.commit()?;
+    Ok(())
+}
+
+/// The human-readable report of `fit`.
+fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> String {
+    let method = exp.estimate.method;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "fit of {} with {} ({})",
+        name,
+        method.as_str(),
+        exp.file
+    );
+    let _ = writeln!(
+        out,
+        "{} ({}) after {} iterations, cost {:.6e}, noise std {} ({})",
+        if f.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        f.termination,
+        f.iterations,
+        f.cost,
+        fmt_num(f.noise_std),
+        if exp.noise.estimate {
+            "estimated"
+        } else {
+            "known"
+        }
+    );
+    let w = f
+        .params
+        .iter()
+        .map(|p| p.name.len())
+        .max()
+        .unwrap_or(9)
+        .max(9);
+    let _ = writeln!(
+        out,
+        "{:<w$}  {:>14}  {:>14}",
+        "parameter", "estimate", "std error"
+    );
+    for p in &f.params {
+        let _ = writeln!(
+            out,
+            "{:<w$}  {:>14}  {:>14}",
+            p.name,
+            fmt_num(p.estimate),
+            p.stderr.map_or("–".into(), fmt_num)
+        );
+    }
+    // The exported model of a delayed system is two pieces: say how they combine.
+    if let (Some(d), Some(_)) = (
+        export::delay_of(&f.fitted.signal),
+        export::tf_of(&f.fitted.signal),
+    ) {
+        let _ = writeln!(
+            out,
+            "model: G(s) e^(-sD) with input delay D = {} s (the parameter delay; --json: model.zpk, model.tf, model.ss give G, model.delay gives D)",
+            fmt_num(d)
+        );
+    }
+    if let Some(dir) = plot {
+        let _ = writeln!(
+            out,
+            "figures in {}: bode.svg (rational systems), spectrum.svg, moment.svg, jitter-pdf.svg",
+            dir.display()
+        );
+    }
+    out
+}

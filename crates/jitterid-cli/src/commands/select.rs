@@ -1,0 +1,75 @@
+//! `jitterid select`: the selection of the study layer, printed as a table or JSON.
+//!
+//! Candidates are ranked by an information criterion (see `docs/method.md`): the best of each
+//! family by the BIC of its exact maximum-likelihood refit, the others by the BIC of their BCLS
+//! fit (each candidate's `ranked_by` says which). With a validation record each candidate's fit
+//! percent on it is reported beside the criterion, and `best_validation` names the candidate
+//! that fits it best.
+
+use crate::exit::{Outcome, Status};
+use crate::output::OutputSet;
+use jitterid_study::error::StudyResult;
+use jitterid_study::experiment::Purpose;
+use jitterid_study::records::read_experiment;
+use jitterid_study::select::{ranked_by, select as run_selection};
+use jitterid_study::study_err;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Options of `select`.
+#[derive(Debug, Clone)]
+pub struct SelectOptions {
+    /// The experiment file (its `[sampling]`, `[input]` and `[select]` are used).
+    pub experiment: PathBuf,
+    /// The estimation record.
+    pub data: PathBuf,
+    /// An optional validation record (same experiment grid; input from its side file).
+    pub validation: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    pub json: bool,
+    /// Write the JSON to this file instead of standard output.
+    pub out: Option<PathBuf>,
+}
+
+/// `jitterid select`.
+pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
+    let exp = read_experiment(&o.experiment, Purpose::Simulate, None, None)?;
+    let selection = run_selection(&exp, &o.data, o.validation.as_deref())?;
+    let (ranked, fits) = (&selection.ranked, &selection.validation_fits);
+    let status = Status::of_convergence(ranked.first().is_some_and(|c| c.converged), false);
+    if o.json || o.out.is_some() {
+        let doc = selection.to_json();
+        let text = serde_json::to_string_pretty(&doc).map_err(|e| study_err!("JSON: {e}"))? + "\n";
+        if let Some(path) = &o.out {
+            let mut outputs = OutputSet::new();
+            outputs.file(path, text);
+            outputs.commit()?;
+            return Ok(Outcome {
+                text: format!("wrote {}\n", path.display()),
+                status,
+            });
+        }
+        return Ok(Outcome { text, status });
+    }
+    let mut out = format!("selection on {} ({})\n", selection.data, exp.file);
+    let _ = writeln!(
+        out,
+        "{:>5}  {:>5}  {:<14}  {:>14}  {:<12}  {:>14}  {:>9}  {:>14}",
+        "poles", "zeros", "family", "BIC", "ranked by", "BCLS BIC", "converged", "validation fit"
+    );
+    for (c, f) in ranked.iter().zip(fits) {
+        let _ = writeln!(
+            out,
+            "{:>5}  {:>5}  {:<14}  {:>14.4}  {:<12}  {:>14.4}  {:>9}  {:>14}",
+            c.poles,
+            c.zeros,
+            c.family,
+            c.criterion,
+            ranked_by(c),
+            c.bcls_criterion,
+            if c.converged { "yes" } else { "no" },
+            f.map_or("–".into(), |v| format!("{v:.2} %"))
+        );
+    }
+    Ok(Outcome { text: out, status })
+}

@@ -1,0 +1,85 @@
+//! `jitterid simulate`: one record of the experiment's truth, written as CSV with the input's
+//! side file.
+
+use crate::output::{self, OutputSet};
+use jitterid::signal::Input;
+use jitterid_study::csvio::{self, Column};
+use jitterid_study::error::StudyResult;
+use jitterid_study::experiment::{self, InputSpec, Purpose};
+use jitterid_study::records::input_side_file;
+use jitterid_study::simulate::{simulate_data, SimulatedData};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Options of `simulate`.
+#[derive(Debug, Clone)]
+pub struct SimulateOptions {
+    /// The experiment file.
+    pub experiment: PathBuf,
+    /// Master seed.
+    pub seed: u64,
+    /// Realisation index (the same record as Monte Carlo run `run`).
+    pub run: u64,
+    /// The data file to write.
+    pub out: PathBuf,
+    /// Whether to write the drawn jitter and noise.
+    pub truth: bool,
+}
+
+/// `jitterid simulate`: one record of the experiment's truth. Returns the report line.
+pub fn simulate(o: &SimulateOptions) -> StudyResult<String> {
+    let exp = experiment::read(&o.experiment, Purpose::Simulate)?;
+    let SimulatedData {
+        t,
+        y,
+        u,
+        tau,
+        v,
+        input,
+    } = simulate_data(&exp, o.seed, o.run)?;
+    let n = exp.grid.len();
+    let k: Vec<usize> = (0..n).collect();
+    let mut cols = vec![
+        Column::Index("k", &k),
+        Column::Real("t", &t),
+        Column::Real("y", &y),
+    ];
+    if let Some(u) = &u {
+        cols.push(Column::Real("u", u));
+    }
+    if o.truth {
+        cols.push(Column::Real("tau", &tau));
+        cols.push(Column::Real("v", &v));
+    }
+    let mut outputs = OutputSet::new();
+    outputs.file(&o.out, csvio::format(&cols));
+    let mut report = format!(
+        "wrote {}: {n} samples ({})",
+        o.out.display(),
+        cols.iter()
+            .map(|c| match c {
+                Column::Index(n, _) | Column::Real(n, _) => *n,
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if let (InputSpec::RandomBinary(_), Some(Input::Piecewise(p))) = (&exp.input, &input) {
+        if output::writes_through(&o.out) {
+            report.push_str(
+                "; the input realisation is not written (a device or FIFO has no side file)",
+            );
+        } else {
+            let side = input_side_file(&o.out);
+            let edges = p.edges();
+            outputs.file(&side, jitterid::estimate::csv::input_to_csv(p));
+            let _ = write!(
+                report,
+                "; {}: the input's {} switch times and levels",
+                side.display(),
+                edges.len()
+            );
+        }
+    }
+    outputs.commit()?;
+    Ok(report)
+}

@@ -1,0 +1,42 @@
+//! The **jitterid** study layer: everything between an experiment file and a report that is not
+//! about parsing arguments or printing. Every front end (the `jitterid` command line, the
+//! Python package, `cargo xtask`) stands on this crate, so that a Rust program embedding
+//! jitterid gets exactly what `jitterid fit`, `montecarlo`, `merge`, `select` and `validate`
+//! compute.
+//!
+//! - [`experiment`]: experiment files (TOML), read once and validated once into an
+//!   [`Experiment`](experiment::Experiment); every error names the file, the line and the key.
+//! - [`records`]: measured records (the plain numeric CSV files) checked against an
+//!   experiment's grid, and their inputs.
+//! - [`fit`]: the fit an experiment asks for — the model structure, the solver, profiling an
+//!   integer jitter parameter, the jitter floor of a Box–Jenkins noise model, the likelihood
+//!   branch — and the parameters as reported (names, estimates, standard errors, covariance).
+//! - [`simulate`]: records of an experiment's truth, realisation by realisation.
+//! - [`montecarlo`]: studies of many realisations, bit-identical across thread counts and
+//!   shards; [`merge`] combines shards, which carry the experiment's [`fingerprint`].
+//! - [`select`]: order and jitter-family selection and the data-driven start (`init = auto`).
+//! - [`validate`]: fit percent, residual tests, flatness, frequency and step responses.
+//! - [`export`]: a fitted system as zpk, tf and state space, with its Bode and step responses.
+//!
+//! Errors are one type, [`StudyError`]: one line of text that names what is wrong. Long work
+//! reports progress through [`Watch`] hooks that a front end draws as it likes.
+#![warn(missing_docs)]
+
+pub mod csvio;
+pub mod error;
+pub mod experiment;
+pub mod export;
+pub mod fingerprint;
+pub mod fit;
+pub mod inputs;
+pub mod merge;
+pub mod montecarlo;
+pub mod records;
+pub mod select;
+pub mod simulate;
+pub mod validate;
+mod watch;
+pub mod whiten;
+
+pub use error::{StudyError, StudyResult};
+pub use watch::{RunsDone, Watch};

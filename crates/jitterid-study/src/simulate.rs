@@ -1,0 +1,159 @@
+//! Records of an experiment's truth: the input of one realisation, the jittered samples and
+//! the coloured measurement noise, exactly as `jitterid simulate` writes them and as every
+//! Monte Carlo realisation draws them.
+
+use crate::error::StudyResult;
+use crate::experiment::{Experiment, InputSpec};
+use crate::fit::signal_of;
+use crate::inputs::input_span;
+use crate::study_err;
+use jitterid::estimate::montecarlo::realization_rng;
+use jitterid::estimate::NoiseModel;
+use jitterid::rand::rngs::StdRng;
+use jitterid::signal::{simulate, AnySignal, Input};
+
+/// The true input of one realisation: a random binary input is drawn from `rng` (from
+/// `history` seconds before `t0`), others are fixed.
+pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> StudyResult<Option<Input>> {
+    Ok(match &exp.input {
+        InputSpec::None => None,
+        InputSpec::Known(i) => Some(i.clone()),
+        InputSpec::RandomBinary(rb) => {
+            let (a, b) = input_span(&exp.grid);
+            Some(Input::Piecewise(
+                rb.generate(a - exp.history, b, rng)
+                    .map_err(|e| study_err!("{}: [input] random-binary: {e}", exp.file))?,
+            ))
+        }
+    })
+}
+
+/// The input as a fit sees it: the true input from the record's first instant `t0` on (what
+/// `simulate` writes beside the record), as a measurement of it would.
+pub fn seen_input(exp: &Experiment, truth: Option<&Input>) -> StudyResult<Option<Input>> {
+    Ok(match truth {
+        Some(Input::Piecewise(p)) if exp.history > 0.0 => Some(Input::Piecewise(
+            crate::inputs::from_start(p, exp.grid.start())
+                .map_err(|e| study_err!("{}: [input] history: {e}", exp.file))?,
+        )),
+        other => other.cloned(),
+    })
+}
+
+/// One simulated record: `y`, and the drawn `τ` and `v`.
+pub struct Simulated {
+    /// Samples.
+    pub y: Vec<f64>,
+    /// Jitter of each sample.
+    pub tau: Vec<f64>,
+    /// Measurement noise of each sample (after the noise filter).
+    pub v: Vec<f64>,
+}
+
+/// Simulates the experiment's truth with `signal`; coloured noise is white noise filtered by
+/// the `[noise]` model with zero initial conditions.
+pub fn simulate_record(
+    exp: &Experiment,
+    signal: &AnySignal,
+    rng: &mut StdRng,
+) -> StudyResult<Simulated> {
+    let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
+        .map_err(|e| study_err!("{}: simulation: {e}", exp.file))?;
+    let shape = &exp.noise.shape;
+    let v = if shape.is_white() {
+        sim.noise.clone()
+    } else {
+        // The ARMA model's parameters are `c1…` then `d1…`.
+        let p = shape.params();
+        let nc = shape
+            .param_names()
+            .iter()
+            .filter(|n| n.starts_with('c'))
+            .count();
+        arma_filter(&p[..nc], &p[nc..], &sim.noise)
+    };
+    let y = sim
+        .y
+        .iter()
+        .zip(&sim.noise)
+        .zip(&v)
+        .map(|((y, e), v)| y - e + v)
+        .collect::<Vec<f64>>();
+    // The door refuses values outside the representable range; this catches a combination of
+    // values inside it that still overflows, rather than writing NaN samples.
+    if let Some(k) = y.iter().position(|x| !x.is_finite()) {
+        return Err(study_err!(
+            "{}: sample {k} of the simulated record is {}: the experiment's values are beyond what double precision can simulate",
+            exp.file,
+            y[k]
+        ));
+    }
+    Ok(Simulated { y, tau: sim.tau, v })
+}
+
+/// `v = (C(q)/D(q)) e` with `C = 1 + c_1 q^{-1} + …`, `D = 1 + d_1 q^{-1} + …`, at rest before.
+pub fn arma_filter(c: &[f64], d: &[f64], e: &[f64]) -> Vec<f64> {
+    let mut v: Vec<f64> = Vec::with_capacity(e.len());
+    for k in 0..e.len() {
+        let mut x = e[k];
+        for (i, ci) in c.iter().enumerate() {
+            if k > i {
+                x += ci * e[k - i - 1];
+            }
+        }
+        for (i, di) in d.iter().enumerate() {
+            if k > i {
+                x -= di * v[k - i - 1];
+            }
+        }
+        v.push(x);
+    }
+    v
+}
+
+/// One simulated record of an experiment, as values (what `jitterid simulate` writes).
+#[derive(Debug, Clone)]
+pub struct SimulatedData {
+    /// Requested sampling times `t_k = t0 + kT`.
+    pub t: Vec<f64>,
+    /// Samples.
+    pub y: Vec<f64>,
+    /// The input at `t_k`, when the experiment has one.
+    pub u: Option<Vec<f64>>,
+    /// Jitter of each sample.
+    pub tau: Vec<f64>,
+    /// Measurement noise of each sample.
+    pub v: Vec<f64>,
+    /// The input realisation (a random binary input's switch times and levels among others).
+    pub input: Option<Input>,
+}
+
+/// Realisation `run` of the experiment's truth under master seed `seed`: the record of Monte
+/// Carlo run `run`.
+pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> StudyResult<SimulatedData> {
+    let mut rng = realization_rng(seed, run);
+    let truth = realize_input(exp, &mut rng)?;
+    let signal = signal_of(&exp.system.kind, truth.as_ref())?;
+    let sim = simulate_record(exp, &signal, &mut rng)?;
+    // What a measurement records, and what the side file holds: the input from t0 on.
+    let input = seen_input(exp, truth.as_ref())?;
+    if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
+        return Err(study_err!(
+            "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
+            exp.file,
+            sim.y[k]
+        ));
+    }
+    let t: Vec<f64> = exp.grid.times().collect();
+    let u = input
+        .as_ref()
+        .map(|i| t.iter().map(|&t| i.value(t)).collect());
+    Ok(SimulatedData {
+        t,
+        y: sim.y,
+        u,
+        tau: sim.tau,
+        v: sim.v,
+        input,
+    })
+}
