@@ -236,7 +236,7 @@ impl Experiment {
             }
         };
         let fit = py.detach(|| {
-            let signal = fitting::signal_of(&exp.system.kind, input.as_ref())?;
+            let signal = fitting::signal_of(&exp, input.as_ref())?;
             fitting::fit_values(&exp, signal, y, "y", &jitterid_study::Watch::none())
         });
         fit.map(|fit| Fit { fit }).map_err(value_error)

@@ -324,7 +324,7 @@ fn the_same_experiment_by_two_paths_merges() {
     assert_eq!(merged["terminations"], whole["terminations"]);
     assert_eq!(merged["fingerprint"], whole["fingerprint"]);
     let shard0 = read_json(&s0);
-    assert_eq!(shard0["fingerprint"].as_str().unwrap().len(), 16);
+    assert_eq!(shard0["fingerprint"].as_str().unwrap().len(), 64);
     assert!(shard0["program"].as_str().unwrap().starts_with("jitterid "));
 }
 

@@ -1,16 +1,20 @@
 //! The identity of an experiment by content: a fingerprint of every parsed value, so that the
 //! same experiment under two paths is one study and an edited file is another.
+//!
+//! The fingerprint decides whether shard files may be merged into one study, so it is a
+//! cryptographic digest (SHA-256): two different experiments cannot be made to collide, by
+//! accident or on purpose, as they could under a 64-bit hash.
 
 use crate::experiment::Experiment;
+use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
-use std::hash::Hasher;
 
-/// The fingerprint of `exp`: a 64-bit FNV-1a hash (16 hexadecimal digits) of the canonical text
+/// The fingerprint of `exp`: the SHA-256 digest (64 hexadecimal digits) of the canonical text
 /// of every parsed value (sampling, input, system, jitter, noise, estimate and title). Numbers
 /// enter with their shortest round-trip text, so two values give the same fingerprint only if
 /// they are equal; the file's name, comments, layout and key order do not enter.
 pub fn experiment_fingerprint(exp: &Experiment) -> String {
-    let mut h = HashWriter(fnv::FnvHasher::default());
+    let mut h = HashWriter(Sha256::new());
     // Writing into a hasher cannot fail.
     let _ = write!(
         h,
@@ -21,16 +25,20 @@ pub fn experiment_fingerprint(exp: &Experiment) -> String {
     if exp.history != 0.0 {
         let _ = write!(h, "\nhistory={:?}", exp.history);
     }
-    format!("{:016x}", h.0.finish())
+    let mut hex = String::with_capacity(64);
+    for byte in h.0.finalize() {
+        let _ = write!(hex, "{byte:02x}");
+    }
+    hex
 }
 
-/// Feeds formatted text straight into the hash, so that a long measured input is hashed
+/// Feeds formatted text straight into the digest, so that a long measured input is hashed
 /// without first being written out as one string.
-struct HashWriter(fnv::FnvHasher);
+struct HashWriter(Sha256);
 
 impl std::fmt::Write for HashWriter {
     fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        self.0.write(s.as_bytes());
+        self.0.update(s.as_bytes());
         Ok(())
     }
 }
@@ -60,6 +68,22 @@ std = 0.01
 
     fn fp(text: &str) -> String {
         experiment_fingerprint(&parse("e.toml", text, Path::new("."), Purpose::Simulate).unwrap())
+    }
+
+    /// The digest is SHA-256 of the canonical text: checked against an independent
+    /// implementation's digest of a known message (FIPS 180-2, appendix B.1).
+    #[test]
+    fn the_digest_is_sha256() {
+        let mut h = HashWriter(Sha256::new());
+        // In two writes, as the fingerprint feeds its fields.
+        let middle = 'b';
+        let _ = write!(h, "a{middle}");
+        let _ = write!(h, "c");
+        let hex: String = h.0.finalize().iter().map(|b| format!("{b:02x}")).collect();
+        assert_eq!(
+            hex,
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
     }
 
     #[test]
@@ -101,6 +125,7 @@ std = 0.01
             "samples = 64\ninterval = 1.0",
         );
         assert_eq!(fp(&reordered), base);
-        assert_eq!(base.len(), 16);
+        assert_eq!(base.len(), 64);
+        assert!(base.bytes().all(|b| b.is_ascii_hexdigit()));
     }
 }

@@ -5,7 +5,7 @@ use crate::experiment::{name_table, Experiment, Method};
 use crate::export::{self, reported_covariance, CovarianceSource};
 use crate::study_err;
 use crate::Watch;
-use jitterid::estimate::solver::{AnySolver, SolverRegistry};
+use jitterid::estimate::solver::AnySolver;
 use jitterid::estimate::{
     AnyCriterion, AnyNoise, EstimateError, Fit as Estimate, FitOptions, ModelStructure, NoiseModel,
     Record,
@@ -14,7 +14,7 @@ use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::Rng;
-use jitterid::signal::registry::{SignalRegistry, Spec, KIND_KEY};
+use jitterid::signal::registry::KIND_KEY;
 use jitterid::signal::{AnySignal, Input, SampleGrid, Signal};
 use serde::Serialize;
 use serde_json::Map;
@@ -32,10 +32,11 @@ fn uniform_sum_with_std(sigma: f64) -> impl Fn(i64) -> Result<AnyJitter, JitterE
 /// The model structure of the command line.
 pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
 
-/// The signal of a system's spec table driven by `input` (a kind that needs one, such as a
-/// rational system, fails without it), built through the signal registry.
-pub fn signal_of(spec: &Spec, input: Option<&Input>) -> StudyResult<AnySignal> {
-    let registry = SignalRegistry::builtin();
+/// The signal of the experiment's system driven by `input` (a kind that needs one, such as a
+/// rational system, fails without it), built through the experiment's signal registry.
+pub fn signal_of(exp: &Experiment, input: Option<&Input>) -> StudyResult<AnySignal> {
+    let registry = &exp.registries.signal;
+    let spec = &exp.system.kind;
     let needs_input = spec
         .get(KIND_KEY)
         .and_then(|k| k.as_str())
@@ -52,7 +53,7 @@ pub fn signal_of(spec: &Spec, input: Option<&Input>) -> StudyResult<AnySignal> {
 /// The model structure for `signal` as the experiment says (free parts, noise, method).
 pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> StudyResult<Structure> {
     let shape_free = exp.noise.estimate
-        && (method.as_str() == "bj" || method.is_likelihood())
+        && (method.as_str() == "bj" || method.is_likelihood_in(&exp.registries.criteria))
         && !exp.noise.shape.is_white();
     let s = ModelStructure::bj(signal, exp.jitter.model.clone(), exp.noise.shape.clone())
         .with_estimated(exp.system.estimate, exp.jitter.estimate, shape_free);
@@ -71,7 +72,7 @@ pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> StudyRe
 /// the solver itself.
 pub fn solver(exp: &Experiment, seed: u64, watch: &Watch) -> StudyResult<AnySolver> {
     let e = &exp.estimate;
-    let registry = SolverRegistry::builtin();
+    let registry = &exp.registries.solvers;
     let mut table = name_table(registry.key(), e.solver.as_str());
     let takes = |key: &str| {
         registry
@@ -331,7 +332,7 @@ pub fn fit(
                 n,
             })
         };
-    let criterion = method.criterion();
+    let criterion = method.criterion_in(&exp.registries.criteria);
     let e = if criterion.is_likelihood() {
         fit_ml(exp, s, record, method, covariance, watch)?
     } else {

@@ -32,6 +32,7 @@ pub mod inputs;
 pub mod merge;
 pub mod montecarlo;
 pub mod records;
+mod registries;
 pub mod select;
 pub mod simulate;
 pub mod validate;
@@ -39,4 +40,5 @@ mod watch;
 pub mod whiten;
 
 pub use error::{StudyError, StudyResult};
+pub use registries::Registries;
 pub use watch::{RunsDone, Watch};

@@ -225,11 +225,11 @@ fn one_run(
     let mut go = || -> Result<Fit, String> {
         let text = |e: StudyError| e.to_string();
         let truth = realize_input(exp, rng).map_err(text)?;
-        let signal = fit::signal_of(&exp.system.kind, truth.as_ref()).map_err(text)?;
+        let signal = fit::signal_of(exp, truth.as_ref()).map_err(text)?;
         let sim = simulate_record(exp, &signal, rng).map_err(text)?;
         // The model sees the input from t0 on only, as a fit of measured data would.
         let seen = seen_input(exp, truth.as_ref()).map_err(text)?;
-        let model = fit::signal_of(&exp.system.kind, seen.as_ref()).map_err(text)?;
+        let model = fit::signal_of(exp, seen.as_ref()).map_err(text)?;
         let s = fit::structure(exp, model, method).map_err(text)?;
         let start = fit::perturb(&s.params(), exp.estimate.perturb, rng);
         let s0 = s.with_params(&start).map_err(|e| e.to_string())?;
@@ -306,7 +306,7 @@ pub fn run_study(
     let mut rng0 = realization_rng(seed, 0);
     let truth0 = realize_input(exp, &mut rng0)?;
     let input0 = seen_input(exp, truth0.as_ref())?;
-    let signal0 = fit::signal_of(&exp.system.kind, input0.as_ref())?;
+    let signal0 = fit::signal_of(exp, input0.as_ref())?;
     let names = fit::param_names(exp, &signal0, method)?;
     let truth = fit::truth_values(exp, &signal0, method)?;
     let part = shard.unwrap_or(Shard::WHOLE);

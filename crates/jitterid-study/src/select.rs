@@ -14,9 +14,8 @@ use crate::records::{read_data, read_input};
 use crate::study_err;
 use jitterid::estimate::selection::{select as run_select, Candidate, SelectionOptions};
 use jitterid::estimate::{initial_model, InitError, InitOptions};
-use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::JitterModel;
-use jitterid::signal::registry::{roots_json, SignalRegistry, Spec};
+use jitterid::signal::registry::{roots_json, Spec};
 use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -127,7 +126,7 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
         }
         None => None,
     };
-    let ranked = run_select(&record, &input, &grid, JitterRegistry::builtin(), &options)
+    let ranked = run_select(&record, &input, &grid, &exp.registries.jitter, &options)
         .map_err(|e| study_err!("{}: {e}", exp.file))?;
     let fits: Vec<Option<f64>> = ranked
         .iter()
@@ -268,7 +267,8 @@ pub fn auto_start(
             ))
         }
     }
-    SignalRegistry::builtin()
+    exp.registries
+        .signal
         .build(&spec, Some(input))
         .map_err(|e| study_err!("{data}: --init auto: the initializer's model: {e}"))
 }

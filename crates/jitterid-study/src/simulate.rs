@@ -133,7 +133,7 @@ pub struct SimulatedData {
 pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> StudyResult<SimulatedData> {
     let mut rng = realization_rng(seed, run);
     let truth = realize_input(exp, &mut rng)?;
-    let signal = signal_of(&exp.system.kind, truth.as_ref())?;
+    let signal = signal_of(exp, truth.as_ref())?;
     let sim = simulate_record(exp, &signal, &mut rng)?;
     // What a measurement records, and what the side file holds: the input from t0 on.
     let input = seen_input(exp, truth.as_ref())?;

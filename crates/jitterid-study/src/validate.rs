@@ -413,7 +413,7 @@ pub fn validate(
     let table = read_data(exp, data)?;
     let y = table.column("y")?.to_vec();
     let input = record_input(exp, data, &exp.grid)?;
-    let signal = fit::signal_of(&exp.system.kind, input.as_ref())?;
+    let signal = fit::signal_of(exp, input.as_ref())?;
     let (fitted, noise_std, covariance) = match model {
         Some(path) => {
             let s = fit::structure(exp, signal, exp.estimate.method)?;

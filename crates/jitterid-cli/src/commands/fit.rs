@@ -57,7 +57,7 @@ pub fn fit(o: &FitOptions) -> StudyResult<Outcome> {
     let table = read_data(&exp, &o.data)?;
     let y = table.column("y")?.to_vec();
     let input = read_input(&exp, &o.data, o.input.as_deref())?;
-    let mut signal = fit::signal_of(&exp.system.kind, input.as_ref())?;
+    let mut signal = fit::signal_of(&exp, input.as_ref())?;
     if o.init == InitChoice::Auto {
         signal = auto_start(&exp, &signal, input.as_ref(), &y, &table.name)?;
     }

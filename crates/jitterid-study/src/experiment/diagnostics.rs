@@ -4,6 +4,7 @@
 use super::raw::keys_of;
 use crate::error::StudyError;
 use crate::study_err;
+use crate::Registries;
 use std::ops::Range;
 use std::path::PathBuf;
 
@@ -15,11 +16,18 @@ pub(super) struct Source<'a> {
     pub(super) dir: PathBuf,
     /// Line of every section header given.
     section_lines: Vec<(&'static str, usize)>,
+    /// The registries every name in the file is looked up in.
+    pub(super) registries: &'a Registries,
 }
 
 impl<'a> Source<'a> {
     /// The text of `file`, with its section headers located.
-    pub(super) fn new(file: &'a str, text: &'a str, dir: PathBuf) -> Self {
+    pub(super) fn new(
+        file: &'a str,
+        text: &'a str,
+        dir: PathBuf,
+        registries: &'a Registries,
+    ) -> Self {
         let mut section_lines = Vec::new();
         for (i, l) in text.lines().enumerate() {
             let l = l.trim();
@@ -35,6 +43,7 @@ impl<'a> Source<'a> {
             text,
             dir,
             section_lines,
+            registries,
         }
     }
 

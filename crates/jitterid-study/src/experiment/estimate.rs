@@ -18,7 +18,7 @@ pub(super) fn parse_estimate(
 ) -> StudyResult<EstimateSpec> {
     let method = match &r.method {
         None => Method::BCLS,
-        Some(m) => Method::parse(m.get_ref()).ok_or_else(|| {
+        Some(m) => Method::parse_in(&cx.registries.criteria, m.get_ref()).ok_or_else(|| {
             cx.err(
                 S,
                 "method",
@@ -26,7 +26,7 @@ pub(super) fn parse_estimate(
                 format!(
                     "unknown method \"{}\"; expected {}",
                     m.get_ref(),
-                    Method::names()
+                    Method::names_in(&cx.registries.criteria)
                 ),
             )
         })?,
@@ -73,7 +73,7 @@ pub(super) fn parse_estimate(
 }
 
 fn parse_solver(cx: &Source, s: &Spanned<String>) -> StudyResult<SolverName> {
-    SolverName::parse(s.get_ref()).ok_or_else(|| {
+    SolverName::parse_in(&cx.registries.solvers, s.get_ref()).ok_or_else(|| {
         cx.err(
             S,
             "solver",

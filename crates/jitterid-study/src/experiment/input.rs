@@ -9,7 +9,7 @@ use crate::csvio;
 use crate::error::StudyResult;
 use crate::inputs::{input_span, piecewise, piecewise_from_table};
 use crate::study_err;
-use jitterid::signal::registry::{SignalRegistry, KIND_KEY};
+use jitterid::signal::registry::KIND_KEY;
 use jitterid::signal::{Input, Multisine, RandomBinary, SampleGrid, Tone};
 use toml::Spanned;
 
@@ -33,7 +33,9 @@ pub(super) fn parse_input_section(
         .get(KIND_KEY)
         .and_then(|k| k.as_str())
         .unwrap_or("");
-    let needs_input = SignalRegistry::builtin()
+    let needs_input = cx
+        .registries
+        .signal
         .kind(name)
         .is_some_and(|k| k.needs_input());
     let why = format!("a {name} system has no input; remove the [input] section");

@@ -11,7 +11,7 @@ use super::range;
 use super::raw::RawTable;
 use super::spec::JitterSpec;
 use crate::error::{StudyError, StudyResult};
-use jitterid::jitter::registry::{Family, JitterRegistry, Spec, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
+use jitterid::jitter::registry::{Family, Spec, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, NoJitter, UniformSum};
 use jitterid::signal::SampleGrid;
 use serde_json::Value;
@@ -26,7 +26,7 @@ pub(super) fn parse_jitter(
     r: &RawTable,
     grid: &SampleGrid,
 ) -> StudyResult<JitterSpec> {
-    let registry = JitterRegistry::builtin();
+    let registry = &cx.registries.jitter;
     let fam = r.get(FAMILY_KEY).ok_or_else(|| {
         cx.err_section(
             S,
@@ -106,7 +106,7 @@ fn check_keys(cx: &Source, r: &RawTable, entry: &Family) -> StudyResult<()> {
     let Some((key, v)) = r.iter().find(|(k, _)| !allowed.contains(&k.as_str())) else {
         return Ok(());
     };
-    let registry = JitterRegistry::builtin();
+    let registry = &cx.registries.jitter;
     let of_another = registry
         .families()
         .any(|f| f.keys().contains(&key.as_str()));
@@ -145,7 +145,7 @@ fn check_ranges(
     path: &str,
     grid: &SampleGrid,
 ) -> StudyResult<()> {
-    let registry = JitterRegistry::builtin();
+    let registry = &cx.registries.jitter;
     let entry = spec
         .get(FAMILY_KEY)
         .and_then(Value::as_str)
@@ -210,7 +210,7 @@ fn fitted_family(
     truth: &AnyJitter,
     spec: &Spec,
 ) -> StudyResult<AnyJitter> {
-    let registry = JitterRegistry::builtin();
+    let registry = &cx.registries.jitter;
     let name = cx.string_value(S, "fit_family", ff)?;
     let fail = |m: String| -> StudyError { cx.err(S, "fit_family", &ff.span(), m) };
     let entry = registry.family(name).ok_or_else(|| {

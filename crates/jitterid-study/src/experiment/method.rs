@@ -33,7 +33,7 @@ pub(super) fn check_method(
     };
     let flag = raw.system.as_ref().and_then(|s| s.estimate.as_ref());
     let at_system = |msg: &str| cx.err_at("system", "estimate", flag, msg);
-    if method.is_likelihood() && !cfg!(feature = "ml") {
+    if method.is_likelihood_in(&cx.registries.criteria) && !cfg!(feature = "ml") {
         return Err(blame(
             "maximum likelihood is not available in this build of jitterid (built without the `ml` feature); use \"bcls\" (or \"ls\", \"bj\")",
         ));

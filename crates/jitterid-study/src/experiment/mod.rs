@@ -31,11 +31,13 @@ pub use spec::{
 use crate::csvio;
 use crate::error::StudyResult;
 use crate::study_err;
+use crate::Registries;
 use diagnostics::{shape_error, toml_error, Source};
 use jitterid::estimate::{AnyNoise, Frequencies};
 use jitterid::signal::Input;
 use raw::RawExperiment;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// What the experiment is read for: what it must be fit for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,9 +67,22 @@ pub fn read(path: &Path, purpose: Purpose) -> StudyResult<Experiment> {
     parse(&file, &text, &dir, purpose)
 }
 
-/// Parses and validates experiment text for `purpose`; `file` names it in messages, `dir`
-/// resolves relative paths.
+/// Parses and validates experiment text for `purpose` with the built-in registries; `file`
+/// names it in messages, `dir` resolves relative paths.
 pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> StudyResult<Experiment> {
+    parse_with(&Registries::builtin(), file, text, dir, purpose)
+}
+
+/// Parses and validates experiment text for `purpose`, looking every name up in `registries`
+/// (which the experiment keeps to build its models); `file` names it in messages, `dir`
+/// resolves relative paths.
+pub fn parse_with(
+    registries: &Arc<Registries>,
+    file: &str,
+    text: &str,
+    dir: &Path,
+    purpose: Purpose,
+) -> StudyResult<Experiment> {
     // TOML knows LF and CRLF only; a lone CR would be reported as a stray character on line 1.
     let bytes = text.as_bytes();
     if (0..bytes.len()).any(|i| bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
@@ -79,14 +94,14 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> StudyResul
         return Err(e);
     }
     let raw: RawExperiment = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
-    let cx = Source::new(file, text, dir.to_path_buf());
+    let cx = Source::new(file, text, dir.to_path_buf(), registries);
     let r_sampling = raw.sampling.as_ref().ok_or_else(|| {
         study_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
     })?;
     let r_system = raw.system.as_ref().ok_or_else(|| {
         study_err!(
             "{file}: missing section [system]; expected kind = {} and its keys",
-            system::kinds()
+            system::kinds(&registries.signal)
         )
     })?;
     let grid = sampling::parse_sampling(&cx, r_sampling)?;
@@ -144,6 +159,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> StudyResul
         file: file.to_string(),
         dir: cx.dir.clone(),
         title: raw.title.clone(),
+        registries: Arc::clone(registries),
         grid,
         input,
         history,

@@ -5,7 +5,7 @@ use super::range;
 use super::raw::RawNoise;
 use super::spec::{quoted_list, NoiseSpec};
 use crate::error::StudyResult;
-use jitterid::estimate::{AnyNoise, ArmaNoise, NoiseRegistry, WhiteNoise};
+use jitterid::estimate::{AnyNoise, ArmaNoise, WhiteNoise};
 
 const S: &str = "noise";
 
@@ -31,7 +31,7 @@ pub(super) fn parse_noise(cx: &Source, r: &RawNoise) -> StudyResult<NoiseSpec> {
     };
     let estimate = r.estimate.as_ref().is_some_and(|e| *e.get_ref());
     let model = r.model.as_ref().map_or("white", |m| m.get_ref().as_str());
-    let registry = NoiseRegistry::builtin();
+    let registry = &cx.registries.noise;
     let names: Vec<&str> = registry.entries().iter().map(|e| e.name).collect();
     let model_span = || r.model.as_ref().map(|m| m.span()).unwrap_or(0..0);
     let Some(entry) = registry.entry(model) else {

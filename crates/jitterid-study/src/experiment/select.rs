@@ -4,7 +4,6 @@ use super::diagnostics::Source;
 use super::raw::RawSelect;
 use crate::error::StudyResult;
 use jitterid::estimate::selection::{SelectionError, SelectionGrid};
-use jitterid::jitter::registry::JitterRegistry;
 use toml::Spanned;
 
 const S: &str = "select";
@@ -41,7 +40,7 @@ pub(super) fn parse_select(cx: &Source, r: &RawSelect, len: usize) -> StudyResul
         zeros,
         families,
     };
-    match grid.candidates(JitterRegistry::builtin(), len) {
+    match grid.candidates(&cx.registries.jitter, len) {
         Ok(_) => Ok(grid),
         Err(SelectionError::InvalidKey { key, message }) => {
             let span = match key {

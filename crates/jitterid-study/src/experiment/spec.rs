@@ -1,5 +1,6 @@
 //! The validated experiment: what every command reads, with nothing left to check.
 
+use crate::Registries;
 use jitterid::estimate::solver::SolverRegistry;
 use jitterid::estimate::{
     AnyCriterion, AnyNoise, CriterionRegistry, Frequencies, NoiseModel, SpecTable,
@@ -9,6 +10,7 @@ use jitterid::signal::registry::Spec;
 use jitterid::signal::{Input, RandomBinary, SampleGrid};
 use std::fmt;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// How the input is obtained.
 #[derive(Debug, Clone, PartialEq)]
@@ -85,6 +87,15 @@ impl fmt::Debug for NoiseSpec {
     }
 }
 
+impl PartialEq for Registries {
+    /// Registries are the same when they are one value (an experiment read with the built-in
+    /// registries equals another read with them): entries hold functions, which do not
+    /// compare.
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
 impl PartialEq for NoiseSpec {
     fn eq(&self, other: &Self) -> bool {
         self.std == other.std
@@ -112,9 +123,13 @@ impl Method {
         self.0
     }
 
-    /// The registry's method of this name, if the command line can run it.
+    /// The built-in registry's method of this name, if the command line can run it.
     pub fn parse(s: &str) -> Option<Self> {
-        let registry = CriterionRegistry::builtin();
+        Self::parse_in(&Registries::builtin().criteria, s)
+    }
+
+    /// The method of this name in `registry`, if it builds from its name alone.
+    pub fn parse_in(registry: &CriterionRegistry, s: &str) -> Option<Self> {
         let entry = registry.entry(s)?;
         registry
             .build(&name_table(registry.key(), entry.name))
@@ -124,28 +139,31 @@ impl Method {
 
     /// The names [`parse`](Self::parse) accepts, quoted, for messages.
     pub fn names() -> String {
-        let registry = CriterionRegistry::builtin();
+        Self::names_in(&Registries::builtin().criteria)
+    }
+
+    /// The names [`parse_in`](Self::parse_in) accepts in `registry`, quoted, for messages.
+    pub fn names_in(registry: &CriterionRegistry) -> String {
         let names: Vec<&str> = registry
             .entries()
             .iter()
             .map(|e| e.name)
-            .filter(|n| Method::parse(n).is_some())
+            .filter(|n| Method::parse_in(registry, n).is_some())
             .collect();
         quoted_list(&names)
     }
 
-    /// The criterion, built through the registry.
-    pub fn criterion(self) -> AnyCriterion {
+    /// The criterion, built through `registry` (the one the method was accepted from).
+    pub fn criterion_in(self, registry: &CriterionRegistry) -> AnyCriterion {
         // Only names that built at the door are held.
-        let registry = CriterionRegistry::builtin();
         registry
             .build(&name_table(registry.key(), self.0))
             .unwrap_or_else(|_| AnyCriterion::first_moment(jitterid::estimate::Bcls))
     }
 
-    /// Whether the method is a likelihood (its cost is `−log L`).
-    pub fn is_likelihood(self) -> bool {
-        self.criterion().is_likelihood()
+    /// Whether the method is a likelihood in `registry` (its cost is `−log L`).
+    pub fn is_likelihood_in(self, registry: &CriterionRegistry) -> bool {
+        self.criterion_in(registry).is_likelihood()
     }
 }
 
@@ -174,10 +192,9 @@ impl SolverName {
         self.0
     }
 
-    /// The registry's solver of this name (or alias), if the command line offers it.
-    pub fn parse(s: &str) -> Option<Self> {
+    /// The solver of this name (or alias) in `registry`, if the command line offers it.
+    pub fn parse_in(registry: &SolverRegistry, s: &str) -> Option<Self> {
         let s = if s == "levenberg-marquardt" { "lm" } else { s };
-        let registry = SolverRegistry::builtin();
         let entry = registry.entry(s)?;
         Self::OFFERED
             .contains(&entry.name)
@@ -260,6 +277,8 @@ pub struct Experiment {
     pub dir: PathBuf,
     /// An optional title.
     pub title: Option<String>,
+    /// The registries the experiment was read with, which build its models when it runs.
+    pub registries: Arc<Registries>,
     /// The sampling grid.
     pub grid: SampleGrid,
     /// The input.

@@ -44,8 +44,8 @@ fn unwritable(kind: &SignalKind) -> Vec<&str> {
 }
 
 /// The signal registry's kinds that an experiment file can describe, quoted, for messages.
-pub(super) fn kinds() -> String {
-    let names: Vec<&str> = SignalRegistry::builtin()
+pub(super) fn kinds(registry: &SignalRegistry) -> String {
+    let names: Vec<&str> = registry
         .kinds()
         .filter(|k| unwritable(k).is_empty())
         .map(SignalKind::name)
@@ -58,10 +58,10 @@ pub(super) fn parse_system(
     r: &RawSystem,
     grid: &SampleGrid,
 ) -> StudyResult<SystemSpec> {
-    let kinds = kinds();
+    let kinds = kinds(&cx.registries.signal);
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {kinds}"))?;
     let name = kind.get_ref().as_str();
-    let Some(entry) = SignalRegistry::builtin().kind(name) else {
+    let Some(entry) = cx.registries.signal.kind(name) else {
         return Err(cx.err(
             S,
             "kind",
