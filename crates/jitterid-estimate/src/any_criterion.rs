@@ -8,7 +8,7 @@ use crate::fit::{estimate, EstimateOptions, Frequencies};
 use crate::ml::{ml_estimate, ml_profile, ExactMl, MlError, MlOptions, QuasiMl};
 use crate::noise::NoiseModel;
 use crate::profile::{profile, Profile};
-use crate::registry::{number, numbers, real, Entry, Registry, RegistryError};
+use crate::registry::{number, numbers, real, Builtin, Entry, Registry, RegistryError};
 use crate::result::Fit;
 use crate::solver::AnySolver;
 use crate::structure::ModelStructure;
@@ -242,20 +242,13 @@ pub type CriterionEntry = Entry<AnyCriterion>;
 /// `"quasi-ml"` and `"ml"` (the exact likelihood; keys `resolution`, `window`).
 pub type CriterionRegistry = Registry<AnyCriterion>;
 
-impl Entry<AnyCriterion> {
-    /// A first-moment criterion without keys.
-    pub fn fixed<C: Criterion + Clone + 'static>(
-        name: &'static str,
-        summary: &'static str,
-        criterion: C,
-    ) -> Self {
-        Entry::new(name, summary, Vec::new(), move |_| {
-            Ok(AnyCriterion::first_moment(criterion.clone()))
-        })
+impl<C: Criterion + Clone + 'static> From<C> for AnyCriterion {
+    fn from(criterion: C) -> Self {
+        AnyCriterion::first_moment(criterion)
     }
 }
 
-impl Registry<AnyCriterion> {
+impl Builtin for AnyCriterion {
     /// The criteria of this crate.
     ///
     /// ```
@@ -271,7 +264,7 @@ impl Registry<AnyCriterion> {
     /// assert_eq!(all.len(), 5);
     /// # Ok::<(), jitterid_estimate::RegistryError>(())
     /// ```
-    pub fn builtin() -> Self {
+    fn builtin() -> Registry<Self> {
         let exact = ExactMl::default();
         let exact_keys = vec![
             real(

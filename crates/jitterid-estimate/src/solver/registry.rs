@@ -5,7 +5,7 @@ use super::{
     MultiStart, NelderMead, SolverError,
 };
 use crate::registry::{
-    count, number, real, whole, Entry, ParamSpec, Registry, RegistryError, SpecTable,
+    count, number, real, whole, Builtin, Entry, ParamSpec, Registry, RegistryError, SpecTable,
 };
 
 /// The key of a spec table that names the solver.
@@ -122,7 +122,7 @@ fn read(table: &SpecTable, entry: &str, specs: &[ParamSpec]) -> Result<Vec<f64>,
         .collect()
 }
 
-impl Registry<AnySolver> {
+impl Builtin for AnySolver {
     /// The solvers of this crate.
     ///
     /// ```
@@ -137,7 +137,7 @@ impl Registry<AnySolver> {
     /// assert_eq!(err.key(), Some("max_iter"));
     /// # Ok::<(), jitterid_estimate::RegistryError>(())
     /// ```
-    pub fn builtin() -> Self {
+    fn builtin() -> Registry<Self> {
         let mut r = Registry::empty(
             SOLVER_KEY,
             "solver",
