@@ -9,9 +9,7 @@ use crate::evaluation_memo::{EvaluationMemo, MEMO_MAX_SAMPLES};
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::result::{CostKind, Fit};
-use crate::solver::{
-    LeastSquares, LevenbergMarquardt, NormalEquations, Solver, SolverError, Termination,
-};
+use crate::solver::{LeastSquares, LevenbergMarquardt, NormalEquations, Solver, SolverError};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
@@ -308,9 +306,9 @@ where
     // A converged fit that leaves a band of frequencies unexplained is not a solution.
     let (converged, termination) = match residual_flatness {
         Some(f) if report.converged && f > crate::FLATNESS_LIMIT => {
-            (false, Termination::ResidualNotFlat)
+            (false, crate::FitTermination::ResidualNotFlat)
         }
-        _ => (report.converged, report.termination),
+        _ => (report.converged, report.termination.into()),
     };
     Ok(Fit {
         criterion: criterion.name().to_string(),

@@ -57,7 +57,6 @@ pub mod csv;
 mod data;
 mod error;
 mod evaluation_memo;
-mod finite_diff;
 mod fit;
 mod flatness;
 mod frequency_data;
@@ -68,7 +67,6 @@ mod measured;
 pub mod ml;
 pub mod montecarlo;
 mod noise;
-mod objective;
 mod parseval;
 mod profile;
 pub mod registry;
@@ -76,8 +74,8 @@ mod restricted_noise;
 mod result;
 pub mod selection;
 mod simd;
-pub mod solver;
 mod structure;
+mod termination;
 pub mod validation;
 
 pub use any_criterion::{AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions};
@@ -94,12 +92,15 @@ pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };
 pub use jitter_floor::{mean_jitter_variance, JITTER_FLOOR_ROUNDS};
+/// The optimisation layer (`jitterid-optim`): objectives, least squares, solvers.
+pub use jitterid_optim as solver;
+pub use jitterid_optim::{ArgminObjective, Objective, WithMetric};
 pub use joint::{check_joint, estimate_joint, JointProblem};
 pub use measured::{InputLayout, MeasuredRecord};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
-pub use objective::{ArgminObjective, Objective, WithMetric};
 pub use profile::{profile, Profile};
 pub use registry::{Entry, ParamSpec, Registry, RegistryError, SpecTable};
 pub use restricted_noise::{restricted_noise_fit, NoiseEstimate, RESTRICTED_NOISE_MAX_SAMPLES};
 pub use result::{CostKind, Fit};
 pub use structure::ModelStructure;
+pub use termination::FitTermination;

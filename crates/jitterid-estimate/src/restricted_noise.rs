@@ -29,15 +29,15 @@
 //! the frequency-domain estimate stands (its `O(1/N)` bias shrinks faster than its `1/√N`
 //! spread).
 
-use crate::finite_diff::{central_difference_vec, hessian, MOMENT_FD_STEP};
 use crate::noise::NoiseModel;
-use crate::objective::Objective;
 use crate::solver::{Bfgs, Solver};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
 use faer::{Mat, Side};
 use jitterid_jitter::JitterModel;
+use jitterid_optim::finite_diff::{central_difference_vec, hessian, MOMENT_FD_STEP};
+use jitterid_optim::Objective;
 use jitterid_signal::{SampleGrid, Signal};
 use num_complex::Complex64;
 use rustfft::FftPlanner;

@@ -1,6 +1,6 @@
 //! The one result type of every estimator: [`Fit`].
 
-use crate::solver::Termination;
+use crate::FitTermination;
 use serde::{Deserialize, Serialize};
 
 /// What [`Fit::cost`] measures.
@@ -38,7 +38,7 @@ pub struct Fit {
     /// Solver iterations.
     pub iterations: u64,
     /// Why the solver stopped.
-    pub termination: Termination,
+    pub termination: FitTermination,
     /// Whether the solver met a convergence test (and, for criteria with flat residuals, the
     /// residual spectrum passed [`residual_flatness`](crate::residual_flatness)).
     pub converged: bool,

@@ -10,9 +10,7 @@ use super::param::{default_transforms, likelihood_param_names, likelihood_params
 use super::MlError;
 use crate::covariance::inverse_gram;
 use crate::data::Record;
-use crate::finite_diff::hessian;
 use crate::noise::NoiseModel;
-use crate::objective::{Objective, WithMetric};
 use crate::profile::{best_of, fitted_jitter, Profile};
 use crate::result::{CostKind, Fit};
 use crate::solver::{Brent, BrentOrBfgs, ObjectiveSolver, ProgressHook, Transform};
@@ -20,6 +18,8 @@ use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
 use jitterid_jitter::JitterModel;
+use jitterid_optim::finite_diff::hessian;
+use jitterid_optim::{Objective, WithMetric};
 use jitterid_signal::Signal;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -245,7 +245,7 @@ where
         cost: report.cost,
         cost_kind: CostKind::NegLogLikelihood,
         iterations: report.iterations,
-        termination: report.termination,
+        termination: report.termination.into(),
         converged: report.converged,
         noise_std: sigma,
         residuals: Vec::new(),

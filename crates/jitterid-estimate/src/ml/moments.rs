@@ -15,10 +15,10 @@
 
 use super::param::Layout;
 use super::MlError;
-use crate::finite_diff::{central_difference, LIKELIHOOD_FD_STEP};
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
+use jitterid_optim::finite_diff::{central_difference, LIKELIHOOD_FD_STEP};
 use jitterid_signal::{local_breaks, Jacobian, SampleGrid, Signal};
 use jitterid_window::{dtft, fft_grid, FrequencySet, Window};
 use num_complex::Complex64;

@@ -4,12 +4,12 @@
 use super::criterion::{GradientRequest, LikelihoodCriterion, LikelihoodData};
 use super::param::{split, Layout};
 use super::MlError;
-use crate::finite_diff::{partial, LIKELIHOOD_FD_STEP};
 use crate::noise::NoiseModel;
-use crate::objective::Objective;
 use crate::solver::{SolverError, Transform};
 use crate::structure::ModelStructure;
 use jitterid_jitter::JitterModel;
+use jitterid_optim::finite_diff::{partial, LIKELIHOOD_FD_STEP};
+use jitterid_optim::Objective;
 use jitterid_signal::Signal;
 use std::sync::Mutex;
 

@@ -7,26 +7,26 @@
 //! relative steps ([`MOMENT_FD_STEP`], [`LIKELIHOOD_FD_STEP`]); each was tuned against its own
 //! analytic gradients, and the reproduced figures depend on them.
 
-use crate::objective::Objective;
+use crate::Objective;
 use faer::Mat;
 
 /// Relative step of the central differences of the first moment `m_k` in the jitter's and the
 /// noise shape's parameters.
-pub(crate) const MOMENT_FD_STEP: f64 = 1e-6;
+pub const MOMENT_FD_STEP: f64 = 1e-6;
 
 /// Relative step of the central differences of the likelihood criteria and the second
 /// moments (`≈ ε^{1/3}`).
-pub(crate) const LIKELIHOOD_FD_STEP: f64 = 6e-6;
+pub const LIKELIHOOD_FD_STEP: f64 = 6e-6;
 
 /// The step `rel · max(|v|, 10⁻³)` of a central difference in a parameter of value `v`.
-pub(crate) fn fd_step(rel: f64, v: f64) -> f64 {
+pub fn fd_step(rel: f64, v: f64) -> f64 {
     rel * v.abs().max(1e-3)
 }
 
 /// Central difference of `f` in coordinate `j` of `theta`, one-sided where a side is outside
 /// the model's domain (`f` returns `None`), `None` if neither side is. `diff(a, b, h)` forms
 /// the quotient `(a − b)/h` of two values.
-pub(crate) fn central_difference<T>(
+pub fn central_difference<T>(
     theta: &[f64],
     j: usize,
     rel: f64,
@@ -47,7 +47,7 @@ pub(crate) fn central_difference<T>(
 }
 
 /// [`central_difference`] of a vector-valued `f`, element by element.
-pub(crate) fn central_difference_vec(
+pub fn central_difference_vec(
     theta: &[f64],
     j: usize,
     rel: f64,
@@ -61,13 +61,7 @@ pub(crate) fn central_difference_vec(
 /// Central difference of a scalar `f` in coordinate `j`, where `+∞` (or NaN) marks a point
 /// outside the domain: one-sided next to such a point (from `f0 = f(θ)`), NaN if both sides
 /// are outside.
-pub(crate) fn partial(
-    f: impl Fn(&[f64]) -> f64,
-    theta: &[f64],
-    j: usize,
-    f0: f64,
-    rel: f64,
-) -> f64 {
+pub fn partial(f: impl Fn(&[f64]) -> f64, theta: &[f64], j: usize, f0: f64, rel: f64) -> f64 {
     let h = fd_step(rel, theta[j]);
     let mut p = theta.to_vec();
     p[j] = theta[j] + h;
@@ -85,7 +79,7 @@ pub(crate) fn partial(
 /// The Hessian of `objective` at `theta` by central differences of its gradient (step
 /// `10⁻⁴ · max(|θ_i|, 10⁻⁴)`, one-sided next to an infeasible point), symmetrised; `None` if a
 /// gradient is not finite on both sides.
-pub(crate) fn hessian<O: Objective + ?Sized>(objective: &O, theta: &[f64]) -> Option<Mat<f64>> {
+pub fn hessian<O: Objective + ?Sized>(objective: &O, theta: &[f64]) -> Option<Mat<f64>> {
     let p = theta.len();
     let mut h = Mat::<f64>::zeros(p, p);
     for i in 0..p {

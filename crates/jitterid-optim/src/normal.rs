@@ -77,7 +77,11 @@ impl NormalEquations {
     }
 
     /// Checks that the shapes fit `n` parameters.
-    pub(crate) fn check_shape(&self, n: usize) -> Result<(), SolverError> {
+    ///
+    /// # Errors
+    ///
+    /// [`SolverError::JacobianShape`] when they do not.
+    pub fn check_shape(&self, n: usize) -> Result<(), SolverError> {
         let (rows, cols) = (self.gram.nrows(), self.gram.ncols());
         if rows != n || cols != n || self.gradient.len() != n {
             return Err(SolverError::JacobianShape {
@@ -125,7 +129,7 @@ fn column(j: &Mat<f64>, c: usize) -> &[f64] {
 }
 
 /// `Σ a_i b_i`.
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -134,21 +138,18 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// Plain sequential dot products rather than faer's product: with a handful of columns and up
 /// to millions of rows the parallel kernel spends its time in barriers, and a fixed summation
 /// order keeps Monte Carlo runs bit-identical whatever the thread count.
-pub(crate) fn jt_r(j: &Mat<f64>, r: &[f64]) -> Vec<f64> {
+pub fn jt_r(j: &Mat<f64>, r: &[f64]) -> Vec<f64> {
     (0..j.ncols()).map(|c| dot(column(j, c), r)).collect()
 }
 
 /// `JᵀJ`, sequential for the reasons given at [`jt_r`].
-pub(crate) fn gram(j: &Mat<f64>) -> Mat<f64> {
+pub fn gram(j: &Mat<f64>) -> Mat<f64> {
     let cols: Vec<&[f64]> = (0..j.ncols()).map(|c| column(j, c)).collect();
     gram_of(&cols, dot)
 }
 
 /// The symmetric matrix `G_ab = inner(col_a, col_b)`, each pair computed once.
-pub(crate) fn gram_of<C: AsRef<[f64]>>(
-    cols: &[C],
-    inner: impl Fn(&[f64], &[f64]) -> f64,
-) -> Mat<f64> {
+pub fn gram_of<C: AsRef<[f64]>>(cols: &[C], inner: impl Fn(&[f64], &[f64]) -> f64) -> Mat<f64> {
     let p = cols.len();
     let mut g = Mat::zeros(p, p);
     for a in 0..p {

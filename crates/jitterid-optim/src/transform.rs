@@ -142,7 +142,7 @@ impl fmt::Display for Transform {
 /// # Example
 ///
 /// ```
-/// use jitterid_estimate::solver::{
+/// use jitterid_optim::{
 ///     LeastSquares, LevenbergMarquardt, SolverError, Transform, Transformed,
 /// };
 ///

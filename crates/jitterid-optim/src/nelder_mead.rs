@@ -3,7 +3,8 @@
 use super::error::check_option;
 use super::problem::{half_sum_sq, start_residuals, validate_start};
 use super::{from_argmin_reason, Solver, SolverError, SolverReport, Termination};
-use crate::objective::{check_objective_start, Objective};
+use crate::objective::check_objective_start;
+use crate::Objective;
 use argmin::core::{CostFunction, Error, Executor, IterState, State};
 use argmin::solver::neldermead::NelderMead as ArgminNelderMead;
 

@@ -4,9 +4,8 @@ use super::{
     AnySolver, Bfgs, Brent, BrentOrBfgs, GaussNewtonLineSearch, LevenbergMarquardt, LmOptions,
     MultiStart, NelderMead, SolverError,
 };
-use crate::registry::{
-    count, number, real, whole, Builtin, Entry, ParamSpec, Registry, RegistryError, SpecTable,
-};
+use jitterid_registry::keys::{count, number, real, whole};
+use jitterid_registry::{Builtin, Entry, ParamSpec, Registry, RegistryError, SpecTable};
 
 /// The key of a spec table that names the solver.
 pub const SOLVER_KEY: &str = "solver";
@@ -126,7 +125,7 @@ impl Builtin for AnySolver {
     /// The solvers of this crate.
     ///
     /// ```
-    /// use jitterid_estimate::solver::SolverRegistry;
+    /// use jitterid_optim::SolverRegistry;
     ///
     /// let registry = SolverRegistry::builtin();
     /// let table = serde_json::json!({ "solver": "lm", "max_iters": 50, "starts": 4, "seed": 7 });
@@ -135,7 +134,7 @@ impl Builtin for AnySolver {
     /// let bad = serde_json::json!({ "solver": "lm", "max_iter": 50 });
     /// let err = registry.build(bad.as_object().unwrap()).unwrap_err();
     /// assert_eq!(err.key(), Some("max_iter"));
-    /// # Ok::<(), jitterid_estimate::RegistryError>(())
+    /// # Ok::<(), jitterid_registry::RegistryError>(())
     /// ```
     fn builtin() -> Registry<Self> {
         let mut r = Registry::empty(

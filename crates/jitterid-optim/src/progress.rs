@@ -21,7 +21,7 @@ pub struct Progress {
 /// iteration. Cheap to clone (shared).
 ///
 /// ```
-/// use jitterid_estimate::solver::{LevenbergMarquardt, ProgressHook};
+/// use jitterid_optim::{LevenbergMarquardt, ProgressHook};
 /// let solver = LevenbergMarquardt::default()
 ///     .with_progress(ProgressHook::new(|p| eprintln!("{} {:.3e}", p.iteration, p.cost)));
 /// # let _ = solver;

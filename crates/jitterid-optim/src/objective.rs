@@ -5,10 +5,10 @@
 //! (quasi-ML, exact ML) as `f = −log L`. A sum of squares keeps its residual form
 //! ([`Objective::as_least_squares`]), which Levenberg–Marquardt and Gauss–Newton need; every
 //! [`LeastSquares`] problem is an `Objective` through a blanket implementation, so one solver
-//! trait ([`Solver`](crate::solver::Solver)) covers both kinds.
+//! trait ([`Solver`](crate::Solver)) covers both kinds.
 
 use crate::finite_diff::{partial, LIKELIHOOD_FD_STEP};
-use crate::solver::{LeastSquares, SolverError};
+use crate::{LeastSquares, SolverError};
 use argmin::core::{CostFunction, Error, Gradient};
 
 /// A smooth objective `f(θ)` to minimise, with its gradient. `f` is `+∞` where `θ` is

@@ -50,8 +50,8 @@
 //! ```
 //! use argmin::core::observers::{Observe, ObserverMode};
 //! use argmin::core::{Error, Executor, State, KV};
-//! use jitterid_estimate::solver::lm::{LevenbergMarquardt, LmState};
-//! use jitterid_estimate::solver::{ArgminProblem, LeastSquares, SolverError};
+//! use jitterid_optim::lm::{LevenbergMarquardt, LmState};
+//! use jitterid_optim::{ArgminProblem, LeastSquares, SolverError};
 //! use std::sync::{Arc, Mutex};
 //!
 //! struct Rosenbrock;

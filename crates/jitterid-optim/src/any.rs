@@ -4,8 +4,8 @@ use super::{
     Bfgs, Brent, BrentOrBfgs, GaussNewtonLineSearch, LevenbergMarquardt, MultiStart, NelderMead,
     ProgressHook, Solver, SolverError, SolverReport,
 };
-use crate::objective::Objective;
-use crate::solver::LeastSquares;
+use crate::LeastSquares;
+use crate::Objective;
 use std::fmt;
 use std::sync::Arc;
 
@@ -65,13 +65,13 @@ impl AnySolver {
     /// the solver it runs.
     ///
     /// ```
-    /// use jitterid_estimate::solver::{ProgressHook, SolverRegistry};
+    /// use jitterid_optim::{ProgressHook, SolverRegistry};
     ///
     /// let table = serde_json::json!({ "solver": "lm", "starts": 3 });
     /// let solver = SolverRegistry::builtin().build(table.as_object().unwrap())?;
     /// let solver = solver.with_progress(ProgressHook::new(|p| eprintln!("{}", p.cost)));
     /// assert!(solver.reports_progress());
-    /// # Ok::<(), jitterid_estimate::RegistryError>(())
+    /// # Ok::<(), jitterid_registry::RegistryError>(())
     /// ```
     #[must_use]
     pub fn with_progress(&self, hook: ProgressHook) -> AnySolver {

@@ -1,26 +1,46 @@
-//! Optimisation layer over [argmin]: one [`Solver`] trait, implemented by every minimiser.
+//! Optimisation for **jitterid**, with no model types: objectives, least squares, solvers over
+//! [argmin], finite differences, the solver registry.
 //!
-//! Every estimation criterion of this crate ends up as an [`Objective`](crate::Objective):
-//! the first-moment criteria as a [`LeastSquares`] problem (a residual vector `r(θ)` and its
-//! Jacobian, cost `V(θ) = ½ Σ rᵢ²`), the likelihood criteria as `−log L` with its gradient.
-//! A [`Solver<P>`](Solver) minimises a problem `P` from a start and returns a [`SolverReport`]
-//! that says where it stopped and why. What a solver needs from `P` is stated in the
-//! where-clause of its implementation and in a "Requirements" section (the argmin style):
+//! This crate knows nothing about signals, jitter or noise: an estimator above it turns its
+//! criterion into one of two problem shapes and hands it to one [`Solver`] trait.
+//!
+//! # Conventions
+//!
+//! * **Parameter order.** A problem's parameters are one `&[f64]` in the problem's own order;
+//!   solvers never reorder them. [`Transform`]s apply one per parameter, in that order.
+//! * **Residual stacking.** A [`LeastSquares`] problem returns one residual vector `r(θ)` of
+//!   length [`LeastSquares::num_residuals`]; a complex residual is stacked by its caller
+//!   (real parts, then imaginary parts, as the estimators above do) before it reaches here.
+//!   The Jacobian is `num_residuals × num_params`, row `i` the gradient of `rᵢ`.
+//! * **Cost scaling.** The cost of a least-squares problem is `V(θ) = ½ Σ rᵢ²` (the `½` is
+//!   part of every reported [`SolverReport::cost`]); an [`Objective`] reports its own cost
+//!   unscaled (`−log L` for the likelihoods above).
+//! * **Derivatives.** Analytic where the problem provides them ([`LeastSquares::jacobian`],
+//!   [`Objective::gradient`]); otherwise central finite differences ([`fd_jacobian`] with
+//!   relative step [`DEFAULT_FD_STEP`], [`finite_diff`] for gradients and Hessians).
+//! * **Infeasible points** are non-finite residuals or costs: the gradient-based solvers
+//!   shorten or reject the step, [`NelderMead`] treats them as an infinite cost. An `Err` from a
+//!   problem aborts the solve.
+//! * **Verdicts.** A [`SolverReport`] says why the solver stopped ([`Termination`]); whether
+//!   the fit is acceptable for the model (a residual spectrum that is not flat, say) is the
+//!   estimator's verdict, not the solver's, and is not represented here.
 //!
 //! | solver | requires | for |
 //! |---|---|---|
 //! | [`LevenbergMarquardt`] | [`LeastSquares`] | first-moment criteria (the workhorse) |
 //! | [`GaussNewtonLineSearch`] | [`LeastSquares`] | first-moment criteria |
-//! | [`NelderMead`] | [`Objective`](crate::Objective) (cost only) | any; derivative-free fallback |
-//! | [`Bfgs`] | [`Objective`](crate::Objective) (cost and gradient) | likelihoods, several parameters |
-//! | [`Brent`] | [`Objective`](crate::Objective) of one parameter | likelihoods, one parameter |
-//! | [`BrentOrBfgs`] | [`Objective`](crate::Objective) | the likelihoods' default |
+//! | [`NelderMead`] | [`Objective`] (cost only) | any; derivative-free fallback |
+//! | [`Bfgs`] | [`Objective`] (cost and gradient) | likelihoods, several parameters |
+//! | [`Brent`] | [`Objective`] of one parameter | likelihoods, one parameter |
+//! | [`BrentOrBfgs`] | [`Objective`] | the likelihoods' default |
 //! | [`MultiStart`] | what its inner solver requires | escaping local minima |
-//! | [`AnySolver`] | [`Objective`](crate::Objective); a residual form for LM and GN | a choice made at run time |
+//! | [`AnySolver`] | [`Objective`]; a residual form for LM and GN | a choice made at run time |
 //!
 //! [`LevenbergMarquardt`] is written here as an argmin [`argmin::core::Solver`] (argmin has
 //! none), so it can also run under argmin's `Executor` with observers and checkpointing; see
-//! [`lm`]. Run-time choices go through the [`SolverRegistry`] and [`AnySolver`].
+//! [`lm`]. Run-time choices go through the [`SolverRegistry`] and [`AnySolver`]. Every shipped
+//! solver passes [`testing::check_solver`], the contract a solver of your own can be run
+//! against.
 //!
 //! # Constraints
 //!
@@ -28,17 +48,10 @@
 //! problem in [`Transformed`] with one [`Transform`] per parameter. A start that violates its
 //! constraint is rejected with [`SolverError::OutsideConstraint`].
 //!
-//! # Infeasible points
-//!
-//! A problem marks a parameter vector as infeasible (say, an unstable model) by returning
-//! non-finite residuals there. The gradient-based solvers then shorten or reject the step;
-//! [`NelderMead`] treats it as an infinite cost. Returning an `Err` from
-//! [`LeastSquares::residuals`] instead aborts the solve with that error.
-//!
 //! # Example
 //!
 //! ```
-//! use jitterid_estimate::solver::{LeastSquares, LevenbergMarquardt, Solver, SolverError};
+//! use jitterid_optim::{LeastSquares, LevenbergMarquardt, Solver, SolverError};
 //!
 //! /// Rosenbrock's function as residuals `[10(y − x²), 1 − x]`.
 //! struct Rosenbrock;
@@ -57,6 +70,7 @@
 //! assert!((report.params[0] - 1.0).abs() < 1e-8 && (report.params[1] - 1.0).abs() < 1e-8);
 //! # Ok::<(), SolverError>(())
 //! ```
+#![warn(missing_docs)]
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -66,14 +80,17 @@ mod bfgs;
 mod brent;
 mod brent_bracket;
 mod error;
+pub mod finite_diff;
 mod gauss_newton;
 pub mod lm;
 mod multistart;
 mod nelder_mead;
 mod normal;
-pub(crate) mod problem;
+mod objective;
+mod problem;
 mod progress;
 mod registry;
+pub mod testing;
 mod transform;
 
 pub use any::{AnySolver, DynSolver};
@@ -84,11 +101,12 @@ pub use gauss_newton::GaussNewtonLineSearch;
 pub use lm::{LevenbergMarquardt, LmOptions, Scaling};
 pub use multistart::MultiStart;
 pub use nelder_mead::NelderMead;
-pub(crate) use normal::{dot, gram};
+pub use normal::{dot, gram};
 pub use normal::{NormalEquations, NormalEquationsOperator};
+pub use objective::{ArgminObjective, Objective, WithMetric};
 pub use problem::{fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, DEFAULT_FD_STEP};
 pub use progress::{Progress, ProgressHook};
-pub use registry::{SolverEntry, SolverRegistry};
+pub use registry::{SolverEntry, SolverRegistry, SOLVER_KEY};
 pub use transform::{Transform, Transformed};
 
 /// A minimiser of problems of type `P`.
@@ -117,11 +135,11 @@ impl<P: ?Sized, S: Solver<P> + ?Sized> Solver<P> for &S {
     }
 }
 
-/// A solver of every [`Objective`](crate::Objective) seen through a trait object: what the
+/// A solver of every [`Objective`] seen through a trait object: what the
 /// likelihood fits ask of their solver. Implemented for every such solver.
-pub trait ObjectiveSolver: for<'o> Solver<dyn crate::Objective + 'o> {}
+pub trait ObjectiveSolver: for<'o> Solver<dyn Objective + 'o> {}
 
-impl<S: ?Sized> ObjectiveSolver for S where S: for<'o> Solver<dyn crate::Objective + 'o> {}
+impl<S: ?Sized> ObjectiveSolver for S where S: for<'o> Solver<dyn Objective + 'o> {}
 
 /// Outcome of [`Solver::minimize`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -155,7 +173,8 @@ pub enum Termination {
     TimeLimit,
     /// Converged with the parameters at these indices on the boundary of their domain (a
     /// jitter width at 0: the data show no detectable jitter); the others met a convergence
-    /// test with those held there. Set by [`estimate`](crate::estimate).
+    /// test with those held there. Set by the estimator that knows the domain, not by the
+    /// solvers.
     AtBound {
         /// Indices (into the free parameter vector) of the parameters at their bound.
         params: Vec<usize>,
@@ -165,11 +184,6 @@ pub enum Termination {
     NonFinite,
     /// The line search found no acceptable step along a non-negligible descent direction.
     LineSearchFailed,
-    /// The solver met a convergence test, but the residual spectrum is far from flat
-    /// ([`residual_flatness`](crate::residual_flatness) above
-    /// [`FLATNESS_LIMIT`](crate::FLATNESS_LIMIT)): a local minimum, or a model that does not
-    /// describe the data. Set by [`estimate`](crate::estimate), not by the solvers.
-    ResidualNotFlat,
     /// Any other reason, described in words.
     Other(String),
 }
@@ -206,10 +220,6 @@ impl fmt::Display for Termination {
                 f.write_str("residuals or Jacobian not finite at every nearby trial point")
             }
             Termination::LineSearchFailed => f.write_str("line search failed"),
-            Termination::ResidualNotFlat => f.write_str(
-                "converged, but the residual spectrum is not flat (a local minimum, or a model \
-                 that does not describe the data)",
-            ),
             Termination::Other(why) => f.write_str(why),
         }
     }

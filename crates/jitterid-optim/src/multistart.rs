@@ -20,7 +20,7 @@ use rand::{Rng, SeedableRng};
 /// # Example
 ///
 /// ```
-/// use jitterid_estimate::solver::{LevenbergMarquardt, MultiStart};
+/// use jitterid_optim::{LevenbergMarquardt, MultiStart};
 ///
 /// // LM from the start and 20 perturbed starts within ±50 %, seed 7.
 /// let solver = MultiStart::new(LevenbergMarquardt::default(), 20, 0.5, 7);

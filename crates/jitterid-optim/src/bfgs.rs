@@ -9,7 +9,8 @@
 
 use super::progress::{Progress, ProgressHook};
 use super::{Solver, SolverError, SolverReport, Termination};
-use crate::objective::{check_objective_start, Objective};
+use crate::objective::check_objective_start;
+use crate::Objective;
 use serde::{Deserialize, Serialize};
 
 /// Dense BFGS with Armijo backtracking (see the module docs).

@@ -1,7 +1,7 @@
 //! Tests of the optimisation layer through its public API.
 
 use faer::Mat;
-use jitterid_estimate::solver::{
+use jitterid_optim::{
     fd_jacobian, GaussNewtonLineSearch, LeastSquares, LevenbergMarquardt, MultiStart, NelderMead,
     Scaling, Solver, SolverError, SolverReport, Termination, Transform, Transformed,
 };
