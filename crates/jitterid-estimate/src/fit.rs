@@ -207,7 +207,7 @@ where
 /// The jitter's reach `(lo, hi)` and the grid's duration when the reach does not fit in the
 /// record (not finite, or wider than the duration): outside the model's domain for every
 /// criterion ([`EstimateError::ReachExceedsRecord`], `MlError::ReachExceedsRecord`).
-pub(crate) fn reach_beyond<J: JitterModel + ?Sized>(
+pub fn reach_beyond<J: JitterModel + ?Sized>(
     jitter: &J,
     grid: &SampleGrid,
 ) -> Option<(f64, f64, f64)> {

@@ -15,7 +15,7 @@ pub enum CostKind {
 
 /// An estimate: the free parameters by name, their standard errors and covariance, the final
 /// value of the criterion and how the solver stopped. Returned by [`estimate`](crate::estimate)
-/// (first-moment criteria), [`ml_estimate`](crate::ml::ml_estimate) (likelihood criteria) and
+/// (first-moment criteria), `jitterid_likelihood::ml_estimate` (likelihood criteria) and
 /// the profiles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Fit {

@@ -16,7 +16,7 @@
 //!   part of every reported [`SolverReport::cost`]); an [`Objective`] reports its own cost
 //!   unscaled (`−log L` for the likelihoods above).
 //! * **Derivatives.** Analytic where the problem provides them ([`LeastSquares::jacobian`],
-//!   [`Objective::gradient`]); otherwise central finite differences ([`fd_jacobian`] with
+//!   [`Objective::cost_gradient`]); otherwise central finite differences ([`fd_jacobian`] with
 //!   relative step [`DEFAULT_FD_STEP`], [`finite_diff`] for gradients and Hessians).
 //! * **Infeasible points** are non-finite residuals or costs: the gradient-based solvers
 //!   shorten or reject the step, [`NelderMead`] treats them as an infinite cost. An `Err` from a

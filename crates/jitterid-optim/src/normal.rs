@@ -142,7 +142,8 @@ pub fn jt_r(j: &Mat<f64>, r: &[f64]) -> Vec<f64> {
     (0..j.ncols()).map(|c| dot(column(j, c), r)).collect()
 }
 
-/// `JᵀJ`, sequential for the reasons given at [`jt_r`].
+/// `JᵀJ`, sequential (plain dot products in a fixed order: bit-identical whatever the thread
+/// count).
 pub fn gram(j: &Mat<f64>) -> Mat<f64> {
     let cols: Vec<&[f64]> = (0..j.ncols()).map(|c| column(j, c)).collect();
     gram_of(&cols, dot)
