@@ -31,6 +31,21 @@
 //! * The sine record of ADC testing: [`sine_least_squares`], [`attenuation_sigma`],
 //!   [`fit_sine`], and the alias question (see the [`sine`] module docs).
 //!
+//! * Beside the likelihoods, this crate holds what needs them: model-order [`selection`] (which
+//!   refits with [`ExactMl`]), model [`validation`] (standardised residuals by the second
+//!   moments) and the run-time criterion [`AnyCriterion`] with the builtin
+//!   [`CriterionRegistry`] (`ls`, `bcls`, `weighted-bcls`, `bj`, `quasi-ml`, `ml`): this is the
+//!   lowest crate that sees both the first-moment criteria (`jitterid-estimate`) and the
+//!   likelihoods.
+//!
+//! Conventions: the parameter vector is the structure's free parameters in its order (signal,
+//! then `jitter.`, then `noise.`), then `σ_v` (`noise.std`) when it is estimated; the cost is
+//! `−log L` including every constant (not scaled by the number of samples); gradients of
+//! [`ExactMl`] are analytic (the same quadrature nodes as the value), those of [`QuasiMl`]
+//! analytic in the signal and by central differences (`jitterid_optim::finite_diff::LIKELIHOOD_FD_STEP`) in the jitter
+//! and noise parameters; the covariance is the inverse Hessian of `−log L` by differences of
+//! the gradient.
+//!
 //! Bad input gives a typed [`MlError`], never a silent NaN: likelihoods that underflow
 //! ([`MlError::LikelihoodUnderflow`]), `λ_k → 0` ([`MlError::VanishingVariance`]), a jitter
 //! reach wider than the record ([`MlError::ReachExceedsRecord`]), a sine record too short to
@@ -64,6 +79,7 @@
 //! assert!((fit.params[0] - 0.5).abs() < 4.0 * se);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+#![warn(missing_docs)]
 #![allow(clippy::type_complexity, clippy::needless_range_loop)]
 
 mod cheb;
