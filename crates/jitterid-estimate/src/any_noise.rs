@@ -1,7 +1,7 @@
 //! The one run-time noise type, [`AnyNoise`], and the registry of noise models by name.
 
 use crate::noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
-use crate::registry::{number, numbers, real, Entry, ParamSpec, Registry, RegistryError};
+use crate::registry::{number, numbers, real, Builtin, Entry, ParamSpec, Registry, RegistryError};
 use crate::EstimateError;
 use std::fmt;
 use std::sync::Arc;
@@ -108,7 +108,7 @@ fn floor_spec() -> ParamSpec {
     )
 }
 
-impl Registry<AnyNoise> {
+impl Builtin for AnyNoise {
     /// The noise models of this crate.
     ///
     /// ```
@@ -122,7 +122,7 @@ impl Registry<AnyNoise> {
     /// assert_eq!(err.key(), Some("c"));
     /// # Ok::<(), jitterid_estimate::RegistryError>(())
     /// ```
-    pub fn builtin() -> Self {
+    fn builtin() -> Registry<Self> {
         let white = NoiseEntry::new(
             "white",
             "white measurement noise, |H| ≡ 1 (OE and JOE structures)",

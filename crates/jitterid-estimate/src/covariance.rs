@@ -327,8 +327,8 @@ const MAX_CONDITION: f64 = 1e12;
 /// `H⁻¹` for a symmetric positive definite `H` (here `JᵀJ`), through the unit-diagonal scaling
 /// `D^{-1/2} H D^{-1/2}` (which removes the
 /// parameters' units from the conditioning), or `None` if it is singular, not finite or worse
-/// conditioned than [`MAX_CONDITION`].
-pub(crate) fn inverse_gram(h: &Mat<f64>) -> Option<Mat<f64>> {
+/// conditioned than `MAX_CONDITION`.
+pub fn inverse_gram(h: &Mat<f64>) -> Option<Mat<f64>> {
     let p = h.nrows();
     let mut scale = Vec::with_capacity(p);
     for i in 0..p {

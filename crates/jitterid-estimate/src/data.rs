@@ -61,7 +61,7 @@ impl Record {
 
 /// `y` holds one finite value per instant of `grid` (what [`Record::new`] checks, for callers
 /// that borrow the samples).
-pub(crate) fn check_samples(grid: &SampleGrid, y: &[f64]) -> Result<(), EstimateError> {
+pub fn check_samples(grid: &SampleGrid, y: &[f64]) -> Result<(), EstimateError> {
     if y.len() != grid.len() {
         return Err(EstimateError::DataLength {
             expected: grid.len(),

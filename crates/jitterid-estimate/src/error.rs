@@ -129,5 +129,5 @@ pub enum EstimateError {
     Solver(#[from] SolverError),
     /// From a likelihood criterion.
     #[error(transparent)]
-    Likelihood(Box<crate::ml::MlError>),
+    Likelihood(Box<crate::MlError>),
 }

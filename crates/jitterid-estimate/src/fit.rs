@@ -9,9 +9,7 @@ use crate::evaluation_memo::{EvaluationMemo, MEMO_MAX_SAMPLES};
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::result::{CostKind, Fit};
-use crate::solver::{
-    LeastSquares, LevenbergMarquardt, NormalEquations, Solver, SolverError, Termination,
-};
+use crate::solver::{LeastSquares, LevenbergMarquardt, NormalEquations, Solver, SolverError};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
@@ -209,7 +207,7 @@ where
 /// The jitter's reach `(lo, hi)` and the grid's duration when the reach does not fit in the
 /// record (not finite, or wider than the duration): outside the model's domain for every
 /// criterion ([`EstimateError::ReachExceedsRecord`], `MlError::ReachExceedsRecord`).
-pub(crate) fn reach_beyond<J: JitterModel + ?Sized>(
+pub fn reach_beyond<J: JitterModel + ?Sized>(
     jitter: &J,
     grid: &SampleGrid,
 ) -> Option<(f64, f64, f64)> {
@@ -308,9 +306,9 @@ where
     // A converged fit that leaves a band of frequencies unexplained is not a solution.
     let (converged, termination) = match residual_flatness {
         Some(f) if report.converged && f > crate::FLATNESS_LIMIT => {
-            (false, Termination::ResidualNotFlat)
+            (false, crate::FitTermination::ResidualNotFlat)
         }
-        _ => (report.converged, report.termination),
+        _ => (report.converged, report.termination.into()),
     };
     Ok(Fit {
         criterion: criterion.name().to_string(),

@@ -8,9 +8,9 @@
 //! local minimum, or a model that cannot describe the data, leaves its misfit where the input
 //! excites the system: some band of frequencies then carries several times the power of the
 //! others. The solvers' convergence tests cannot see this; [`estimate`](crate::estimate)
-//! reports such a fit as not converged ([`Termination::ResidualNotFlat`]).
+//! reports such a fit as not converged ([`FitTermination::ResidualNotFlat`]).
 //!
-//! [`Termination::ResidualNotFlat`]: crate::solver::Termination::ResidualNotFlat
+//! [`FitTermination::ResidualNotFlat`]: crate::FitTermination::ResidualNotFlat
 
 /// Number of contiguous frequency bands compared.
 pub const FLATNESS_BANDS: usize = 4;

@@ -3,12 +3,12 @@
 
 use crate::criterion::{Criterion, WeightContext};
 use crate::data::Record;
-use crate::finite_diff::{central_difference_vec, MOMENT_FD_STEP};
 use crate::noise::NoiseModel;
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
 use jitterid_jitter::{JitterModel, NoJitter};
+use jitterid_optim::finite_diff::{central_difference_vec, MOMENT_FD_STEP};
 use jitterid_signal::Signal;
 use jitterid_window::{transform, FrequencySet, Window};
 use num_complex::Complex64;

@@ -188,7 +188,7 @@ where
                 Err(e) => {
                     estimate.converged = false;
                     estimate.termination =
-                        Termination::Other(format!("restricted noise likelihood: {e}"));
+                        Termination::Other(format!("restricted noise likelihood: {e}")).into();
                 }
             }
         }
@@ -204,9 +204,9 @@ fn replace_noise_block(estimate: &mut Fit, first: usize, noise: &NoiseEstimate) 
     estimate.noise_std = noise.noise_std;
     estimate.converged &= noise.converged;
     if !noise.converged {
-        estimate.termination = Termination::Other(
+        estimate.termination = crate::FitTermination::Solver(Termination::Other(
             "the restricted likelihood of the noise parameters did not converge".into(),
-        );
+        ));
     }
     let Some(cov) = estimate.covariance.as_mut() else {
         return;

@@ -284,7 +284,7 @@ where
         cost: report.cost,
         cost_kind: CostKind::SumOfSquares,
         iterations: report.iterations,
-        termination: report.termination,
+        termination: report.termination.into(),
         converged: report.converged,
         residuals,
         noise_std,

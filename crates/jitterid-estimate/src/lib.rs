@@ -4,10 +4,10 @@
 //! noise model (OE, BJ, JOE, JBJ, or any part fixed). A [`Criterion`] compares the data's DTFT
 //! `Y(f)` with the model's first moment `μ_Y(f; θ)` over a frequency set: naive [`Ls`] (the
 //! paper's eq. 9, jitter ignored), [`Bcls`] (eq. 14), [`WeightedBcls`] and the [`BoxJenkins`]
-//! criterion; the likelihood criteria of [`ml`] use the second moment. Every criterion is an
+//! criterion; the likelihood criteria of `jitterid-likelihood` use the second moment. Every criterion is an
 //! [`Objective`] for one [`solver::Solver`] trait: Levenberg–Marquardt (written here as an
 //! argmin solver), Gauss–Newton with line search, Nelder–Mead, BFGS, Brent, multi-start.
-//! [`estimate`] (first moment) and [`ml::ml_estimate`] (likelihoods) return the one result
+//! [`estimate`] (first moment) and `jitterid_likelihood::ml_estimate` (likelihoods) return the one result
 //! type, [`Fit`]: `θ̂` by name, standard errors and covariance (the sandwich form that accounts
 //! for the heteroscedastic jittered samples, or the inverse Hessian of `−log L`), the cost,
 //! the termination reason. An integer-valued jitter parameter is profiled ([`profile`]).
@@ -20,9 +20,10 @@
 //! data carry the jitter's white floor ([`ModelStructure::with_jitter_floor`]).
 //!
 //! Run-time choices (a command line, Python) go through [`AnyNoise`] / [`NoiseRegistry`],
-//! [`AnyCriterion`] / [`CriterionRegistry`] and [`solver::AnySolver`] /
+//! `AnyCriterion` / `CriterionRegistry` (in `jitterid-likelihood`, which sees every criterion)
+//! and [`solver::AnySolver`] /
 //! [`solver::SolverRegistry`], built from spec tables whose keys are described by
-//! [`ParamSpec`]; [`AnyCriterion::fit`] fits any of them.
+//! [`ParamSpec`].
 //!
 //! ```
 //! use jitterid_estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
@@ -48,7 +49,6 @@
 //! ```
 #![warn(missing_docs)]
 
-mod any_criterion;
 mod any_noise;
 mod boundary;
 mod covariance;
@@ -57,30 +57,24 @@ pub mod csv;
 mod data;
 mod error;
 mod evaluation_memo;
-mod finite_diff;
 mod fit;
 mod flatness;
 mod frequency_data;
 mod init;
 mod jitter_floor;
 mod joint;
+mod likelihood_error;
 mod measured;
-pub mod ml;
 pub mod montecarlo;
 mod noise;
-mod objective;
 mod parseval;
 mod profile;
 pub mod registry;
 mod restricted_noise;
 mod result;
-pub mod selection;
-mod simd;
-pub mod solver;
 mod structure;
-pub mod validation;
+mod termination;
 
-pub use any_criterion::{AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions};
 pub use any_noise::{AnyNoise, DynNoise, NoiseEntry, NoiseRegistry};
 pub use criterion::{Bcls, BoxJenkins, Criterion, Ls, WeightContext, WeightedBcls};
 pub use data::Record;
@@ -94,12 +88,26 @@ pub use init::{
     fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
 };
 pub use jitter_floor::{mean_jitter_variance, JITTER_FLOOR_ROUNDS};
+/// The optimisation layer (`jitterid-optim`): objectives, least squares, solvers.
+pub use jitterid_optim as solver;
+pub use jitterid_optim::{ArgminObjective, Objective, WithMetric};
 pub use joint::{check_joint, estimate_joint, JointProblem};
+pub use likelihood_error::MlError;
 pub use measured::{InputLayout, MeasuredRecord};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
-pub use objective::{ArgminObjective, Objective, WithMetric};
 pub use profile::{profile, Profile};
 pub use registry::{Entry, ParamSpec, Registry, RegistryError, SpecTable};
 pub use restricted_noise::{restricted_noise_fit, NoiseEstimate, RESTRICTED_NOISE_MAX_SAMPLES};
 pub use result::{CostKind, Fit};
 pub use structure::ModelStructure;
+pub use termination::FitTermination;
+
+/// Building blocks the likelihood layer (`jitterid-likelihood`) shares with the first-moment
+/// estimators of this crate, so that both judge records, reaches and profiles alike.
+pub mod support {
+    pub use crate::covariance::inverse_gram;
+    pub use crate::data::check_samples;
+    pub use crate::fit::reach_beyond;
+    pub use crate::profile::{best_of, fitted_jitter, Best};
+    pub use crate::restricted_noise::measurement_autocovariance;
+}

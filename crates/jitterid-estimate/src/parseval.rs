@@ -25,13 +25,13 @@
 //! (`g`), none per column, so no column's transform buffers add to the memory of the others.
 
 use crate::criterion::Criterion;
-use crate::finite_diff::{central_difference_vec, MOMENT_FD_STEP};
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::solver::NormalEquations;
 use crate::structure::ModelStructure;
 use faer::Mat;
 use jitterid_jitter::{JitterModel, NoJitter};
+use jitterid_optim::finite_diff::{central_difference_vec, MOMENT_FD_STEP};
 use jitterid_signal::Signal;
 use jitterid_window::{fft_in_place, Complex64, Window};
 

@@ -33,10 +33,10 @@ pub struct Profile<J> {
 
 /// The outcome of [`best_of`]: the winner (value and fit), the cost of every value, the first
 /// error.
-type Best<E> = (Option<(i64, Fit)>, Vec<(i64, Option<f64>)>, Option<E>);
+pub type Best<E> = (Option<(i64, Fit)>, Vec<(i64, Option<f64>)>, Option<E>);
 
 /// The best of the fits of a profile: converged beats not converged, then the lower cost.
-pub(crate) fn best_of<E>(fits: Vec<(i64, Result<Fit, E>)>) -> Best<E> {
+pub fn best_of<E>(fits: Vec<(i64, Result<Fit, E>)>) -> Best<E> {
     let mut best: Option<(i64, Fit)> = None;
     let mut costs = Vec::new();
     let mut first_error = None;
@@ -66,7 +66,7 @@ pub(crate) fn best_of<E>(fits: Vec<(i64, Result<Fit, E>)>) -> Best<E> {
 
 /// The jitter of `structure` after the fit `estimate` (its estimated jitter parameters, if
 /// any, put into `jitter`).
-pub(crate) fn fitted_jitter<S, J, N>(
+pub fn fitted_jitter<S, J, N>(
     structure: &ModelStructure<S, J, N>,
     jitter: J,
     estimate: &Fit,

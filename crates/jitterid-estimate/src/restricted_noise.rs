@@ -29,15 +29,15 @@
 //! the frequency-domain estimate stands (its `O(1/N)` bias shrinks faster than its `1/√N`
 //! spread).
 
-use crate::finite_diff::{central_difference_vec, hessian, MOMENT_FD_STEP};
 use crate::noise::NoiseModel;
-use crate::objective::Objective;
 use crate::solver::{Bfgs, Solver};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::linalg::solvers::{DenseSolveCore, Solve};
 use faer::{Mat, Side};
 use jitterid_jitter::JitterModel;
+use jitterid_optim::finite_diff::{central_difference_vec, hessian, MOMENT_FD_STEP};
+use jitterid_optim::Objective;
 use jitterid_signal::{SampleGrid, Signal};
 use num_complex::Complex64;
 use rustfft::FftPlanner;
@@ -132,9 +132,9 @@ impl<N: NoiseModel> Objective for RestrictedNoise<'_, N> {
 /// measurement part of the shape (`|H|²` less its floor, which is the jitter's and already in
 /// `λ_k`), from `M` samples of the spectrum by one FFT: `M` the power of two at least
 /// `max(16n, 4096)`, the same spectral sampling as
-/// [`noise_autocovariance`](crate::ml::noise_autocovariance) (aliasing error of order
+/// `jitterid_likelihood::noise_autocovariance` (aliasing error of order
 /// `r(M − l)`) in `O(M log M)` instead of `O(M n)`.
-fn measurement_autocovariance<N: NoiseModel>(noise: &N, interval: f64, n: usize) -> Vec<f64> {
+pub fn measurement_autocovariance<N: NoiseModel>(noise: &N, interval: f64, n: usize) -> Vec<f64> {
     let m = (16 * n).max(4096).next_power_of_two();
     let floor = noise.floor();
     let mut z: Vec<Complex64> = (0..m)
@@ -308,15 +308,8 @@ mod tests {
         cost
     }
 
-    #[test]
-    fn the_fft_autocovariance_is_the_direct_sums() {
-        let noise = ArmaNoise::new(vec![0.3], vec![-PHI, 0.2]).unwrap();
-        let fast = measurement_autocovariance(&noise, 0.5, 300);
-        let direct = crate::ml::noise_autocovariance(&noise, 0.5, 300);
-        for (a, b) in fast.iter().zip(&direct) {
-            assert!((a - b).abs() <= 1e-12 * direct[0], "{a} vs {b}");
-        }
-    }
+    // The FFT autocovariance against the likelihood layer's direct sums is tested in
+    // jitterid-likelihood (tests/restricted_noise.rs), which sees both.
 
     #[test]
     fn without_a_mean_the_cost_is_the_kalman_filters_exact_likelihood() {

@@ -1,6 +1,6 @@
 //! The one result type of every estimator: [`Fit`].
 
-use crate::solver::Termination;
+use crate::FitTermination;
 use serde::{Deserialize, Serialize};
 
 /// What [`Fit::cost`] measures.
@@ -15,7 +15,7 @@ pub enum CostKind {
 
 /// An estimate: the free parameters by name, their standard errors and covariance, the final
 /// value of the criterion and how the solver stopped. Returned by [`estimate`](crate::estimate)
-/// (first-moment criteria), [`ml_estimate`](crate::ml::ml_estimate) (likelihood criteria) and
+/// (first-moment criteria), `jitterid_likelihood::ml_estimate` (likelihood criteria) and
 /// the profiles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
@@ -38,7 +38,7 @@ pub struct Fit {
     /// Solver iterations.
     pub iterations: u64,
     /// Why the solver stopped.
-    pub termination: Termination,
+    pub termination: FitTermination,
     /// Whether the solver met a convergence test (and, for criteria with flat residuals, the
     /// residual spectrum passed [`residual_flatness`](crate::residual_flatness)).
     pub converged: bool,

@@ -16,7 +16,8 @@
 //! * [`signal`]: the [`Signal`](signal::Signal) trait, transfer functions, inputs, the exact
 //!   jittered simulator.
 //! * [`window`]: DTFT, FFT, the Dirichlet kernel and the first moment `μ_Y` two ways.
-//! * [`estimate`]: criteria, solvers and model structures.
+//! * [`estimate`]: criteria, solvers and model structures (`jitterid-estimate`), with the
+//!   likelihoods (`jitterid-likelihood`) and the solvers (`jitterid-optim`) beside them.
 //!
 //! Conventions (Hz, no `1/2π`, the corrected uniform-sum characteristic function) are those of
 //! the crate docs of [`jitter`] and [`window`].
@@ -43,7 +44,20 @@
 //! ```
 #![warn(missing_docs)]
 
-pub use jitterid_estimate as estimate;
+/// Estimation: criteria, solvers and model structures, with the likelihood layer as [`ml`](estimate::ml)
+/// and the optimisation layer as [`solver`](estimate::solver). One path for the workspace's
+/// estimation crates (`jitterid-estimate`, `jitterid-likelihood`, `jitterid-optim`,
+/// `jitterid-registry`), as the front ends have always used it.
+pub mod estimate {
+    pub use jitterid_estimate::*;
+    /// The likelihood layer (`jitterid-likelihood`).
+    pub use jitterid_likelihood as ml;
+    pub use jitterid_likelihood::{
+        selection, validation, AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions,
+    };
+    /// The optimisation layer (`jitterid-optim`).
+    pub use jitterid_optim as solver;
+}
 pub use jitterid_jitter as jitter;
 pub use jitterid_signal as signal;
 pub use jitterid_window as window;

@@ -29,7 +29,9 @@ mod builtin;
 mod family;
 mod reader;
 
-pub use family::{Family, ParamSpec};
+pub use family::Family;
+/// The description of one spec-table key, shared by every registry of the workspace.
+pub use jitterid_registry::ParamSpec;
 pub use reader::SpecReader;
 
 use crate::{AnyJitter, JitterError, Shifted};

@@ -1,0 +1,348 @@
+//! Fisher information and Cramér–Rao bounds for jittered samples with white measurement noise.
+//!
+//! * [`gaussian_fisher`]: the Slepian–Bangs formula for independent Gaussian samples with
+//!   mean `m_k(θ)` and variance `λ_k(θ)`,
+//!   `I = Σ_k [∇m_k ∇m_kᵀ / λ_k + ½ ∇λ_k ∇λ_kᵀ / λ_k²]`. It is the information of the Gaussian
+//!   approximation that [`QuasiMl`](super::QuasiMl) maximises, not a bound for the true,
+//!   non-Gaussian data.
+//! * [`exact_fisher`]: the information of the exact model,
+//!   `I = Σ_k ∫ ∇log p(y; θ) ∇log p(y; θ)ᵀ p(y; θ) dy`, by numerical integration over `y`
+//!   (composite 16-point Gauss–Legendre on `[min s − 10σ_v, max s + 10σ_v]` over the jitter's
+//!   reach, 16 nodes per `8σ_v`) with the exact per-sample likelihood of
+//!   [`ExactMl`](super::ExactMl): scores analytic in the signal's parameters and `σ_v`, central
+//!   differences in the jitter's. Its inverse is the Cramér–Rao bound.
+//!
+//! The parameters are the likelihood's ([`likelihood_param_names`](super::likelihood_param_names)):
+//! the structure's free ones, then `σ_v` if the structure does not fix it.
+
+use super::exact::{signal_table, ExactMl, JitterPrep, SampleModel, Scratch, SignalEval};
+use super::fit::spd_inverse;
+use super::moments::second_moments;
+use super::param::{likelihood_param_names, Layout};
+use super::MlError;
+use faer::Mat;
+use jitterid_estimate::ModelStructure;
+use jitterid_estimate::NoiseModel;
+use jitterid_jitter::kernels::gauss::gl16;
+use jitterid_jitter::JitterModel;
+use jitterid_optim::finite_diff::{fd_step, LIKELIHOOD_FD_STEP};
+use jitterid_signal::{SampleGrid, Signal};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// A Fisher information matrix in named parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FisherInformation {
+    /// Parameter names.
+    pub names: Vec<String>,
+    /// The matrix `I[i][j]`.
+    pub matrix: Vec<Vec<f64>>,
+    /// For [`exact_fisher`]: the largest `|∫ p(y) dy − 1|` over the samples, a check of the
+    /// integration over `y`.
+    pub max_mass_error: Option<f64>,
+}
+
+impl FisherInformation {
+    /// The Cramér–Rao bound `I⁻¹`, if `I` is positive definite.
+    pub fn crb(&self) -> Option<Vec<Vec<f64>>> {
+        let p = self.names.len();
+        spd_inverse(&Mat::from_fn(p, p, |i, j| self.matrix[i][j]))
+    }
+
+    /// Square roots of the bound's diagonal.
+    pub fn crb_std(&self) -> Option<Vec<f64>> {
+        let c = self.crb()?;
+        Some((0..c.len()).map(|i| c[i][i].sqrt()).collect())
+    }
+
+    /// The bound's standard deviation of the parameter called `name`.
+    pub fn crb_std_of(&self, name: &str) -> Option<f64> {
+        let i = self.names.iter().position(|n| n == name)?;
+        Some(self.crb_std()?[i])
+    }
+}
+
+/// `√(gᵀ C g)`: the delta-method standard deviation of a function with gradient `g` of an
+/// estimate with covariance `C`.
+///
+/// # Errors
+///
+/// [`MlError::InvalidArgument`] naming `covariance` (with its number of rows) if it does not
+/// have one row per gradient entry, or the first row (by index) of another length.
+pub fn delta_method_std(covariance: &[Vec<f64>], gradient: &[f64]) -> Result<f64, MlError> {
+    let n = gradient.len();
+    if covariance.len() != n {
+        return Err(MlError::InvalidArgument {
+            name: "covariance",
+            value: covariance.len() as f64,
+            reason: "must have one row per gradient entry",
+        });
+    }
+    if let Some(i) = covariance.iter().position(|row| row.len() != n) {
+        return Err(MlError::InvalidArgument {
+            name: "covariance row",
+            value: i as f64,
+            reason: "every row must have one entry per gradient entry",
+        });
+    }
+    let mut v = 0.0;
+    for (i, gi) in gradient.iter().enumerate() {
+        for (j, gj) in gradient.iter().enumerate() {
+            v += gi * covariance[i][j] * gj;
+        }
+    }
+    Ok(v.max(0.0).sqrt())
+}
+
+fn white_only<N: NoiseModel>(noise: &N, what: &'static str) -> Result<(), MlError> {
+    if noise.is_white() {
+        Ok(())
+    } else {
+        Err(MlError::ColouredNoise { criterion: what })
+    }
+}
+
+/// The Slepian–Bangs (Gaussian) Fisher information of the record's samples at `structure`,
+/// with noise level `noise_std` (used when the structure does not fix it).
+///
+/// # Errors
+///
+/// Coloured noise; a vanishing variance `λ_k`; errors of [`second_moments`].
+pub fn gaussian_fisher<S, J, N>(
+    structure: &ModelStructure<S, J, N>,
+    grid: &SampleGrid,
+    noise_std: f64,
+) -> Result<FisherInformation, MlError>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+{
+    white_only(&structure.noise, "gaussian-fisher")?;
+    let m = second_moments(structure, grid, noise_std, true)?;
+    let (Some(dm), Some(dl)) = (&m.mean_gradient, &m.variance_gradient) else {
+        return Err(MlError::Unsupported("no gradient".into()));
+    };
+    let p = dm.len();
+    let mut info = vec![vec![0.0; p]; p];
+    for (k, &lambda) in m.variance.iter().enumerate() {
+        if !(lambda > 0.0 && lambda.is_finite()) {
+            return Err(MlError::VanishingVariance {
+                index: k,
+                variance: lambda,
+            });
+        }
+        for i in 0..p {
+            for j in 0..p {
+                info[i][j] +=
+                    dm[i][k] * dm[j][k] / lambda + 0.5 * dl[i][k] * dl[j][k] / (lambda * lambda);
+            }
+        }
+    }
+    Ok(FisherInformation {
+        names: m.names,
+        matrix: info,
+        max_mass_error: None,
+    })
+}
+
+/// Options of [`exact_fisher`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FisherOptions {
+    /// The likelihood's quadrature.
+    pub quadrature: ExactMl,
+    /// Width, in `σ_v`, of one 16-point sub-interval of the integration over `y`. Default 8.
+    pub y_step: f64,
+    /// Margin, in `σ_v`, beyond the signal's range. Default 10.
+    pub y_margin: f64,
+}
+
+impl Default for FisherOptions {
+    fn default() -> Self {
+        FisherOptions {
+            quadrature: ExactMl {
+                parallel: false,
+                ..ExactMl::default()
+            },
+            y_step: 8.0,
+            y_margin: 10.0,
+        }
+    }
+}
+
+/// The exact model's Fisher information of the record's samples at `structure` with
+/// measurement-noise level `noise_std` (used when the structure does not fix it). See the
+/// module docs. Samples are processed in parallel.
+///
+/// # Errors
+///
+/// Coloured noise, `σ_v = 0`, a reach wider than the record, invalid options, a jitter
+/// parameter that admits no finite difference, a likelihood that underflows inside the
+/// integration range.
+pub fn exact_fisher<S, J, N>(
+    structure: &ModelStructure<S, J, N>,
+    grid: &SampleGrid,
+    noise_std: f64,
+    options: &FisherOptions,
+) -> Result<FisherInformation, MlError>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+{
+    white_only(&structure.noise, "exact-fisher")?;
+    options.quadrature.validate()?;
+    for (name, v) in [("y_step", options.y_step), ("y_margin", options.y_margin)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(MlError::InvalidArgument {
+                name,
+                value: v,
+                reason: "must be finite and > 0",
+            });
+        }
+    }
+    let sigma = structure.noise_std.unwrap_or(noise_std);
+    if !(sigma.is_finite() && sigma > 0.0) {
+        return Err(MlError::NoNoise { value: sigma });
+    }
+    super::criterion::check_reach(&structure.jitter, grid)?;
+    let (lo, hi) = structure.jitter.reach();
+    let layout = Layout::of(structure);
+    let names = likelihood_param_names(structure);
+    let p = layout.len();
+    let signal = &structure.signal;
+    let rate = signal.rate();
+    let ns_grad = if layout.ns > 0 {
+        signal.num_params()
+    } else {
+        0
+    };
+    let table = signal_table(signal, grid, (lo, hi), ns_grad > 0);
+    let mut breaks = signal.breakpoints();
+    breaks.sort_by(f64::total_cmp);
+    let prep = JitterPrep::new(&structure.jitter, rate);
+    // Jitter parameter ± h (one-sided where a side is invalid).
+    let theta_j = structure.jitter.params();
+    let mut shifted = Vec::new();
+    if layout.nj > 0 {
+        for j in 0..layout.nj {
+            let h = fd_step(LIKELIHOOD_FD_STEP, theta_j[j]);
+            let mk = |d: f64| {
+                let mut t = theta_j.clone();
+                t[j] += d;
+                structure
+                    .jitter
+                    .with_params(&t)
+                    .ok()
+                    .map(|jit| JitterPrep::new(&jit, rate))
+            };
+            let (up, dn) = (mk(h), mk(-h));
+            let denom = match (&up, &dn) {
+                (Some(_), Some(_)) => 2.0 * h,
+                (Some(_), None) | (None, Some(_)) => h,
+                (None, None) => {
+                    return Err(MlError::Unsupported(format!(
+                        "jitter parameter {j} = {} admits no finite difference",
+                        theta_j[j]
+                    )))
+                }
+            };
+            shifted.push((up, dn, denom));
+        }
+    }
+    let quad = options.quadrature;
+    let model = |jp| SampleModel {
+        opts: quad,
+        signal: SignalEval {
+            signal,
+            table: &table,
+            grad_channels: ns_grad,
+        },
+        jitter: jp,
+        breaks: &breaks,
+        sigma,
+    };
+    let base = model(&prep);
+    let shifted: Vec<(Option<SampleModel<'_, S>>, Option<SampleModel<'_, S>>, f64)> = shifted
+        .iter()
+        .map(|(up, dn, d)| (up.as_ref().map(model), dn.as_ref().map(model), *d))
+        .collect();
+    let (gx, gw) = gl16();
+    let too_large = || MlError::QuadratureTooLarge {
+        limit: super::exact::MAX_SAMPLE_NODES,
+        noise_std: sigma,
+    };
+    let per_sample = |k: usize| -> Result<(Vec<f64>, f64), MlError> {
+        let t = grid.time(k);
+        let mut scratch = Scratch::default();
+        let (smin, smax) = base.signal_range(t);
+        let ya = smin - options.y_margin * sigma;
+        let yb = smax + options.y_margin * sigma;
+        let m = ((yb - ya) / (options.y_step * sigma)).ceil().max(1.0) as usize;
+        let width = (yb - ya) / m as f64;
+        let mut info = vec![0.0; p * p];
+        let mut mass = 0.0;
+        let mut g = vec![0.0; ns_grad + 1];
+        let mut score = vec![0.0; p];
+        for i in 0..m {
+            let mid = ya + (i as f64 + 0.5) * width;
+            for (x, w) in gx.iter().zip(gw) {
+                let y = mid + 0.5 * width * x;
+                let lp = base
+                    .log_p(t, y, Some(&mut g), &mut scratch)
+                    .map_err(|_| too_large())?;
+                if !lp.is_finite() {
+                    return Err(MlError::LikelihoodUnderflow {
+                        index: k,
+                        y,
+                        log_p: lp,
+                    });
+                }
+                let dens = lp.exp();
+                if dens == 0.0 {
+                    continue;
+                }
+                score[..layout.ns].copy_from_slice(&g[..layout.ns]);
+                for (j, (up, dn, denom)) in shifted.iter().enumerate() {
+                    let f = |sm: &Option<SampleModel<'_, S>>, scratch: &mut Scratch| {
+                        sm.as_ref()
+                            .map(|sm| sm.log_p(t, y, None, scratch).map_err(|_| too_large()))
+                            .transpose()
+                    };
+                    let lu = f(up, &mut scratch)?.unwrap_or(lp);
+                    let ld = f(dn, &mut scratch)?.unwrap_or(lp);
+                    score[layout.ns + j] = (lu - ld) / denom;
+                }
+                if let Some(si) = layout.sigma_index() {
+                    score[si] = g[ns_grad];
+                }
+                let wd = 0.5 * width * w * dens;
+                mass += wd;
+                for a in 0..p {
+                    for b in 0..p {
+                        info[a * p + b] += wd * score[a] * score[b];
+                    }
+                }
+            }
+        }
+        Ok((info, (mass - 1.0).abs()))
+    };
+    let parts: Vec<Result<(Vec<f64>, f64), MlError>> =
+        (0..grid.len()).into_par_iter().map(per_sample).collect();
+    let mut matrix = vec![vec![0.0; p]; p];
+    let mut max_err: f64 = 0.0;
+    for part in parts {
+        let (info, err) = part?;
+        max_err = max_err.max(err);
+        for a in 0..p {
+            for b in 0..p {
+                matrix[a][b] += info[a * p + b];
+            }
+        }
+    }
+    Ok(FisherInformation {
+        names,
+        matrix,
+        max_mass_error: Some(max_err),
+    })
+}

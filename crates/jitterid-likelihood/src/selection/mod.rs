@@ -1,0 +1,450 @@
+//! Model-order and jitter-family selection.
+//!
+//! [`select`] fits every candidate of a [`SelectionGrid`] — a number of zeros and poles (a
+//! transfer function `N(s)/A(s)`, `A` monic) and a jitter family taken from a
+//! [`JitterRegistry`] by name, `"none"` included — with BCLS, each started by the data-driven
+//! initializer ([`jitterid_estimate::initial_model`]) with the jitter at a standard deviation of
+//! `f · T` through [`JitterRegistry::from_std_dev`], once for every fraction `f` of
+//! [`SelectionOptions::jitter_fractions`], keeping the lowest-cost converged fit. Several jitter
+//! starts because the BCLS cost is not convex in the jitter's scale for families whose `γ(f)`
+//! oscillates (periodic: `J₀`, two-point: `cos`): from one start the fit of the true family can
+//! end in a local minimum with the scale far off, and a wrong family would then win.
+//!
+//! Two stages rank the candidates.
+//!
+//! 1. **BCLS screen.** Every candidate gets the BIC of a Gaussian quasi-likelihood of the
+//!    frequency-domain residuals: with independent samples the residual `D(f) = Y(f) − μ_Y(f)`
+//!    has the same variance `Σ_k λ_k` at every frequency, even though the jittered samples are
+//!    heteroscedastic in time, so one common variance is the right nuisance parameter and
+//!    `N ln(cost) + k ln N` (with `k` the number of estimated parameters: gain, numerator and
+//!    denominator coefficients, the jitter's free parameters) is, up to a constant shared by
+//!    all candidates, `−2 log L + k ln N`. It picks the order well (the order shapes the first
+//!    moment) but not always the family: families whose `γ(f)` differ only where the signal
+//!    has little power give nearly the same first moment.
+//! 2. **Exact-likelihood final** ([`SelectionOptions::refine_by_likelihood`]). Within each
+//!    family the candidate the screen ranks first is refitted by exact maximum likelihood
+//!    ([`ExactMl`](crate::ExactMl), the noise level estimated), started at its BCLS
+//!    estimate; so is every jittered family's candidate at the screen winner's order, started
+//!    at the winner's system with the family's jitter at the winner's standard deviation
+//!    (families of equal spread have nearly the same first moment, so this start does not
+//!    depend on the family's own BCLS fits, which can end in a wrong local minimum of the
+//!    jitter's scale). These finalists are ranked by Schwarz's BIC `−2 log L̂ + k ln N` of the
+//!    exact likelihood of independent samples (`k` now counts `σ_v` too). That likelihood
+//!    sees the jitter's whole law through the spread of `s(t_k + τ)`, not only `γ(f)`.
+//!
+//! The ranking: finalists whose likelihood fit converged, by that BIC; then the other
+//! converged candidates by the screen's BIC; then the failed ones, with their reason.
+//! The two BICs are never compared with each other.
+
+use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
+use jitterid_signal::registry::{SignalRegistry, Spec};
+use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
+use rayon::prelude::*;
+use serde_json::json;
+
+use crate::validation::{fit_percent, on_record};
+use jitterid_estimate::{
+    estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record,
+};
+
+mod likelihood;
+
+/// A rectangular grid of candidate model orders and jitter families.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionGrid {
+    /// Inclusive range of the number of poles.
+    pub poles: (usize, usize),
+    /// Inclusive range of the number of zeros.
+    pub zeros: (usize, usize),
+    /// Jitter family names, as the registry knows them (`"none"` for no jitter).
+    pub families: Vec<String>,
+}
+
+/// Settings of [`select`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionOptions {
+    /// Starting jitter standard deviations as fractions of the sampling interval `T`: every
+    /// jittered candidate is fitted from each, and the lowest-cost converged fit is kept.
+    pub jitter_fractions: Vec<f64>,
+    /// Whether the best candidate of each family is refitted by exact maximum likelihood and
+    /// the finalists ranked by the likelihood's BIC (default true); false ranks by the BCLS
+    /// screen alone.
+    pub refine_by_likelihood: bool,
+    /// An input delay (dead time, s, `≥ 0`) every candidate carries as its parameter `delay`,
+    /// estimated with the system from this start (the initializer fits the response to the
+    /// input delayed by it); `None`: no delay. A known delay is not a parameter: pass the
+    /// input delayed by it instead.
+    pub delay: Option<f64>,
+    /// Whether every candidate carries the free response from an unknown state at the record's
+    /// first instant (parameters `initial.0 … initial.{n−1}` for `n` poles, started at 0).
+    pub initial_state: bool,
+}
+
+impl Default for SelectionOptions {
+    fn default() -> Self {
+        Self {
+            jitter_fractions: vec![0.1, 0.25, 0.4],
+            refine_by_likelihood: true,
+            delay: None,
+            initial_state: false,
+        }
+    }
+}
+
+/// One fitted (or failed) candidate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// Number of poles.
+    pub poles: usize,
+    /// Number of zeros.
+    pub zeros: usize,
+    /// Jitter family name.
+    pub family: String,
+    /// The information criterion the candidate is ranked by: the exact likelihood's BIC if
+    /// [`ranked_by_likelihood`](Self::ranked_by_likelihood), else the BCLS BIC; `+∞` for a
+    /// failed candidate.
+    pub criterion: f64,
+    /// Whether the fit that gives [`criterion`](Self::criterion) converged.
+    pub converged: bool,
+    /// Whether the candidate is a finalist whose exact maximum-likelihood fit converged: then
+    /// [`criterion`](Self::criterion), [`parameters`](Self::parameters) and
+    /// [`fitted`](Self::fitted) are those of the likelihood fit.
+    pub ranked_by_likelihood: bool,
+    /// The BIC of the BCLS screen (`+∞` for a candidate whose BCLS fit failed).
+    pub bcls_criterion: f64,
+    /// Whether the BCLS fit converged.
+    pub bcls_converged: bool,
+    /// The exact likelihood's BIC `−2 log L̂ + k ln N` of a finalist, converged or not.
+    pub likelihood_criterion: Option<f64>,
+    /// Why a finalist's likelihood fit failed or did not converge, if it did.
+    pub likelihood_failure: Option<String>,
+    /// The estimated parameters by name (empty for a failed candidate).
+    pub parameters: Vec<(String, f64)>,
+    /// Why the candidate failed, if it did.
+    pub failure: Option<String>,
+    /// The fitted system and jitter (absent for a failed candidate): the rational model
+    /// (registry kind `tf`), with the [`SelectionOptions::delay`] and
+    /// [`SelectionOptions::initial_state`] the selection ran with.
+    pub fitted: Option<(AnySignal, AnyJitter)>,
+}
+
+impl Candidate {
+    /// The normalised fit percent ([`fit_percent`]) of the candidate's expected samples
+    /// `m_k = E[s(t_k + τ)]` against a validation `record` driven by `input`. The fitted
+    /// delay is kept. A candidate with a free response starts from the validation record's own
+    /// state, re-estimated on that record with everything else held
+    /// ([`on_record`], as `jitterid validate` does): the
+    /// estimation record's state says nothing about another record's. `None` for a failed
+    /// candidate, where that re-estimation or the rebuilt model fails, or where the fit percent
+    /// is undefined (constant data).
+    pub fn validation_fit(&self, record: &Record, input: &Input) -> Option<f64> {
+        let (signal, jitter) = self.fitted.as_ref()?;
+        let fitted = ModelStructure::oe(signal.clone(), jitter.clone());
+        let carried = on_record(&fitted, record.grid(), record.y(), Some(input)).ok()?;
+        let m = carried
+            .signal
+            .expected_values(record.grid(), &carried.jitter);
+        fit_percent(record.y(), &m).ok()
+    }
+}
+
+/// Why a selection could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SelectionError {
+    /// A key of the grid holds an invalid value.
+    #[error("select.{key}: {message}")]
+    InvalidKey {
+        /// The offending key.
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+fn invalid(key: &'static str, message: impl Into<String>) -> SelectionError {
+    SelectionError::InvalidKey {
+        key,
+        message: message.into(),
+    }
+}
+
+impl SelectionGrid {
+    /// The (poles, zeros, family) triples of the grid, rejecting bad input by key: an empty
+    /// range, no proper order (zeros > poles everywhere), an unknown family, more parameters
+    /// than the record of `len` samples supports.
+    ///
+    /// # Errors
+    ///
+    /// [`SelectionError::InvalidKey`] naming `poles`, `zeros` or `families`.
+    pub fn candidates(
+        &self,
+        registry: &JitterRegistry,
+        len: usize,
+    ) -> Result<Vec<(usize, usize, String)>, SelectionError> {
+        let (p0, p1) = self.poles;
+        let (z0, z1) = self.zeros;
+        if p0 == 0 || p0 > p1 {
+            return Err(invalid(
+                "poles",
+                format!("[{p0}, {p1}] must be 1 ≤ min ≤ max"),
+            ));
+        }
+        if z0 > z1 {
+            return Err(invalid("zeros", format!("[{z0}, {z1}] must be min ≤ max")));
+        }
+        if z0 > p1 {
+            return Err(invalid(
+                "zeros",
+                format!("at least {z0} zeros but at most {p1} poles: no proper model"),
+            ));
+        }
+        if self.families.is_empty() {
+            return Err(invalid("families", "the list is empty"));
+        }
+        let known: Vec<&str> = registry.families().map(|f| f.name()).collect();
+        for name in &self.families {
+            if !known.contains(&name.as_str()) {
+                return Err(invalid(
+                    "families",
+                    format!("unknown family {name:?}; known: {}", known.join(", ")),
+                ));
+            }
+        }
+        // Levy's linear fit needs 2n + m + 1 real equations from bins below N/2.
+        let needed = 2 * p1 + p1.min(z1) + 2;
+        if needed > len {
+            return Err(invalid(
+                "poles",
+                format!("{p1} poles need at least {needed} samples; the record has {len}"),
+            ));
+        }
+        let mut out = Vec::new();
+        for poles in p0..=p1 {
+            for zeros in z0..=z1.min(poles) {
+                for family in &self.families {
+                    out.push((poles, zeros, family.clone()));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Monic `(s+1)(s+2)…(s+n)`: a stable template of distinct poles (its values are ignored).
+fn template(zeros: usize, poles: usize) -> Result<TransferFunction, String> {
+    let mut den = vec![1.0];
+    for r in 1..=poles {
+        let mut next = vec![0.0; den.len() + 1];
+        for (i, c) in den.iter().enumerate() {
+            next[i] += c;
+            next[i + 1] += c * r as f64;
+        }
+        den = next;
+    }
+    TransferFunction::new(&vec![1.0; zeros + 1], &den).map_err(|e| e.to_string())
+}
+
+type Structure = ModelStructure<AnySignal, AnyJitter, jitterid_estimate::WhiteNoise>;
+
+/// The structure a candidate of `family` is fitted in: its system estimated, its jitter too
+/// unless the family is `"none"`.
+fn structure_of(family: &str, signal: AnySignal, jitter: AnyJitter) -> Structure {
+    if family == "none" {
+        ModelStructure::oe(signal, jitter)
+    } else {
+        ModelStructure::joe(signal, jitter)
+    }
+}
+
+/// The candidate's signal: `model` driven by `input`, with the options' delay and free
+/// response from an unknown state at the record's first instant (coefficients at 0).
+fn candidate_signal(
+    model: &TransferFunction,
+    input: &Input,
+    record: &Record,
+    options: &SelectionOptions,
+) -> Result<AnySignal, String> {
+    let mut spec = Spec::new();
+    spec.insert("kind".into(), json!("tf"));
+    spec.insert("num".into(), json!(model.num()));
+    spec.insert("den".into(), json!(model.den()));
+    if let Some(d) = options.delay {
+        spec.insert("delay".into(), json!(d));
+    }
+    if options.initial_state {
+        spec.insert("initial".into(), json!(vec![0.0; model.den().len() - 1]));
+        spec.insert("origin".into(), json!(record.grid().start()));
+    }
+    SignalRegistry::builtin()
+        .build(&spec, Some(input))
+        .map_err(|e| e.to_string())
+}
+
+/// One BCLS fit of a candidate from the initializer's model with the jitter at `fraction · T`.
+fn fit_from(
+    record: &Record,
+    input: &Input,
+    registry: &JitterRegistry,
+    options: &SelectionOptions,
+    (family, poles, zeros): (&str, usize, usize),
+    fraction: f64,
+) -> Result<(Structure, jitterid_estimate::Fit), String> {
+    let sigma = fraction * record.grid().interval();
+    let jitter = registry
+        .from_std_dev(family, sigma, &serde_json::Map::new())
+        .map_err(|e| format!("jitter start: {e}"))?;
+    let model = template(zeros, poles).map_err(|e| format!("template: {e}"))?;
+    // The initializer fits the response to the input as the system sees it, so that the
+    // rational model does not absorb the delay's phase as well.
+    let driven = match options.delay {
+        Some(d) => input.delayed(d).map_err(|e| format!("delay: {e}"))?,
+        None => input.clone(),
+    };
+    let rational = ModelStructure::oe(LtiResponse::new(model, driven), jitter.clone());
+    let rational = initialize(&rational, record, &InitOptions::default())
+        .map_err(|e| format!("initializer: {e}"))?;
+    let signal = candidate_signal(rational.signal.model(), input, record, options)
+        .map_err(|e| format!("candidate system: {e}"))?;
+    let structure = structure_of(family, signal, rational.jitter);
+    // The ranking needs the cost only; the sandwich covariance would dominate the time.
+    let options = EstimateOptions {
+        covariance: false,
+        ..EstimateOptions::default()
+    };
+    let fit = estimate(&structure, record, &Bcls, &options).map_err(|e| format!("fit: {e}"))?;
+    Ok((structure, fit))
+}
+
+fn fit_candidate(
+    record: &Record,
+    input: &Input,
+    registry: &JitterRegistry,
+    options: &SelectionOptions,
+    (poles, zeros, family): (usize, usize, String),
+) -> Candidate {
+    let failed = |reason: String| Candidate {
+        poles,
+        zeros,
+        family: family.clone(),
+        criterion: f64::INFINITY,
+        converged: false,
+        ranked_by_likelihood: false,
+        bcls_criterion: f64::INFINITY,
+        bcls_converged: false,
+        likelihood_criterion: None,
+        likelihood_failure: None,
+        parameters: Vec::new(),
+        failure: Some(reason),
+        fitted: None,
+    };
+    // "none" has no scale: one start is enough.
+    let fractions: &[f64] = if family == "none" {
+        &options.jitter_fractions[..1]
+    } else {
+        &options.jitter_fractions
+    };
+    let mut best: Option<(Structure, jitterid_estimate::Fit)> = None;
+    let mut last_error = String::new();
+    for &fraction in fractions {
+        match fit_from(
+            record,
+            input,
+            registry,
+            options,
+            (&family, poles, zeros),
+            fraction,
+        ) {
+            Ok((s, fit)) => {
+                let better = match &best {
+                    None => true,
+                    Some((_, b)) => (fit.converged, -fit.cost) > (b.converged, -b.cost),
+                };
+                if better {
+                    best = Some((s, fit));
+                }
+            }
+            Err(e) => last_error = e,
+        }
+    }
+    let Some((structure, fit)) = best else {
+        return failed(last_error);
+    };
+    let n = record.y().len() as f64;
+    let k = fit.params.len() as f64;
+    let criterion = if fit.cost > 0.0 && fit.cost.is_finite() {
+        n * fit.cost.ln() + k * n.ln()
+    } else {
+        return failed(format!("cost {} is not positive and finite", fit.cost));
+    };
+    Candidate {
+        poles,
+        zeros,
+        family,
+        criterion,
+        converged: fit.converged,
+        ranked_by_likelihood: false,
+        bcls_criterion: criterion,
+        bcls_converged: fit.converged,
+        likelihood_criterion: None,
+        likelihood_failure: None,
+        parameters: fit
+            .names
+            .iter()
+            .cloned()
+            .zip(fit.params.iter().copied())
+            .collect(),
+        failure: (!fit.converged).then(|| fit.termination.to_string()),
+        fitted: structure
+            .with_params(&fit.params)
+            .ok()
+            .map(|s| (s.signal, s.jitter)),
+    }
+}
+
+/// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first
+/// (see the [module docs](self)): the finalists ranked by the exact likelihood's BIC, then the
+/// other converged candidates by the BCLS BIC, then the failed ones. Candidates are fitted in
+/// parallel; the order is deterministic (ties broken by grid order).
+///
+/// # Errors
+///
+/// Those of [`SelectionGrid::candidates`].
+pub fn select(
+    record: &Record,
+    input: &Input,
+    grid: &SelectionGrid,
+    registry: &JitterRegistry,
+    options: &SelectionOptions,
+) -> Result<Vec<Candidate>, SelectionError> {
+    let fractions = &options.jitter_fractions;
+    if fractions.is_empty() || !fractions.iter().all(|f| f.is_finite() && *f > 0.0) {
+        return Err(invalid(
+            "jitter_fractions",
+            format!("{fractions:?} must be a non-empty list of positive finite numbers"),
+        ));
+    }
+    let list = grid.candidates(registry, record.y().len())?;
+    let mut out: Vec<Candidate> = list
+        .into_par_iter()
+        .map(|c| fit_candidate(record, input, registry, options, c))
+        .collect();
+    if options.refine_by_likelihood {
+        likelihood::refine_finalists(record, registry, &mut out);
+    }
+    // A stable sort keeps grid order among equal keys: deterministic for any thread count.
+    let group = |c: &Candidate| match (c.ranked_by_likelihood, c.converged) {
+        (true, _) => 0,
+        (false, true) => 1,
+        (false, false) => 2,
+    };
+    out.sort_by(|a, b| {
+        group(a)
+            .cmp(&group(b))
+            .then(a.criterion.total_cmp(&b.criterion))
+    });
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests;
