@@ -1,79 +1,67 @@
-//! Progress on stderr, drawn only when stderr is a terminal: a bar for Monte Carlo runs, the
-//! elapsed time of a single long fit.
+//! Progress on stderr, drawn by [`indicatif`] only when stderr is a terminal: a bar for Monte
+//! Carlo runs, the elapsed time of a single long fit.
 
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use jitterid::estimate::solver::{Progress as SolverProgress, ProgressHook};
-use std::io::{IsTerminal, Write};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::io::IsTerminal;
 use std::sync::{mpsc, Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-/// Counts finished realisations and redraws a bar at most ten times a second.
+/// Where progress is drawn: stderr at most `hz` times a second when it is a terminal (indicatif
+/// also hides it when `TERM` is unset or `dumb`), nowhere otherwise.
+fn stderr_target(hz: u8) -> ProgressDrawTarget {
+    if std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr_with_hz(hz)
+    } else {
+        ProgressDrawTarget::hidden()
+    }
+}
+
+/// Seconds since the bar started, with one decimal.
+fn seconds(state: &ProgressState, w: &mut dyn std::fmt::Write) {
+    let _ = write!(w, "{:.1} s", state.elapsed().as_secs_f64());
+}
+
+/// The time left at the mean pace so far, while some but not all runs are done.
+fn time_left(state: &ProgressState, w: &mut dyn std::fmt::Write) {
+    let (done, total) = (state.pos(), state.len().unwrap_or(0).max(1));
+    if done > 0 && done < total {
+        let secs = state.elapsed().as_secs_f64();
+        let _ = write!(
+            w,
+            ", ~{:.0} s left",
+            secs / done as f64 * (total - done) as f64
+        );
+    }
+}
+
+/// Counts finished realisations on a bar redrawn at most ten times a second:
+/// `[#####     ] 12/40 runs, 3.1 s, ~8 s left`.
 #[derive(Debug)]
 pub struct Progress {
-    total: u64,
-    done: AtomicU64,
-    start: Instant,
-    last: Mutex<Option<Instant>>,
-    enabled: bool,
+    bar: ProgressBar,
 }
 
 impl Progress {
     /// A bar for `total` items (silent unless stderr is a terminal).
     pub fn new(total: u64) -> Self {
-        Self {
-            total,
-            done: AtomicU64::new(0),
-            start: Instant::now(),
-            last: Mutex::new(None),
-            enabled: std::io::stderr().is_terminal(),
-        }
+        let style = ProgressStyle::with_template("[{bar:30}] {pos}/{len} runs, {seconds}{left}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("# ")
+            .with_key("seconds", seconds)
+            .with_key("left", time_left);
+        let bar = ProgressBar::with_draw_target(Some(total), stderr_target(10)).with_style(style);
+        Self { bar }
     }
 
     /// One more item done.
     pub fn tick(&self) {
-        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        if !self.enabled {
-            return;
-        }
-        let Ok(mut last) = self.last.lock() else {
-            return;
-        };
-        let now = Instant::now();
-        if done < self.total && last.is_some_and(|l| now - l < Duration::from_millis(100)) {
-            return;
-        }
-        *last = Some(now);
-        self.draw(done);
+        self.bar.inc(1);
     }
 
-    fn draw(&self, done: u64) {
-        const WIDTH: u64 = 30;
-        let total = self.total.max(1);
-        let filled = (done.min(total) * WIDTH / total) as usize;
-        let secs = self.start.elapsed().as_secs_f64();
-        let eta = if done > 0 && done < total {
-            format!(
-                ", ~{:.0} s left",
-                secs / done as f64 * (total - done) as f64
-            )
-        } else {
-            String::new()
-        };
-        let mut err = std::io::stderr().lock();
-        let _ = write!(
-            err,
-            "\r[{}{}] {done}/{total} runs, {secs:.1} s{eta}   ",
-            "#".repeat(filled),
-            " ".repeat(WIDTH as usize - filled)
-        );
-        let _ = err.flush();
-    }
-
-    /// Ends the bar's line.
+    /// Draws the final count and leaves the line.
     pub fn finish(&self) {
-        if self.enabled {
-            let _ = writeln!(std::io::stderr());
-        }
+        self.bar.finish();
     }
 }
 
@@ -99,6 +87,7 @@ pub fn active_fit_hook() -> Option<ProgressHook> {
 /// line is cleared when the computation ends.
 #[derive(Debug)]
 pub struct Ticker {
+    bar: Option<ProgressBar>,
     stop: Option<mpsc::Sender<()>>,
     handle: Option<std::thread::JoinHandle<()>>,
 }
@@ -113,39 +102,38 @@ impl Ticker {
     pub fn start(what: &str) -> Self {
         if !std::io::stderr().is_terminal() {
             return Self {
+                bar: None,
                 stop: None,
                 handle: None,
             };
         }
-        let (tx, rx) = mpsc::channel::<()>();
-        let what = what.to_string();
         let latest: Latest = Arc::new(Mutex::new(None));
         if let Ok(mut active) = ACTIVE.lock() {
             *active = Some(latest.clone());
         }
-        let handle = std::thread::spawn(move || {
-            let start = Instant::now();
-            if rx.recv_timeout(TICKER_DELAY) != Err(mpsc::RecvTimeoutError::Timeout) {
-                return;
+        let solver = move |_: &ProgressState, w: &mut dyn std::fmt::Write| {
+            if let Some(p) = latest.lock().ok().and_then(|l| *l) {
+                let _ = write!(w, ", iteration {}, cost {:.6e}", p.iteration, p.cost);
             }
-            let drawn = loop {
-                let mut line = format!("{what}: {:.1} s", start.elapsed().as_secs_f64());
-                if let Some(p) = latest.lock().ok().and_then(|l| *l) {
-                    line.push_str(&format!(", iteration {}, cost {:.6e}", p.iteration, p.cost));
-                }
-                let mut err = std::io::stderr().lock();
-                let _ = write!(err, "\r{line}");
-                let _ = err.flush();
-                drop(err);
-                if rx.recv_timeout(TICKER_PERIOD) != Err(mpsc::RecvTimeoutError::Timeout) {
-                    break line.chars().count();
-                }
-            };
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "\r{}\r", " ".repeat(drawn));
-            let _ = err.flush();
+        };
+        let style = ProgressStyle::with_template("{prefix}: {seconds}{solver}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner())
+            .with_key("seconds", seconds)
+            .with_key("solver", solver);
+        // Hidden for the first second; a thread then shows it and indicatif redraws it.
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden())
+            .with_style(style)
+            .with_prefix(what.to_string());
+        let (tx, rx) = mpsc::channel::<()>();
+        let shown = bar.clone();
+        let handle = std::thread::spawn(move || {
+            if rx.recv_timeout(TICKER_DELAY) == Err(mpsc::RecvTimeoutError::Timeout) {
+                shown.set_draw_target(stderr_target(20));
+                shown.enable_steady_tick(TICKER_PERIOD);
+            }
         });
         Self {
+            bar: Some(bar),
             stop: Some(tx),
             handle: Some(handle),
         }
@@ -154,11 +142,14 @@ impl Ticker {
 
 impl Drop for Ticker {
     fn drop(&mut self) {
-        // Closing the channel stops the thread; joining makes the cleared line come before
-        // anything printed next.
+        // Closing the channel stops a thread still waiting to show the line; joining it and
+        // then clearing the line makes the cleared line come before anything printed next.
         self.stop.take();
         if let Some(h) = self.handle.take() {
             let _ = h.join();
+        }
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
         }
         if let Ok(mut active) = ACTIVE.lock() {
             *active = None;

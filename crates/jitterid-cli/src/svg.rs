@@ -1,5 +1,11 @@
 //! A small hand-written SVG plotter: panels with linear or logarithmic axes, lines, markers,
 //! bars, vertical rules, filled bands and a legend.
+//!
+//! Kept hand-written rather than drawn with `plotters` (checked with plotters 0.3.7 and its SVG
+//! backend, issue 26): that backend has no dash pattern (a dashed line becomes one `<polyline>`
+//! per dash, 50 for a ±bound line), no `<path>` (bands are `<polygon>`), integer stroke widths
+//! and coordinates, and upper-case colours; the figure tests (`tests/validate.rs`) find the
+//! dashed 99 % bounds, the stems, the bands and the solid model lines by exactly those marks.
 
 use std::fmt::Write as _;
 
@@ -150,11 +156,23 @@ pub struct Panel {
     pub series: Vec<Series>,
 }
 
+/// `s` as XML text or attribute value: markup characters escaped, and the characters XML 1.0
+/// forbids (control characters other than tab and line ends, U+FFFE, U+FFFF; a title can hold
+/// them through TOML's `\u` escapes) replaced by U+FFFD, so that the file stays well-formed.
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\t' | '\n' | '\r' => out.push(c),
+            c if c < ' ' || c == '\u{fffe}' || c == '\u{ffff}' => out.push('\u{fffd}'),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// A compact label for a tick value.
@@ -825,6 +843,10 @@ mod tests {
         let s = figure("x", "y", &[p], 1);
         assert!(s.starts_with("<svg") && s.ends_with("</svg>\n"));
         assert!(s.contains("no finite data") && s.contains("t &lt;&amp;&gt;"));
+        assert_eq!(
+            esc("a\u{1}\u{1b}\tb\u{ffff}é"),
+            "a\u{fffd}\u{fffd}\tb\u{fffd}é"
+        );
     }
 
     #[test]
