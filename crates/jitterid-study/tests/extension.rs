@@ -162,7 +162,10 @@ perturb = 0.2
 
 #[test]
 fn the_family_is_the_uniform_sum_of_two_terms() {
-    let (t, u) = (Triangle::new(0.5).unwrap(), UniformSum::new(1, 0.5).unwrap());
+    let (t, u) = (
+        Triangle::new(0.5).unwrap(),
+        UniformSum::new(1, 0.5).unwrap(),
+    );
     for f in [0.0, 0.1, 0.7, 1.3, 4.0] {
         assert!((t.cf(f) - u.cf(f)).norm() < 1e-15, "cf at {f}");
     }
