@@ -94,7 +94,6 @@ mod dtft;
 mod error;
 mod frequencies;
 pub mod moment;
-mod phase;
 mod window;
 
 pub use dtft::{dtft, fft_grid, fft_in_place, transform};
