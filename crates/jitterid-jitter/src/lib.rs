@@ -84,7 +84,9 @@ pub use exponential::ExponentialDelay;
 pub use gaussian::Gaussian;
 pub use laplace::Laplace;
 pub use mixture::Mixture;
-pub use model::{sample_n, Atom, JitterModel, TAIL_MASS};
+pub use model::{
+    sample_n, Atom, CfAtParams, InverseSampler, JitterModel, CF_GRADIENT_STEP, TAIL_MASS,
+};
 pub use num_complex;
 pub use periodic::Periodic;
 pub use rule::QuadratureRule;
