@@ -131,4 +131,17 @@ impl JitterError {
     }
 }
 
+impl From<jitterid_numeric::validate::InvalidValue> for JitterError {
+    /// The same parameter, value and problem, as a jitter error.
+    fn from(e: jitterid_numeric::validate::InvalidValue) -> Self {
+        use jitterid_numeric::validate::Problem;
+        let (name, value) = (e.name, e.value);
+        match e.problem {
+            Problem::NotFinite => JitterError::NotFinite { name, value },
+            Problem::NotPositive => JitterError::NotPositive { name, value },
+            Problem::Negative => JitterError::Negative { name, value },
+        }
+    }
+}
+
 pub(crate) use crate::kernels::validate::{finite, param_count, positive};

@@ -2,8 +2,9 @@
 //!
 //! A sensor asked to sample at `t_k = t0 + kT` measures at `t_k + τ_k`, with `τ_k` independent
 //! draws from a jitter distribution `p(τ; θ)`. This crate holds the [`JitterModel`] trait, its
-//! families, the run-time type [`AnyJitter`] with the [`registry`] of families by name, and the
-//! workspace's numerical [`kernels`].
+//! families, the run-time type [`AnyJitter`] with the [`registry`] of families by name, and
+//! [`kernels`], a re-export of the workspace's numerical kernels from their one home, the
+//! crate `jitterid-numeric`.
 //!
 //! Families: [`NoJitter`], [`UniformSum`] (the paper's), [`Gaussian`], [`Laplace`],
 //! [`TwoPoint`], [`ExponentialDelay`], [`Periodic`] (arcsine law of a tone), and the
@@ -84,7 +85,9 @@ pub use exponential::ExponentialDelay;
 pub use gaussian::Gaussian;
 pub use laplace::Laplace;
 pub use mixture::Mixture;
-pub use model::{sample_n, Atom, JitterModel, TAIL_MASS};
+pub use model::{
+    sample_n, Atom, CfAtParams, InverseSampler, JitterModel, CF_GRADIENT_STEP, TAIL_MASS,
+};
 pub use num_complex;
 pub use periodic::Periodic;
 pub use rule::QuadratureRule;

@@ -61,6 +61,10 @@ const WEIGHT_SUM_TOL: f64 = 1e-12;
 impl<J: JitterModel> Mixture<J> {
     /// A mixture of two or more `components` with `weights` (one each, in `(0, 1)`, summing to
     /// 1 within `1e-12`; they are renormalised). The weights are estimated parameters.
+    ///
+    /// Only `w_1 … w_{K−1}` are parameters, so the first weight is stored as
+    /// `1 − Σ_{k≥1} w_k`, exactly as [`with_params`](JitterModel::with_params) rebuilds it:
+    /// it may differ from the given (renormalised) `w_0` in the last bits.
     pub fn new(components: Vec<J>, weights: Vec<f64>) -> Result<Self, JitterError> {
         if components.len() < 2 {
             return Err(JitterError::OutOfRange {
@@ -79,7 +83,10 @@ impl<J: JitterModel> Mixture<J> {
         for &w in &weights {
             check_weight(w)?;
         }
-        let total: f64 = weights.iter().sum();
+        // Summed as w_0 + (w_1 + … + w_{K−1}), the association of `first_weight`: the weights
+        // of a mixture built here then sum to exactly 1, so that rebuilding it from its own
+        // weights (a spec table, serde) leaves them unchanged.
+        let total = weights[0] + weights[1..].iter().sum::<f64>();
         if (total - 1.0).abs() > WEIGHT_SUM_TOL {
             return Err(JitterError::OutOfRange {
                 name: "weights",
@@ -87,8 +94,13 @@ impl<J: JitterModel> Mixture<J> {
                 range: "weights summing to 1",
             });
         }
+        let mut weights: Vec<f64> = weights.iter().map(|w| w / total).collect();
+        // w_0 is not a parameter: `with_params` derives it from the others, and so does the
+        // constructor, so that `with_params(params())` rebuilds the mixture exactly (given
+        // [0.3, 0.7], 1 − 0.7 is 0.30000000000000004, not the double nearest 0.3).
+        weights[0] = check_weight(first_weight(&weights[1..]))?;
         Ok(Mixture {
-            weights: weights.iter().map(|w| w / total).collect(),
+            weights,
             components,
             fixed_weights: false,
         })
@@ -114,6 +126,12 @@ impl<J: JitterModel> Mixture<J> {
     pub fn weights(&self) -> &[f64] {
         &self.weights
     }
+}
+
+/// `w_0 = 1 − Σ_{k≥1} w_k`, the one formula of the first weight (constructor and
+/// `with_params` alike).
+fn first_weight(rest: &[f64]) -> f64 {
+    1.0 - rest.iter().sum::<f64>()
 }
 
 fn check_weight(w: f64) -> Result<f64, JitterError> {
@@ -186,8 +204,7 @@ impl<J: JitterModel + Clone> JitterModel for Mixture<J> {
             for &w in rest {
                 check_weight(w)?;
             }
-            let first = 1.0 - rest.iter().sum::<f64>();
-            let mut w = vec![check_weight(first)?];
+            let mut w = vec![check_weight(first_weight(rest))?];
             w.extend_from_slice(rest);
             w
         };
@@ -349,6 +366,31 @@ mod tests {
             m.param_names(),
             vec!["terms.0.amplitude", "terms.1.d", "weights.1"]
         );
+    }
+
+    #[test]
+    fn with_params_of_params_is_exact_for_any_weights() {
+        // [0.3, 0.7] used to rebuild w_0 as 1 − 0.7 = 0.30000000000000004 ≠ 0.3.
+        let g = |s| Gaussian::new(s).unwrap();
+        for weights in [
+            vec![0.3, 0.7],
+            vec![0.1, 0.2, 0.7],
+            vec![0.7, 0.2, 0.1],
+            vec![1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
+            vec![0.123, 0.456, 0.421],
+        ] {
+            let k = weights.len();
+            let m = Mixture::new((1..=k).map(|i| g(0.01 * i as f64)).collect(), weights).unwrap();
+            let again = m.with_params(&m.params()).unwrap();
+            assert_eq!(again, m);
+            // Independent of the parametrisation: the stored weights sum to 1 exactly, and
+            // the mixture rebuilt from them is the same.
+            assert_eq!(m.weights()[0] + m.weights()[1..].iter().sum::<f64>(), 1.0);
+            let rebuilt = Mixture::new(m.components().to_vec(), m.weights().to_vec()).unwrap();
+            assert_eq!(rebuilt, m);
+        }
+        let m = Mixture::new(vec![g(0.01), g(0.05)], vec![0.3, 0.7]).unwrap();
+        check_contract(&m, 5).unwrap();
     }
 
     #[test]

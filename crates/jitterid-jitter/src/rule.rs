@@ -13,13 +13,8 @@ use crate::JitterModel;
 
 pub use crate::kernels::gauss::{gauss_legendre, gl16, GL_ORDER};
 use crate::kernels::gauss::{panels, subdivisions};
-
-/// Largest `rate × width` allowed on one sub-interval: with 16 nodes the Gauss–Legendre error
-/// for `e^{zτ}` with `|z|·width ≤ 6` is below `1e-15` relative.
-pub const MAX_RATE_WIDTH: f64 = 6.0;
-
-/// Upper bound on the sub-intervals of one piece, so that a huge rate cannot exhaust memory.
-pub const MAX_SUBDIVISIONS: usize = 4096;
+/// Re-exported from the kernels' home, [`jitterid_numeric::gauss`].
+pub use crate::kernels::gauss::{MAX_RATE_WIDTH, MAX_SUBDIVISIONS};
 
 /// A quadrature rule for expectations over the jitter: `E[h(τ)] ≈ Σ weights[i] · h(nodes[i])`.
 #[derive(Debug, Clone, Default, PartialEq)]

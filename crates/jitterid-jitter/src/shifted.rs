@@ -146,6 +146,13 @@ impl<J: JitterModel> JitterModel for Shifted<J> {
             .collect()
     }
 
+    /// The inner family's reach, moved: a family whose support reaches beyond its pieces and
+    /// atoms (the periodic family's ends) keeps it.
+    fn reach(&self) -> (f64, f64) {
+        let (lo, hi) = self.inner.reach();
+        (lo + self.offset, hi + self.offset)
+    }
+
     fn mean(&self) -> f64 {
         self.offset + self.inner.mean()
     }

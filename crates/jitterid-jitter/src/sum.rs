@@ -280,6 +280,13 @@ impl<A: JitterModel + Clone, B: JitterModel + Clone> JitterModel for Sum<A, B> {
         self.a.variance() + self.b.variance()
     }
 
+    /// The sum of the terms' reaches, which is where the sum's draws lie: a term whose support
+    /// reaches beyond its pieces and atoms (the periodic family's ends) keeps it.
+    fn reach(&self) -> (f64, f64) {
+        let ((a_lo, a_hi), (b_lo, b_hi)) = (self.a.reach(), self.b.reach());
+        (a_lo + b_lo, a_hi + b_hi)
+    }
+
     fn sample(&self, rng: &mut dyn RngCore) -> f64 {
         self.a.sample(rng) + self.b.sample(rng)
     }

@@ -15,6 +15,12 @@
 //!
 //! Frequencies and steps are scaled by the model's own spread `s` (its standard deviation, or
 //! the size of its reach if that is zero), so the same checks work for `σ = 1e-9` and `σ = 5`.
+//!
+//! A family that overrides the provided [`mgf`](JitterModel::mgf),
+//! [`cf_gradient`](JitterModel::cf_gradient) or [`sample`](JitterModel::sample) (all shipped
+//! ones do) can also run [`check_overrides`], which holds them against the trait's defaults
+//! through [`ProvidedDefaults`], and [`check_distribution`], a Kolmogorov–Smirnov test of the
+//! sampler.
 
 use crate::{JitterError, JitterModel};
 use num_complex::Complex64;
@@ -485,6 +491,190 @@ fn mean_se(values: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
     let mean = values.clone().sum::<f64>() / n;
     let var = values.map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
     (mean, (var / n).sqrt())
+}
+
+/// A family that forwards every method of `J` except the three with generic defaults,
+/// [`mgf`](JitterModel::mgf), [`cf_gradient`](JitterModel::cf_gradient) and
+/// [`sample`](JitterModel::sample): its values for those are the trait's provided ones, built
+/// from `J`'s required core (and `J`'s own `rule`, `reach` and `atoms`).
+///
+/// [`check_overrides`] holds a family's exact overrides against it; `check_contract` on it
+/// checks the defaults themselves against the contract.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProvidedDefaults<J>(pub J);
+
+impl<J: JitterModel> JitterModel for ProvidedDefaults<J> {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn param_names(&self) -> Vec<String> {
+        self.0.param_names()
+    }
+    fn params(&self) -> Vec<f64> {
+        self.0.params()
+    }
+    fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
+        self.0.with_params(params).map(ProvidedDefaults)
+    }
+    fn cf(&self, f: f64) -> Complex64 {
+        self.0.cf(f)
+    }
+    fn pdf(&self, tau: f64) -> f64 {
+        self.0.pdf(tau)
+    }
+    fn atoms(&self) -> Vec<crate::Atom> {
+        self.0.atoms()
+    }
+    fn pieces(&self) -> Vec<(f64, f64)> {
+        self.0.pieces()
+    }
+    fn mean(&self) -> f64 {
+        self.0.mean()
+    }
+    fn variance(&self) -> f64 {
+        self.0.variance()
+    }
+    fn num_params(&self) -> usize {
+        self.0.num_params()
+    }
+    fn std_dev(&self) -> f64 {
+        self.0.std_dev()
+    }
+    fn reach(&self) -> (f64, f64) {
+        self.0.reach()
+    }
+    fn rule(&self, breaks: &[f64], rate: f64) -> crate::QuadratureRule {
+        self.0.rule(breaks, rate)
+    }
+    fn rule_from(&self, from: f64, breaks: &[f64], rate: f64) -> crate::QuadratureRule {
+        self.0.rule_from(from, breaks, rate)
+    }
+}
+
+/// Acceptance threshold of `√n · D_n` for the Kolmogorov–Smirnov statistic `D_n`: a correct
+/// sampler exceeds it with probability `2e^{-2x²} ≈ 6e-7`, the false-alarm rate of the
+/// [`MC_SIGMAS`] bands (for a law with atoms the test is conservative).
+pub const KS_THRESHOLD: f64 = 2.745;
+
+/// Points at which [`check_distribution`] compares the distribution functions: the empirical
+/// quantiles of order `j/KS_POINTS`.
+pub const KS_POINTS: usize = 200;
+
+/// Kolmogorov–Smirnov test of [`MC_DRAWS`] draws of `model.sample` from
+/// `StdRng::seed_from_u64(seed)` against the distribution function computed independently of
+/// the sampler, `P(τ < t) = 1 − mass of rule_from(t)` (the family's own expectation rule,
+/// plus the atoms at `t` for `P(τ ≤ t)`). Both sides are compared at [`KS_POINTS`] empirical
+/// quantiles, a subset of the points of the full statistic, so `√n · D` over them exceeds
+/// [`KS_THRESHOLD`] with at most the full test's probability for a correct sampler.
+pub fn check_distribution<J: JitterModel + ?Sized>(model: &J, seed: u64) -> Result<(), String> {
+    let mut rng = StdRng::seed_from_u64(seed);
+    let draws: Vec<f64> = (0..MC_DRAWS).map(|_| model.sample(&mut rng)).collect();
+    let mut fails = Vec::new();
+    distribution(model, draws, &mut fails);
+    report(model, fails)
+}
+
+fn distribution<J: JitterModel + ?Sized>(model: &J, mut draws: Vec<f64>, fails: &mut Vec<String>) {
+    if draws.iter().any(|t| !t.is_finite()) {
+        fails.push("a draw is not finite".into());
+        return;
+    }
+    draws.sort_by(f64::total_cmp);
+    let n = draws.len();
+    let atoms = model.atoms();
+    let mut d = 0.0f64;
+    for j in 1..=KS_POINTS {
+        let t = draws[(j * n / KS_POINTS).saturating_sub(1)];
+        // P(τ < t) and P(τ ≤ t), the atoms at t making the difference.
+        let below = 1.0 - model.rule_from(t, &[], 0.0).mass();
+        let at: f64 = atoms
+            .iter()
+            .filter(|a| a.position == t)
+            .map(|a| a.mass)
+            .sum();
+        let lt = draws.partition_point(|&x| x < t) as f64 / n as f64;
+        let le = draws.partition_point(|&x| x <= t) as f64 / n as f64;
+        d = d.max((le - (below + at)).abs()).max((lt - below).abs());
+    }
+    let stat = (n as f64).sqrt() * d;
+    if !(stat <= KS_THRESHOLD) {
+        fails.push(format!(
+            "Kolmogorov–Smirnov: √n·D = {stat:.3} > {KS_THRESHOLD} for {n} draws"
+        ));
+    }
+}
+
+/// Holds a family's overrides of the provided methods against the trait's defaults, computed
+/// by the independent routes of [`ProvidedDefaults`]:
+///
+/// * `mgf` against the default (the family's quadrature rule) at `z = -i2πf` for `2πf·s` up to
+///   30 and at the small real parts of [`check_closed_forms`], to `1e-10` relative;
+/// * `cf_gradient` against the default central differences, to the tolerance of
+///   [`check_closed_forms`]' own difference check;
+/// * `sample` and the default inverse-transform sampler ([`InverseSampler`](crate::InverseSampler))
+///   both pass the Kolmogorov–Smirnov test of [`check_distribution`] (seeds `seed` and
+///   `seed + 1`).
+pub fn check_overrides<J: JitterModel + Clone>(model: &J, seed: u64) -> Result<(), String> {
+    let mut fails = Vec::new();
+    let defaults = ProvidedDefaults(model.clone());
+    let s = spread(model);
+    let zs = RULE_FREQS
+        .iter()
+        .flat_map(|&c| [c, -c])
+        .map(|c| Complex64::new(0.0, -c / s))
+        .chain(
+            [
+                Complex64::new(0.05, 0.0),
+                Complex64::new(-0.05, 0.0),
+                Complex64::new(-0.03, 0.7),
+                Complex64::new(0.02, -2.0),
+            ]
+            .map(|z| z / s),
+        );
+    for z in zs {
+        if let (Some(m), Some(d)) = (model.mgf(z), defaults.mgf(z)) {
+            if !((m - d).norm() <= RULE_CF_TOL * m.norm().max(1.0)) {
+                fails.push(format!("mgf({z}) = {m} but the default gives {d}"));
+            }
+        }
+    }
+    let p = model.params();
+    for c in MODERATE {
+        let f = freq(c, s);
+        let (g, exact, fd) = (model.cf(f), model.cf_gradient(f), defaults.cf_gradient(f));
+        if exact.len() != fd.len() {
+            fails.push(format!(
+                "cf_gradient has {} entries, the default {}",
+                exact.len(),
+                fd.len()
+            ));
+            break;
+        }
+        for (j, (a, b)) in exact.iter().zip(&fd).enumerate() {
+            let scale = p[j].abs().max(s);
+            if !((a - b).norm() <= FD_TOL * (a.norm() + g.norm() / scale)) {
+                fails.push(format!(
+                    "∂γ/∂θ_{j} = {a} but the default central difference gives {b} at 2πf·s = {c}"
+                ));
+            }
+        }
+    }
+    let mut rng = StdRng::seed_from_u64(seed);
+    let draws = (0..MC_DRAWS).map(|_| model.sample(&mut rng)).collect();
+    distribution(model, draws, &mut fails);
+    // The default `sample` is one draw of an `InverseSampler` built afresh; building it once
+    // gives the same draws without recomputing the pieces' masses for each.
+    let mut rng = StdRng::seed_from_u64(seed.wrapping_add(1));
+    let sampler = crate::InverseSampler::new(model);
+    let draws = (0..MC_DRAWS).map(|_| sampler.draw(&mut rng)).collect();
+    let mut default_fails = Vec::new();
+    distribution(model, draws, &mut default_fails);
+    fails.extend(
+        default_fails
+            .into_iter()
+            .map(|f| format!("default sampler: {f}")),
+    );
+    report(model, fails)
 }
 
 #[cfg(test)]

@@ -192,20 +192,28 @@ impl SignalError {
     }
 }
 
-pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SignalError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(SignalError::NotFinite { name, value })
+impl From<jitterid_numeric::validate::InvalidValue> for SignalError {
+    /// The same name and value as a signal error; a negative value where a non-negative one
+    /// was needed reads as not positive (the signal crate asks only for finite and positive
+    /// values).
+    fn from(e: jitterid_numeric::validate::InvalidValue) -> Self {
+        use jitterid_numeric::validate::Problem;
+        let (name, value) = (e.name, e.value);
+        match e.problem {
+            Problem::NotFinite => SignalError::NotFinite { name, value },
+            Problem::NotPositive | Problem::Negative => SignalError::NotPositive { name, value },
+        }
     }
 }
 
+/// [`jitterid_numeric::validate::finite`], as a signal error.
+pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SignalError> {
+    Ok(jitterid_numeric::validate::finite(name, value)?)
+}
+
+/// [`jitterid_numeric::validate::positive`], as a signal error.
 pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, SignalError> {
-    if finite(name, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(SignalError::NotPositive { name, value })
-    }
+    Ok(jitterid_numeric::validate::positive(name, value)?)
 }
 
 pub(crate) fn all_finite(name: &'static str, values: &[f64]) -> Result<(), SignalError> {

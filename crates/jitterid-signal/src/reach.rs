@@ -36,11 +36,11 @@
 //! moment `E[s(t_k + τ)²]`, and tells when they would still be too large (the response then
 //! expands the square and uses [`InReach`] at sums of poles).
 
-use jitterid_jitter::kernels::chebyshev::ChebyshevBasis;
-use jitterid_jitter::kernels::complex::cexp;
-use jitterid_jitter::kernels::filon::FilonIntegrand;
-use jitterid_jitter::kernels::gauss::{gl16, panels, subdivisions, GL_ORDER};
 use jitterid_jitter::JitterModel;
+use jitterid_numeric::chebyshev::ChebyshevBasis;
+use jitterid_numeric::complex::cexp;
+use jitterid_numeric::filon::FilonIntegrand;
+use jitterid_numeric::gauss::{gl16, panels, subdivisions, GL_ORDER};
 use num_complex::Complex64;
 use std::sync::OnceLock;
 

@@ -25,12 +25,12 @@
 use crate::{
     Jacobian, PiecewiseConstant, RandomBinary, Root, SampleGrid, Signal, SignalError, Zpk,
 };
-use jitterid_jitter::rule::gl16;
 use jitterid_jitter::JitterModel;
+use jitterid_numeric::clenshaw_curtis::cc17;
+use jitterid_numeric::gauss::gl16;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use std::fmt::Write as _;
-use std::sync::OnceLock;
 
 /// Relative finite-difference step for parameter derivatives, scaled by `max(|θ_j|, 1)`.
 const FD_STEP: f64 = 1e-6;
@@ -147,30 +147,7 @@ fn panel(g: &dyn Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
             .sum::<f64>()
             * half
     };
-    (rule(gl16()), rule(clenshaw_curtis()))
-}
-
-/// Nodes `cos(kπ/16)` and weights of the 17-point Clenshaw–Curtis rule on `[-1, 1]`.
-fn clenshaw_curtis() -> &'static (Vec<f64>, Vec<f64>) {
-    static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    RULE.get_or_init(|| {
-        const N: usize = 16;
-        let theta = |k: usize| k as f64 * std::f64::consts::PI / N as f64;
-        let nodes = (0..=N).map(|k| theta(k).cos()).collect();
-        let weights = (0..=N)
-            .map(|k| {
-                let sum: f64 = (1..=N / 2)
-                    .map(|j| {
-                        let b = if j == N / 2 { 1.0 } else { 2.0 };
-                        b / (4.0 * (j * j) as f64 - 1.0) * (2.0 * j as f64 * theta(k)).cos()
-                    })
-                    .sum();
-                let c = if k == 0 || k == N { 1.0 } else { 2.0 };
-                c / N as f64 * (1.0 - sum)
-            })
-            .collect();
-        (nodes, weights)
-    })
+    (rule(gl16()), rule(cc17()))
 }
 
 /// Halves `[a, b]` until the Gauss rule on the panel agrees with the sum over its halves and,

@@ -169,3 +169,91 @@ fn a_rate_too_low_is_caught() {
     let err = check_contract(&signal, &j, &grid(), 3).unwrap_err();
     assert!(err.contains("breakpoints() and rate() sufficient"), "{err}");
 }
+
+/// `check_contract` of one signal, against a jitter and with a seed.
+type Check = Box<dyn Fn(&dyn JitterModel, u64) -> Result<(), String>>;
+
+/// Signals of every kind with parameters drawn from `seed` (asymmetric pole pairs, zeros on
+/// either side, arbitrary phases and pulse coefficients), each checked against jitter families
+/// that `jitters()` leaves out (an asymmetric mixture, a dual-Dirac sum, a shifted one-sided
+/// delay) with parameters drawn too.
+#[test]
+fn every_signal_kind_passes_at_random_parameters() {
+    use jitterid_jitter::{Mixture, Sum};
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+    for seed in 0..3u64 {
+        let mut rng = StdRng::seed_from_u64(900 + seed);
+        let mut r = |lo: f64, hi: f64| rng.random_range(lo..hi);
+        let spread = r(0.05, 0.3);
+        // Not yet the periodic family: with it the LTI route's m_k differs from the
+        // reference integration by about 4e-8 (seed 0, zpk), above the check's tolerance,
+        // an open question about the in-reach integrals near the arcsine law's ends.
+        let jitters: Vec<Box<dyn JitterModel>> = vec![
+            Box::new(
+                Mixture::new(
+                    vec![
+                        Gaussian::new(spread * r(0.2, 1.0)).unwrap(),
+                        Gaussian::new(spread * r(0.5, 2.0)).unwrap(),
+                    ],
+                    {
+                        let w = r(0.1, 0.9);
+                        vec![w, 1.0 - w]
+                    },
+                )
+                .unwrap(),
+            ),
+            Box::new(Sum::new(
+                Gaussian::new(spread * r(0.1, 0.5)).unwrap(),
+                TwoPoint::new(spread * r(0.2, 1.0)).unwrap(),
+            )),
+            Box::new(
+                Shifted::new(
+                    ExponentialDelay::new(spread * r(0.2, 1.0)).unwrap(),
+                    -r(0.0, spread),
+                )
+                .unwrap(),
+            ),
+        ];
+        let u = binary(seed + 40, r(2.0, 5.0), -5.0, 35.0).unwrap();
+        let zpk = eq17(r(0.1, 2.0), r(-2.0, 2.0), -r(0.1, 1.0), r(0.1, 1.5)).unwrap();
+        let tf = TransferFunction::new(
+            &[r(-1.0, 1.0), r(0.2, 2.0)],
+            &[1.0, r(0.5, 3.0), r(0.2, 2.0)],
+        )
+        .unwrap();
+        let sinusoid = Sinusoid::new(r(0.2, 2.0), r(0.05, 0.45), r(-3.0, 3.0)).unwrap();
+        let pulse_input = PiecewiseConstant::zero_order_hold(
+            -3.0,
+            0.5,
+            &[r(-1.0, 1.0), r(-1.0, 1.0), r(0.0, 2.0)],
+        )
+        .unwrap();
+        let pulse =
+            PulseResponse::new(vec![r(0.1, 1.0), r(-0.5, 0.5)], r(0.2, 0.6), pulse_input).unwrap();
+        let signals: Vec<(&str, Check)> = vec![
+            ("zpk", {
+                let s = LtiResponse::new(zpk, u.clone());
+                Box::new(move |j: &dyn JitterModel, k| check_contract(&s, j, &grid(), k))
+            }),
+            ("tf", {
+                let s = LtiResponse::new(tf, u.clone());
+                Box::new(move |j: &dyn JitterModel, k| check_contract(&s, j, &grid(), k))
+            }),
+            (
+                "sinusoid",
+                Box::new(move |j: &dyn JitterModel, k| check_contract(&sinusoid, j, &grid(), k)),
+            ),
+            (
+                "pulse",
+                Box::new(move |j: &dyn JitterModel, k| check_contract(&pulse, j, &grid(), k)),
+            ),
+        ];
+        for (name, check) in &signals {
+            for (i, j) in jitters.iter().enumerate() {
+                check(j.as_ref(), 70 + 10 * seed + i as u64)
+                    .unwrap_or_else(|e| panic!("seed {seed}, {name}, {}: {e}", j.name()));
+            }
+        }
+    }
+}

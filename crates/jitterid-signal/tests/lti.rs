@@ -294,7 +294,7 @@ fn nearly_repeated_poles_follow_the_closed_form() {
             .sum()
     };
     // (x, w) of 16-point Gauss–Legendre on [−1, 1], from the jitter crate's tables.
-    let (nodes, weights) = jitterid_jitter::kernels::gauss::gl16();
+    let (nodes, weights) = jitterid_numeric::gauss::gl16();
     let uniform_mean = |d: f64, t: f64| -> f64 {
         let mut cuts: Vec<f64> = vec![t - a, t + a];
         cuts.extend(

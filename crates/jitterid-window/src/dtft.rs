@@ -19,9 +19,9 @@
 //! `f·k·T` up to `10^7` cycles.
 
 use crate::frequencies::FrequencySet;
-use crate::phase::{cis_neg_cycles, Cycles};
 use crate::window::Window;
 use crate::WindowError;
+use jitterid_numeric::phase::{cis_neg_cycles, Cycles};
 use jitterid_signal::SampleGrid;
 use num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};

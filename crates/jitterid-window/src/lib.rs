@@ -88,13 +88,14 @@
 //! * [`dtft()`], [`fft_grid`], [`transform`]: transforms of a record.
 //! * [`moment`]: the first moment `μ_Y`, both routes.
 //! * [`WindowError`]: everything that can go wrong.
+//! * [`testing`]: the contract every [`Window`] must meet, as a check to run in tests.
 #![warn(missing_docs)]
 
 mod dtft;
 mod error;
 mod frequencies;
 pub mod moment;
-mod phase;
+pub mod testing;
 mod window;
 
 pub use dtft::{dtft, fft_grid, fft_in_place, transform};

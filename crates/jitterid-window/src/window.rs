@@ -6,7 +6,7 @@
 //! `μ_Y(f) = ∫ S_c(ψ) γ(-ψ) e^{i2πψ t0} K(f-ψ) dψ`.
 
 use crate::dtft::dtft_at;
-use crate::phase::{cis_neg_half_cycles, sin_pi_times, Cycles};
+use jitterid_numeric::phase::{cis_neg_half_cycles, sin_pi_times, Cycles};
 use jitterid_signal::SampleGrid;
 use num_complex::Complex64;
 use std::f64::consts::PI;

@@ -1,5 +1,6 @@
 //! Validators for a family's constructor: each returns the value or a
-//! [`JitterError`] that names the parameter.
+//! [`JitterError`] that names the parameter. The tests themselves are those of
+//! [`jitterid_numeric::validate`], whose error converts into a `JitterError` with `?`.
 //!
 //! ```
 //! use jitterid_jitter::kernels::validate::{finite, param_count, positive};
@@ -11,32 +12,21 @@
 //! ```
 
 use crate::JitterError;
+use jitterid_numeric::validate as numeric;
 
 /// Checks that `value` is finite; the error names the parameter.
 pub fn finite(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(JitterError::NotFinite { name, value })
-    }
+    Ok(numeric::finite(name, value)?)
 }
 
 /// Checks that `value` is finite and strictly positive.
 pub fn positive(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if finite(name, value)? > 0.0 {
-        Ok(value)
-    } else {
-        Err(JitterError::NotPositive { name, value })
-    }
+    Ok(numeric::positive(name, value)?)
 }
 
 /// Checks that `value` is finite and not negative.
 pub fn non_negative(name: &'static str, value: f64) -> Result<f64, JitterError> {
-    if finite(name, value)? >= 0.0 {
-        Ok(value)
-    } else {
-        Err(JitterError::Negative { name, value })
-    }
+    Ok(numeric::non_negative(name, value)?)
 }
 
 /// Checks the length of a parameter vector given to `with_params` (`model` is the family's

@@ -4,9 +4,9 @@
 //! in the docs of the parent module, [`crate::moment`].
 
 use crate::dtft::CompensatedSum;
-use crate::phase::{cis_cycles, frac_prod};
 use crate::{FrequencySet, Window, WindowError};
 use jitterid_jitter::JitterModel;
+use jitterid_numeric::phase::{cis_cycles, frac_prod};
 use jitterid_signal::{SampleGrid, Spectrum};
 use num_complex::Complex64;
 

@@ -131,7 +131,7 @@ pub fn i0_real(w: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels::gauss::integrate;
+    use crate::gauss::integrate;
 
     /// Independent route: `J_n(x) = (1/π)∫_0^π cos(nθ − x sin θ) dθ` by refined Gauss–Legendre.
     fn bessel_integral(n: f64, x: f64) -> f64 {

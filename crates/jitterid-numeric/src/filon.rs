@@ -145,7 +145,7 @@ pub fn filon_exp(values: &[f64; GL_ORDER], omega: Complex64) -> (Complex64, Comp
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels::gauss::integrate;
+    use crate::gauss::integrate;
 
     /// Independent route: Gauss–Legendre refined to width `1/|ω|`.
     fn refined(f: impl Fn(f64) -> f64, omega: Complex64, weight: impl Fn(f64) -> f64) -> Complex64 {

@@ -1,8 +1,14 @@
 //! Gauss–Legendre rules: nodes and weights on `[-1, 1]`, and the cached 16-point rule that the
 //! expectation rules, the signal crate's reach integrals and the exact likelihood share.
 
-use crate::rule::{MAX_RATE_WIDTH, MAX_SUBDIVISIONS};
 use std::sync::OnceLock;
+
+/// Largest `rate × width` allowed on one sub-interval: with 16 nodes the Gauss–Legendre error
+/// for `e^{zτ}` with `|z|·width ≤ 6` is below `1e-15` relative.
+pub const MAX_RATE_WIDTH: f64 = 6.0;
+
+/// Upper bound on the sub-intervals of one piece, so that a huge rate cannot exhaust memory.
+pub const MAX_SUBDIVISIONS: usize = 4096;
 
 /// Number of Gauss–Legendre nodes per sub-interval of the workspace's rules.
 pub const GL_ORDER: usize = 16;
@@ -11,7 +17,7 @@ pub const GL_ORDER: usize = 16;
 /// Legendre recurrence. Nodes are increasing and symmetric.
 ///
 /// ```
-/// use jitterid_jitter::kernels::gauss::gauss_legendre;
+/// use jitterid_numeric::gauss::gauss_legendre;
 /// let (x, w) = gauss_legendre(3);
 /// assert!((x[2] - 0.6f64.sqrt()).abs() < 1e-15 && (w[1] - 8.0 / 9.0).abs() < 1e-15);
 /// ```
@@ -58,7 +64,7 @@ pub fn gl16() -> &'static (Vec<f64>, Vec<f64>) {
 /// [`MAX_SUBDIVISIONS`] (one for a rate or width that is not positive and finite).
 ///
 /// ```
-/// use jitterid_jitter::kernels::gauss::subdivisions;
+/// use jitterid_numeric::gauss::subdivisions;
 /// assert_eq!((subdivisions(7.0, 1.0), subdivisions(f64::NAN, 1.0)), (2, 1));
 /// ```
 pub fn subdivisions(rate: f64, width: f64) -> usize {
@@ -74,7 +80,7 @@ pub fn subdivisions(rate: f64, width: f64) -> usize {
 /// `mid + half · x_i` with weight `half · w_i`.
 ///
 /// ```
-/// use jitterid_jitter::kernels::gauss::panels;
+/// use jitterid_numeric::gauss::panels;
 /// let p: Vec<(f64, f64)> = panels(0.0, 2.0, 2).collect();
 /// assert_eq!(p, vec![(0.5, 0.5), (1.5, 0.5)]);
 /// ```
@@ -91,7 +97,7 @@ pub fn panels(a: f64, b: f64, parts: usize) -> impl Iterator<Item = (f64, f64)> 
 /// `∫_a^b f(t) dt` by the 16-point rule on `parts` equal sub-intervals (at least one).
 ///
 /// ```
-/// use jitterid_jitter::kernels::gauss::integrate;
+/// use jitterid_numeric::gauss::integrate;
 /// let s = integrate(0.0, std::f64::consts::PI, 1, f64::sin);
 /// assert!((s - 2.0).abs() < 1e-15);
 /// ```

@@ -1,6 +1,6 @@
 //! Merging the smooth pieces of several laws.
 //!
-//! A family's [`pieces`](crate::JitterModel::pieces) are sorted, disjoint intervals on which
+//! A jitter family's pieces (`JitterModel::pieces` in `jitterid-jitter`) are sorted, disjoint intervals on which
 //! its density is smooth. A law built from several families (a mixture, or a sum with a
 //! discrete term) has a density that is smooth between the knots of all of them, so its
 //! pieces are the union of theirs cut at every knot: [`merge_pieces`].
@@ -10,7 +10,7 @@
 /// union. Empty or non-finite input intervals are ignored.
 ///
 /// ```
-/// use jitterid_jitter::kernels::pieces::merge_pieces;
+/// use jitterid_numeric::pieces::merge_pieces;
 /// let merged = merge_pieces(&[vec![(0.0, 2.0)], vec![(1.0, 3.0), (5.0, 6.0)]]);
 /// assert_eq!(merged, vec![(0.0, 1.0), (1.0, 2.0), (2.0, 3.0), (5.0, 6.0)]);
 /// ```

@@ -125,7 +125,7 @@ impl ChebyshevBasis {
 /// `Σ c_j T_j(x)` by Clenshaw's recurrence (0 for no coefficient).
 ///
 /// ```
-/// use jitterid_jitter::kernels::chebyshev::clenshaw;
+/// use jitterid_numeric::chebyshev::clenshaw;
 /// // T_2(x) = 2x² - 1.
 /// assert_eq!(clenshaw(&[0.0, 0.0, 1.0], 0.5), -0.5);
 /// ```

@@ -7,7 +7,7 @@ use num_complex::Complex64;
 /// result is then 1 instead of a NaN from `sin(∞)`.
 ///
 /// ```
-/// use jitterid_jitter::kernels::complex::phasor;
+/// use jitterid_numeric::complex::phasor;
 /// let e = phasor(0.25); // e^{-iπ/2} = -i
 /// assert!(e.re.abs() < 1e-16 && (e.im + 1.0).abs() < 1e-16);
 /// assert_eq!(phasor(1e300).re, 1.0);
@@ -30,7 +30,7 @@ pub fn phasor(x: f64) -> Complex64 {
 /// modulus underflows (so that a huge imaginary part cannot turn `0 · sin(∞)` into a NaN).
 ///
 /// ```
-/// use jitterid_jitter::kernels::complex::cexp;
+/// use jitterid_numeric::complex::cexp;
 /// use num_complex::Complex64;
 /// assert_eq!(cexp(Complex64::new(1e3, 0.0)), Complex64::new(f64::INFINITY, 0.0));
 /// assert_eq!(cexp(Complex64::new(-1e3, 1e300)), Complex64::new(0.0, 0.0));

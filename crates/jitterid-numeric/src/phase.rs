@@ -4,6 +4,16 @@
 //! A product `a·b` of two doubles is split exactly into `hi + lo` with a fused multiply-add
 //! (`lo = fma(a, b, -hi)`); the integer part of `hi` is removed exactly (`hi - round(hi)` is
 //! exact by Sterbenz's lemma), and only then is `lo` added.
+//!
+//! The window crate's DTFTs, Dirichlet kernels and first moments reduce their phases here.
+//!
+//! ```
+//! use jitterid_numeric::phase::{frac_prod, Cycles};
+//! // 0.1 · 1e15 keeps its fractional part 0.00555…: the product is split exactly.
+//! assert!((frac_prod(0.1, 1e15) - 0.005_551_115_123_125_783).abs() < 1e-15);
+//! // 3 Hz at T = 0.5 s is 1.5 cycles per sample: 12 345 samples are half a cycle.
+//! assert_eq!(Cycles::new(3.0, 0.5).times(12345.0).abs(), 0.5);
+//! ```
 
 use num_complex::Complex64;
 use std::f64::consts::{PI, TAU};
@@ -25,7 +35,7 @@ fn centred_frac(x: f64) -> f64 {
 /// unevaluated sum `hi + lo` (`hi ∈ [-0.5, 0.5]`, `|lo| ≲ 1e-16`), so that phases `k·x` can
 /// be reduced modulo one cycle without losing the digits `f·T` has above the unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Cycles {
+pub struct Cycles {
     hi: f64,
     lo: f64,
 }
@@ -33,7 +43,7 @@ pub(crate) struct Cycles {
 impl Cycles {
     /// `f·T` reduced modulo 1.
     #[inline]
-    pub(crate) fn new(f: f64, interval: f64) -> Self {
+    pub fn new(f: f64, interval: f64) -> Self {
         let (p, e) = two_prod(f, interval);
         Self {
             hi: centred_frac(p),
@@ -44,7 +54,7 @@ impl Cycles {
     /// The same frequency shifted by `d` cycles per sample (`d` small, such as `±1/N`),
     /// reduced again, without rounding the sum.
     #[inline]
-    pub(crate) fn shifted(self, d: f64) -> Self {
+    pub fn shifted(self, d: f64) -> Self {
         // two-sum of hi and d
         let s = self.hi + d;
         let bb = s - self.hi;
@@ -58,20 +68,20 @@ impl Cycles {
 
     /// The reduced value `x mod 1`, rounded to a double, in about `[-0.5, 0.5]`.
     #[inline]
-    pub(crate) fn value(self) -> f64 {
+    pub fn value(self) -> f64 {
         self.hi + self.lo
     }
 
     /// Whether the value is finite.
     #[inline]
-    pub(crate) fn is_finite(self) -> bool {
+    pub fn is_finite(self) -> bool {
         self.hi.is_finite() && self.lo.is_finite()
     }
 
     /// `k·x` reduced modulo 1 into about `[-0.5, 0.5]`, with an absolute error of a few
     /// `1e-17` for any `k` below `2^53`.
     #[inline]
-    pub(crate) fn times(self, k: f64) -> f64 {
+    pub fn times(self, k: f64) -> f64 {
         let (p, e) = two_prod(k, self.hi);
         let s = centred_frac(p) + (e + k * self.lo);
         centred_frac(s)
@@ -80,7 +90,7 @@ impl Cycles {
     /// `k·x` reduced modulo 2 into about `[-1, 1]` (for half-angle formulas), as accurately
     /// as [`times`](Self::times).
     #[inline]
-    pub(crate) fn times_mod2(self, k: f64) -> f64 {
+    pub fn times_mod2(self, k: f64) -> f64 {
         let (p, e) = two_prod(k, self.hi);
         let r = p - 2.0 * (0.5 * p).round();
         let s = r + (e + k * self.lo);
@@ -90,28 +100,28 @@ impl Cycles {
 
 /// `e^{-i2πφ}` for a phase `φ` in cycles.
 #[inline]
-pub(crate) fn cis_neg_cycles(phi: f64) -> Complex64 {
+pub fn cis_neg_cycles(phi: f64) -> Complex64 {
     let (s, c) = (TAU * phi).sin_cos();
     Complex64::new(c, -s)
 }
 
 /// `e^{+i2πφ}` for a phase `φ` in cycles.
 #[inline]
-pub(crate) fn cis_cycles(phi: f64) -> Complex64 {
+pub fn cis_cycles(phi: f64) -> Complex64 {
     let (s, c) = (TAU * phi).sin_cos();
     Complex64::new(c, s)
 }
 
 /// `e^{-iπφ}` for a half-phase `φ` (so `φ = 2` is a full cycle).
 #[inline]
-pub(crate) fn cis_neg_half_cycles(phi: f64) -> Complex64 {
+pub fn cis_neg_half_cycles(phi: f64) -> Complex64 {
     let (s, c) = (PI * phi).sin_cos();
     Complex64::new(c, -s)
 }
 
 /// `(a·b) mod 1` in about `[-0.5, 0.5]`, with an absolute error near `1e-16`.
 #[inline]
-pub(crate) fn frac_prod(a: f64, b: f64) -> f64 {
+pub fn frac_prod(a: f64, b: f64) -> f64 {
     let (p, e) = two_prod(a, b);
     centred_frac(centred_frac(p) + e)
 }
@@ -119,7 +129,7 @@ pub(crate) fn frac_prod(a: f64, b: f64) -> f64 {
 /// `sin(π·k·x)` for `x` in cycles per sample, exact up to rounding of the final sine: the
 /// product is reduced modulo 2 first.
 #[inline]
-pub(crate) fn sin_pi_times(x: Cycles, k: f64) -> f64 {
+pub fn sin_pi_times(x: Cycles, k: f64) -> f64 {
     (PI * x.times_mod2(k)).sin()
 }
 
