@@ -2,6 +2,7 @@
 #![allow(clippy::type_complexity)]
 
 mod demo;
+mod outputs;
 mod paper;
 mod reproduce;
 mod reproduce_initial;

@@ -1,5 +1,6 @@
 //! `cargo xtask reproduce <case>`: the paper's experiments and the project's demonstrations.
 
+use crate::outputs::{fmt_opt, runs_range, write_outputs};
 use crate::paper::{self, NOISE_STD, RUNS};
 use crate::Options;
 use jitterid::estimate::montecarlo::{run as mc_run, Summary};
@@ -41,10 +42,6 @@ pub(crate) fn row(
     }
 }
 
-pub(crate) fn fmt_opt(x: Option<f64>) -> String {
-    x.map_or("–".into(), |v| format!("{v:.4}"))
-}
-
 pub(crate) fn table(rows: &[ParamRow], paper: Option<&[(f64, f64)]>) -> String {
     let mut s = String::from(
         "| parameter | true | paper mean | paper std | mean | std | se of mean | asymptotic std | (mean − true)/se |\n|---|---|---|---|---|---|---|---|---|\n",
@@ -70,38 +67,6 @@ pub(crate) fn table(rows: &[ParamRow], paper: Option<&[(f64, f64)]>) -> String {
         );
     }
     s
-}
-
-pub(crate) fn write_outputs(
-    case: &str,
-    o: &Options,
-    value: &serde_json::Value,
-    md: &str,
-) -> Result<(), String> {
-    std::fs::create_dir_all(&o.out).map_err(|e| format!("{}: {e}", o.out))?;
-    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
-    let suffix = if o.shard.1 > 1 {
-        format!(".shard{}of{}", o.shard.0, o.shard.1)
-    } else {
-        String::new()
-    };
-    for (path, body) in [
-        (format!("{}/{case}{suffix}.json", o.out), &text),
-        (format!("{}/{case}{suffix}.md", o.out), &md.to_string()),
-    ] {
-        std::fs::write(&path, body).map_err(|e| format!("{path}: {e}"))?;
-    }
-    if let Some(path) = &o.json {
-        std::fs::write(path, text).map_err(|e| format!("{path}: {e}"))?;
-    }
-    println!("{md}");
-    Ok(())
-}
-
-pub(crate) fn runs_range(o: &Options, default: u64) -> std::ops::Range<u64> {
-    let total = o.runs.unwrap_or(default);
-    let (i, n) = o.shard;
-    (total * i / n)..(total * (i + 1) / n)
 }
 
 pub fn run(case: &str, o: &Options) -> Result<(), String> {

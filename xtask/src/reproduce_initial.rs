@@ -11,8 +11,8 @@
 //! a residual spectrum that is not flat (the symptom of the missing free response), which the
 //! command line's own summary leaves out.
 
+use crate::outputs::{fmt_opt, write_outputs};
 use crate::paper::RUNS;
-use crate::reproduce::{fmt_opt, write_outputs};
 use crate::Options;
 use jitterid::estimate::montecarlo::Summary;
 use jitterid_study::experiment::{self, Purpose};

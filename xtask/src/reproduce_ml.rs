@@ -1,7 +1,7 @@
 //! Reproduction cases of maximum-likelihood estimation: `table1-ml` and `sine`.
 
+use crate::outputs::{runs_range, write_outputs};
 use crate::paper::{self, NOISE_STD, RUNS};
-use crate::reproduce::{runs_range, write_outputs};
 use crate::Options;
 use jitterid::estimate::ml::{
     attenuation_sigma, exact_fisher, fit_sine, gaussian_fisher, ml_estimate, ml_profile,

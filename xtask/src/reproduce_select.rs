@@ -9,7 +9,7 @@
 //! true number of poles and the true family. The same run also reports what the BCLS screen
 //! alone (the first stage of [`select`]) would have picked.
 
-use crate::reproduce::{runs_range, write_outputs};
+use crate::outputs::{runs_range, write_outputs};
 use crate::Options;
 use jitterid::estimate::montecarlo::run as mc_run;
 use jitterid::estimate::selection::{select, Candidate, SelectionGrid, SelectionOptions};

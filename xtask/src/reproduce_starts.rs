@@ -16,8 +16,8 @@
 //! is within a relative `COST_TOL` of that lowest cost, and every parameter is within
 //! `PARAM_TOL` (relative to the parameter's magnitude) of the lowest-cost parameters.
 
+use crate::outputs::{runs_range, write_outputs};
 use crate::paper::{self, NOISE_STD, RUNS};
-use crate::reproduce::{runs_range, write_outputs};
 use crate::Options;
 use jitterid::estimate::montecarlo::run as mc_run;
 use jitterid::estimate::solver::{LevenbergMarquardt, MultiStart, Solver};

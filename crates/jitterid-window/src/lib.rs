@@ -91,6 +91,7 @@
 //! * [`testing`]: the contract every [`Window`] must meet, as a check to run in tests.
 #![warn(missing_docs)]
 
+mod direct;
 mod dtft;
 mod error;
 mod frequencies;

@@ -5,7 +5,7 @@
 //! the Dirichlet kernel `Γ_N` in the first moment (eq. 14b):
 //! `μ_Y(f) = ∫ S_c(ψ) γ(-ψ) e^{i2πψ t0} K(f-ψ) dψ`.
 
-use crate::dtft::dtft_at;
+use crate::direct::dtft_at;
 use jitterid_numeric::phase::{cis_neg_half_cycles, sin_pi_times, Cycles};
 use jitterid_signal::SampleGrid;
 use num_complex::Complex64;

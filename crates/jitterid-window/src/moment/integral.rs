@@ -3,7 +3,7 @@
 //! The method (folding, trapezoidal rule, tail estimate) and its measured accuracy are described
 //! in the docs of the parent module, [`crate::moment`].
 
-use crate::dtft::CompensatedSum;
+use crate::direct::CompensatedSum;
 use crate::{FrequencySet, Window, WindowError};
 use jitterid_jitter::JitterModel;
 use jitterid_numeric::phase::{cis_cycles, frac_prod};
