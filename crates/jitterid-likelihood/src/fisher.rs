@@ -16,11 +16,11 @@
 //! the structure's free ones, then `σ_v` if the structure does not fix it.
 
 use super::exact::{signal_table, ExactMl, JitterPrep, SampleModel, Scratch, SignalEval};
-use super::fit::spd_inverse;
 use super::moments::second_moments;
 use super::param::{likelihood_param_names, Layout};
 use super::MlError;
 use faer::Mat;
+use jitterid_estimate::support::inverse_gram;
 use jitterid_estimate::ModelStructure;
 use jitterid_estimate::NoiseModel;
 use jitterid_jitter::kernels::gauss::gl16;
@@ -345,4 +345,20 @@ where
         matrix,
         max_mass_error: Some(max_err),
     })
+}
+
+/// The inverse of a symmetric matrix (a Hessian or a Fisher matrix), if it is positive
+/// definite, well enough conditioned to invert ([`inverse_gram`]) and the result finite with
+/// a positive diagonal.
+pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
+    let p = m.nrows();
+    let inv = inverse_gram(m)?;
+    let out: Vec<Vec<f64>> = (0..p)
+        .map(|i| (0..p).map(|j| inv[(i, j)]).collect())
+        .collect();
+    out.iter()
+        .flatten()
+        .all(|v| v.is_finite())
+        .then_some(out)
+        .filter(|o| (0..p).all(|i| o[i][i] > 0.0))
 }

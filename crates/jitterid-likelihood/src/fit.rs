@@ -3,14 +3,13 @@
 //! log-likelihood.
 
 use super::criterion::{LikelihoodCriterion, LikelihoodData};
-use super::fisher::gaussian_fisher;
+use super::fisher::{gaussian_fisher, spd_inverse};
 use super::moments::second_moments;
 use super::objective::{LikelihoodObjective, TransformedObjective};
 use super::param::{default_transforms, likelihood_param_names, likelihood_params, Layout};
 use super::MlError;
 use faer::Mat;
 use jitterid_estimate::solver::{Brent, BrentOrBfgs, ObjectiveSolver, ProgressHook, Transform};
-use jitterid_estimate::support::inverse_gram;
 use jitterid_estimate::support::{best_of, fitted_jitter};
 use jitterid_estimate::EstimateError;
 use jitterid_estimate::ModelStructure;
@@ -89,22 +88,6 @@ fn noise_start<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
         }
         Err(_) => floor,
     }
-}
-
-/// The inverse of a symmetric matrix (a Hessian or a Fisher matrix), if it is positive
-/// definite, well enough conditioned to invert ([`inverse_gram`]) and the result finite with
-/// a positive diagonal.
-pub(crate) fn spd_inverse(m: &Mat<f64>) -> Option<Vec<Vec<f64>>> {
-    let p = m.nrows();
-    let inv = inverse_gram(m)?;
-    let out: Vec<Vec<f64>> = (0..p)
-        .map(|i| (0..p).map(|j| inv[(i, j)]).collect())
-        .collect();
-    out.iter()
-        .flatten()
-        .all(|v| v.is_finite())
-        .then_some(out)
-        .filter(|o| (0..p).all(|i| o[i][i] > 0.0))
 }
 
 /// Estimates the likelihood's parameters (the structure's free parameters, then `σ_v` when

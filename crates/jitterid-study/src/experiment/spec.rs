@@ -201,7 +201,7 @@ impl SolverName {
             .then_some(SolverName(entry.name))
     }
 
-    /// The names [`parse`](Self::parse) accepts, quoted, for messages.
+    /// The names [`parse_in`](Self::parse_in) accepts, quoted, for messages.
     pub fn names() -> String {
         quoted_list(&Self::OFFERED)
     }
