@@ -1,7 +1,7 @@
 //! `jitterid fit`: the study layer's fit of one record, printed as a table or JSON, with its
 //! figures.
 
-use super::fmt_num;
+use super::{fmt_num, name_width};
 use crate::exit::{Outcome, Status};
 use crate::output::OutputSet;
 use crate::plots;
@@ -180,13 +180,7 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
             "known"
         }
     );
-    let w = f
-        .params
-        .iter()
-        .map(|p| p.name.len())
-        .max()
-        .unwrap_or(9)
-        .max(9);
+    let w = name_width(f.params.iter().map(|p| p.name.as_str()));
     let _ = writeln!(
         out,
         "{:<w$}  {:>14}  {:>14}",

@@ -18,6 +18,12 @@ pub use validate::{validate, ValidateOptions};
 
 use jitterid_study::StudyError;
 
+/// The width of a report table's parameter column: the longest name, at least as wide as its
+/// heading `parameter`.
+pub(crate) fn name_width<'a>(names: impl Iterator<Item = &'a str>) -> usize {
+    names.map(str::len).max().unwrap_or(9).max(9)
+}
+
 /// A number as the reports print it: six decimals, or four significant digits in scientific
 /// notation outside `[1e-3, 1e5)`, and `–` for a value that is not finite.
 pub(crate) fn fmt_num(x: f64) -> String {

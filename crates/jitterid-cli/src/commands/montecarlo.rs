@@ -1,7 +1,7 @@
 //! `jitterid montecarlo`: the study layer's Monte Carlo study, printed as a table or JSON, with
 //! its figures and a progress bar.
 
-use super::fmt_num;
+use super::{fmt_num, name_width};
 use crate::exit::{Outcome, Status};
 use crate::output::OutputSet;
 use crate::plots;
@@ -66,13 +66,7 @@ fn mc_table(j: &McJson) -> String {
             s.index, s.count, s.first, s.end, s.runs_total
         );
     }
-    let w = j
-        .parameters
-        .iter()
-        .map(|p| p.name.len())
-        .max()
-        .unwrap_or(9)
-        .max(9);
+    let w = name_width(j.parameters.iter().map(|p| p.name.as_str()));
     let _ = writeln!(
         out,
         "{:<w$}  {:>12}  {:>12}  {:>12}  {:>12}  {:>12}",
