@@ -303,6 +303,25 @@ struct Raw {
     n: Option<u32>,
 }
 
+impl Raw {
+    /// The outcome of an estimator with the structure it fitted and the profiled `n`, if any.
+    fn of(e: Estimate, fitted: Structure, n: Option<u32>) -> Self {
+        Raw {
+            params: e.params,
+            std_errors: e.std_errors,
+            names: e.names,
+            covariance: e.covariance,
+            cost: e.cost,
+            iterations: e.iterations,
+            termination: e.termination.to_string(),
+            converged: e.converged,
+            noise_std: e.noise_std,
+            fitted,
+            n,
+        }
+    }
+}
+
 /// Fits structure `s` (started at its parameters) to `record` with `method`; the error is a
 /// message.
 pub fn fit(
@@ -318,19 +337,7 @@ pub fn fit(
     let raw =
         |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
             let (e, fitted, n) = r.map_err(|e| e.to_string())?;
-            Ok(Raw {
-                params: e.params,
-                std_errors: e.std_errors,
-                names: e.names,
-                covariance: e.covariance,
-                cost: e.cost,
-                iterations: e.iterations,
-                termination: e.termination.to_string(),
-                converged: e.converged,
-                noise_std: e.noise_std,
-                fitted,
-                n,
-            })
+            Ok(Raw::of(e, fitted, n))
         };
     let criterion = method.criterion_in(&exp.registries.criteria);
     let e = if criterion.is_likelihood() {
@@ -479,19 +486,7 @@ fn fit_ml(
         .with_params(e.params.get(..k).unwrap_or(&e.params))
         .map_err(|x| x.to_string())?;
     fitted.noise_std = Some(e.noise_std);
-    Ok(Raw {
-        params: e.params,
-        std_errors: e.std_errors,
-        names: e.names,
-        covariance: e.covariance,
-        cost: e.cost,
-        iterations: e.iterations,
-        termination: e.termination.to_string(),
-        converged: e.converged,
-        noise_std: e.noise_std,
-        fitted,
-        n,
-    })
+    Ok(Raw::of(e, fitted, n))
 }
 
 /// `θ ∘ (1 + U(−r, r))`, componentwise, drawn from `rng`.
