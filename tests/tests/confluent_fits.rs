@@ -2,7 +2,7 @@
 //! form): noise-free data from the exact first moment must give back the truth, and a noisy
 //! record must land within a few standard errors of it.
 
-use jitterid::estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid::estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid::jitter::UniformSum;
 use jitterid::prelude::*;
 use jitterid::rand::SeedableRng;
@@ -25,7 +25,7 @@ fn fit_tf(
 ) -> jitterid::estimate::Fit {
     let structure = ModelStructure::oe(LtiResponse::new(start, input.clone()), jitter());
     let record = Record::new(grid(), y).unwrap();
-    estimate(&structure, &record, &Bcls, &EstimateOptions::default()).unwrap()
+    fit(&structure, &record, &Bcls, &FitOptions::default()).unwrap()
 }
 
 fn exact_data(num: &[f64], den: &[f64], input: &PiecewiseConstant) -> Vec<f64> {

@@ -10,8 +10,8 @@
 //! * estimates from the exact first moment (noise-free data), which must recover the truth.
 
 use jitterid::estimate::{
-    estimate, initialize, Bcls, EstimateError, EstimateOptions, Frequencies, InitError,
-    InitOptions, ModelStructure, Record,
+    fit, initialize, Bcls, EstimateError, FitOptions, Frequencies, InitError, InitOptions,
+    ModelStructure, Record,
 };
 use jitterid::jitter::{
     ExponentialDelay, Gaussian, JitterModel, NoJitter, Shifted, TwoPoint, UniformSum,
@@ -114,11 +114,8 @@ fn recovers_truth<M: RationalModel + std::fmt::Debug>(
     let m = truth.expected_values(&grid, &jitter);
     let record = Record::new(grid, m).unwrap();
     let structure = ModelStructure::oe(LtiResponse::new(start, truth.input().clone()), jitter);
-    let options = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
-    let fit = estimate(&structure, &record, &Bcls, &options).unwrap();
+    let options = FitOptions::default().with_covariance(false);
+    let fit = fit(&structure, &record, &Bcls, &options).unwrap();
     assert!(fit.converged, "{fit:?}");
     for (got, want) in fit.params.iter().zip(truth.params()) {
         assert!(
@@ -182,7 +179,7 @@ fn lightly_damped_poles_damping_one_percent() {
         (q[2] / p[2] - 1.0).abs() < 0.01,
         "initial pole {q:?} vs {p:?}"
     );
-    let fit = estimate(&init, &record, &Bcls, &EstimateOptions::default()).unwrap();
+    let fit = fit(&init, &record, &Bcls, &FitOptions::default()).unwrap();
     assert!(fit.converged);
     for (got, want) in fit.params.iter().zip(&p) {
         assert!((got - want).abs() <= 1e-7 * want.abs(), "{:?}", fit.params);
@@ -261,18 +258,15 @@ fn jitter_reach_far_below_the_sample_interval() {
     // Estimation with the tiny jitter known gives the same estimate as with no jitter.
     let record = Record::new(grid, m0).unwrap();
     let start = eq17(0.21, 0.48, -0.26, 0.31);
-    let opts = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
-    let with = estimate(
+    let opts = FitOptions::default().with_covariance(false);
+    let with = fit(
         &ModelStructure::oe(LtiResponse::new(start.clone(), s.input().clone()), tiny),
         &record,
         &Bcls,
         &opts,
     )
     .unwrap();
-    let without = estimate(
+    let without = fit(
         &ModelStructure::oe(LtiResponse::new(start, s.input().clone()), NoJitter),
         &record,
         &Bcls,
@@ -320,7 +314,7 @@ fn jitter_reach_far_above_the_sample_interval() {
         LtiResponse::new(eq17(0.21, 0.48, -0.26, 0.31), s.input().clone()),
         UniformSum::new(2, 4.5 * t).unwrap(),
     );
-    let fit = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).unwrap();
+    let fit = fit(&structure, &record, &Bcls, &FitOptions::default()).unwrap();
     assert!(fit.converged, "{}", fit.termination);
     for (got, want) in fit.params.iter().zip([0.2, -0.5, -0.25, 0.3, 5.0]) {
         assert!((got - want).abs() < 1e-6 * want.abs(), "{:?}", fit.params);
@@ -443,12 +437,9 @@ fn frequencies_exactly_at_multiples_of_one_over_t() {
     // The estimate entry point reports the out-of-period frequency as a typed error.
     let record = Record::new(grid, s.expected_values(&grid, &jitter)).unwrap();
     let structure = ModelStructure::oe(s.clone(), jitter);
-    let options = EstimateOptions {
-        frequencies: Frequencies::List(vec![0.1, 1.0]),
-        ..EstimateOptions::default()
-    };
+    let options = FitOptions::default().with_frequencies(Frequencies::List(vec![0.1, 1.0]));
     assert!(matches!(
-        estimate(&structure, &record, &Bcls, &options),
+        fit(&structure, &record, &Bcls, &options),
         Err(EstimateError::Window(WindowError::FrequencyOutOfRange {
             index: 1,
             ..
@@ -473,7 +464,7 @@ fn two_samples() {
     let record = Record::new(grid, m.clone()).unwrap();
     let start = Zpk::new(0.7, vec![], vec![Root::Real(-0.8)]).unwrap();
     let structure = ModelStructure::oe(LtiResponse::new(start, u.clone()), jitter);
-    let fit = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).unwrap();
+    let fit = fit(&structure, &record, &Bcls, &FitOptions::default()).unwrap();
     assert!(fit.converged, "{}", fit.termination);
     assert!(
         (fit.params[0] - 0.8).abs() < 1e-8 && (fit.params[1] + 0.7).abs() < 1e-8,
@@ -486,7 +477,7 @@ fn two_samples() {
         jitter,
     );
     assert!(matches!(
-        estimate(&structure, &record, &Bcls, &EstimateOptions::default()),
+        jitterid::estimate::fit(&structure, &record, &Bcls, &FitOptions::default()),
         Err(EstimateError::TooFewData {
             what: "samples",
             available: 2,
@@ -504,7 +495,7 @@ fn two_samples() {
         jitter,
     );
     assert!(matches!(
-        estimate(&structure, &record, &Bcls, &EstimateOptions::default()),
+        jitterid::estimate::fit(&structure, &record, &Bcls, &FitOptions::default()),
         Err(EstimateError::TooFewData { .. })
     ));
 }
@@ -530,7 +521,7 @@ fn records_with_no_input_switch() {
         initialize(&structure, &record, &InitOptions::default()).unwrap_err(),
         InitError::NotExcited
     );
-    let fit = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).unwrap();
+    let fit = fit(&structure, &record, &Bcls, &FitOptions::default()).unwrap();
     let fitted = structure.with_params(&fit.params).unwrap();
     assert!(
         (fitted.signal.model().modal().unwrap().dc_gain - dc).abs() < 1e-8,
@@ -552,7 +543,7 @@ fn records_with_no_input_switch() {
         initialize(&structure, &record, &InitOptions::default()).unwrap_err(),
         InitError::NotExcited
     );
-    let fit = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).unwrap();
+    let fit = jitterid::estimate::fit(&structure, &record, &Bcls, &FitOptions::default()).unwrap();
     assert_eq!(fit.cost, 0.0);
     assert!(fit.std_errors.is_none(), "{:?}", fit.std_errors);
     // (c) One switch before the record: the record holds the step's transient only, which

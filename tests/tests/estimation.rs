@@ -6,8 +6,8 @@
 
 use jitterid::estimate::montecarlo::{realization_rng, Summary};
 use jitterid::estimate::{
-    estimate, ArmaNoise, Bcls, BoxJenkins, Criterion, EstimateOptions, FrequencyData, Ls,
-    ModelStructure, Record, WithFloor,
+    fit, ArmaNoise, Bcls, BoxJenkins, Criterion, FitOptions, FrequencyData, Ls, ModelStructure,
+    Record, WithFloor,
 };
 use jitterid::jitter::{Gaussian, JitterModel, NoJitter, UniformSum};
 use jitterid::prelude::*;
@@ -52,11 +52,8 @@ fn eq17_fit<C: Criterion>(
     let s = perturbed(&truth, 0.2, &mut rng);
     let start = LtiResponse::new(eq17(s[0], s[1], s[2], s[3]), input);
     let structure = ModelStructure::oe(start, jitter);
-    let opts = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
-    let e = estimate(
+    let opts = FitOptions::default().with_covariance(false);
+    let e = fit(
         &structure,
         &Record::new(grid, data.y).unwrap(),
         criterion,
@@ -142,11 +139,11 @@ fn joe_recovers_the_jitter_standard_deviation() {
         .unwrap();
         let start = Gaussian::new(sigma * (1.0 + rng.random_range(-0.2..=0.2))).unwrap();
         let structure = ModelStructure::joe(signal, start).with_estimated(false, true, false);
-        let e = estimate(
+        let e = fit(
             &structure,
             &Record::new(grid, data.y).unwrap(),
             &Bcls,
-            &EstimateOptions::default(),
+            &FitOptions::default(),
         )
         .unwrap();
         assert!(e.converged, "run {r}: {}", e.termination);
@@ -189,11 +186,11 @@ fn box_jenkins_recovers_a_known_noise_model() {
         // The jitter's own noise is white: the residual spectrum is σ_e²(|H|² + ρ).
         let noise = WithFloor::new(ArmaNoise::new(vec![], vec![-0.5]).unwrap(), 0.1).unwrap();
         let structure = ModelStructure::bj(start, jitter, noise);
-        let fit = estimate(
+        let fit = fit(
             &structure,
             &Record::new(grid, y).unwrap(),
             &BoxJenkins,
-            &EstimateOptions::default(),
+            &FitOptions::default(),
         )
         .unwrap();
         assert!(fit.converged, "run {r}: {}", fit.termination);
@@ -233,13 +230,13 @@ proptest! {
         let start = s.with_params(&perturbed(&theta0, 0.05, &mut rng));
         prop_assume!(start.is_ok());
         let structure = ModelStructure::oe(start.unwrap(), jitter);
-        let opts = EstimateOptions { covariance: false, ..EstimateOptions::default() };
-        let bc = estimate(&structure, &record, &Bcls, &opts).unwrap();
+        let opts = FitOptions::default().with_covariance(false);
+        let bc = fit(&structure, &record, &Bcls, &opts).unwrap();
         prop_assume!(bc.cost < 1e-20); // a local minimum elsewhere is a start problem, not bias
         for (p, t) in bc.params.iter().zip(&theta0) {
             prop_assert!((p - t).abs() <= 1e-6 * t.abs().max(1.0), "{:?} vs {:?}", bc.params, theta0);
         }
-        let ls = estimate(&structure, &record, &Ls, &opts).unwrap();
+        let ls = fit(&structure, &record, &Ls, &opts).unwrap();
         // The exact data are not in the naive model set: its best fit leaves a residual.
         let damping = (1.0 - jitter.cf(0.1).re).abs();
         if damping > 1e-3 {

@@ -31,7 +31,7 @@ use jitterid::estimate::solver::{
     AnySolver, LevenbergMarquardt, MultiStart, NelderMead, SolverRegistry,
 };
 use jitterid::estimate::{
-    estimate, initialize, Bcls, Criterion, CriterionRegistry, EstimateError, EstimateOptions, Fit,
+    fit, initialize, Bcls, Criterion, CriterionRegistry, EstimateError, Fit, FitOptions,
     Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, NoiseRegistry, Record,
     Registry,
 };
@@ -40,7 +40,7 @@ use jitterid::jitter::{AnyJitter, JitterError, JitterModel};
 use jitterid::prelude::*;
 use jitterid::signal::registry::{SignalRegistry, SpecReader, KIND_KEY};
 use jitterid::signal::{AnySignal, SignalError, Tone};
-use jitterid::window::{DirichletWindow, HannWindow};
+use jitterid::window::HannWindow;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestRunner};
 use serde_json::Value;
@@ -723,18 +723,15 @@ where
     match initialize(structure, record, &InitOptions::default()) {
         Ok(start) => {
             bump(&TALLY.init_ok);
-            let options = EstimateOptions {
-                frequencies: Frequencies::Dft,
-                window: DirichletWindow,
-                solver: MultiStart::new(
-                    LevenbergMarquardt::default().with_max_iters(15),
+            let options = FitOptions::default()
+                .with_solver(MultiStart::new(
+                    AnySolver::new(LevenbergMarquardt::default().with_max_iters(15)),
                     2,
                     0.5,
                     1,
-                ),
-                covariance: false,
-            };
-            match estimate(&start, record, &Bcls, &options) {
+                ))
+                .with_covariance(false);
+            match fit(&start, record, &Bcls, &options) {
                 Ok(e) => check_estimate(&e, &start)?,
                 Err(e) => note_error(&e),
             }
@@ -803,23 +800,18 @@ fn run_structure<N: NoiseModel + Clone>(
 ) -> Result<(), TestCaseError> {
     let frequencies = in_hertz(&case.frequencies, case.interval);
     let solver = solver.clone();
-    let result = if case.hann {
-        let options = EstimateOptions {
-            frequencies,
-            window: HannWindow,
-            solver,
-            covariance: case.covariance,
-        };
-        estimate(&structure, record, criterion, &options)
-    } else {
-        let options = EstimateOptions {
-            frequencies,
-            window: DirichletWindow,
-            solver,
-            covariance: case.covariance,
-        };
-        estimate(&structure, record, criterion, &options)
+    let options = FitOptions {
+        frequencies,
+        solver: Some(solver),
+        covariance: case.covariance,
+        ..FitOptions::default()
     };
+    let options = if case.hann {
+        options.with_window(HannWindow)
+    } else {
+        options
+    };
+    let result = fit(&structure, record, &criterion, &options);
     match result {
         Ok(e) => {
             bump(&TALLY.estimate_ok);
@@ -1125,16 +1117,13 @@ fn nelder_mead_rejects_an_overflowing_start() {
     let zero = PiecewiseConstant::new(vec![0.0, 1.0], vec![0.0]).unwrap();
     let model = Zpk::new(1.0, vec![], vec![Root::Real(-1.0)]).unwrap();
     let structure = ModelStructure::oe(LtiResponse::new(model, zero), NoJitter);
-    let lm = estimate(&structure, &record, &Ls, &EstimateOptions::default());
+    let lm = fit(&structure, &record, &Ls, &FitOptions::default());
     assert!(matches!(lm, Err(EstimateError::Solver(_))), "{lm:?}");
-    let options = EstimateOptions {
-        frequencies: Frequencies::Dft,
-        window: DirichletWindow,
-        solver: NelderMead::default(),
-        covariance: false,
-    };
+    let options = FitOptions::default()
+        .with_solver(NelderMead::default())
+        .with_covariance(false);
     // A typed error is right; so would be a report with a finite cost.
-    if let Ok(e) = estimate(&structure, &record, &Ls, &options) {
+    if let Ok(e) = fit(&structure, &record, &Ls, &options) {
         assert!(e.cost.is_finite(), "Ok with cost {}", e.cost);
     }
 }

@@ -4,7 +4,7 @@
 //! standard errors (`se = std/√R`, R runs) of the truth.
 
 use jitterid::estimate::montecarlo::{realization_rng, Summary};
-use jitterid::estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid::estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::serde_json::{self, json};
 use jitterid::jitter::AnyJitter;
@@ -47,11 +47,11 @@ fn monte_carlo(truth: &AnyJitter, design: &Design, seed: u64) -> Vec<Summary> {
             .collect();
         let start = truth.with_params(&start).unwrap();
         let structure = ModelStructure::joe(signal, start).with_estimated(false, true, false);
-        let e = estimate(
+        let e = fit(
             &structure,
             &Record::new(grid, data.y).unwrap(),
             &Bcls,
-            &EstimateOptions::default(),
+            &FitOptions::default(),
         )
         .unwrap();
         assert!(e.converged, "run {r}: {}", e.termination);

@@ -5,7 +5,7 @@ use crate::paper::{self, NOISE_STD, RUNS};
 use crate::Options;
 use jitterid::estimate::montecarlo::{run as mc_run, Summary};
 use jitterid::estimate::{
-    estimate, profile, Bcls, Criterion, EstimateOptions, Ls, ModelStructure, Record,
+    fit, fit_profile, Bcls, Criterion, FitOptions, Ls, ModelStructure, Record,
 };
 use jitterid::jitter::JitterModel;
 use jitterid::prelude::*;
@@ -128,7 +128,7 @@ fn fit_eq17<C: Criterion>(
     criteria
         .iter()
         .map(
-            |c| match estimate(&structure, &record, *c, &EstimateOptions::default()) {
+            |c| match fit(&structure, &record, *c, &FitOptions::default()) {
                 // Parameters are [gain, zero, pole.re, pole.im]; the paper's z is −zero.
                 Ok(e) => {
                     let p = vec![e.params[0], -e.params[1], e.params[2], e.params[3]];
@@ -276,14 +276,11 @@ fn alias(o: &Options) -> Result<(), String> {
     for start in [0.78, 1.78] {
         let s = Sinusoid::new(0.9, start + 0.001, 0.25).map_err(|e| e.to_string())?;
         let structure = ModelStructure::oe(s, jitter);
-        let e = estimate(
+        let e = fit(
             &structure,
             &record,
             &Bcls,
-            &EstimateOptions {
-                covariance: false,
-                ..Default::default()
-            },
+            &FitOptions::default().with_covariance(false),
         )
         .map_err(|e| e.to_string())?;
         let _ = writeln!(
@@ -388,11 +385,11 @@ fn table1(o: &Options) -> Result<(), String> {
                 let start = paper::uniform_sum_with_std(s0)(0).ok()?;
                 let structure =
                     ModelStructure::oe(signal, start).with_estimated(false, true, false);
-                let p = profile(
+                let p = fit_profile(
                     &structure,
                     &record,
                     &Bcls,
-                    &EstimateOptions::default(),
+                    &FitOptions::default(),
                     0..=9,
                     paper::uniform_sum_with_std(structure.jitter.std_dev()),
                 )

@@ -4,11 +4,14 @@ use crate::outputs::{runs_range, write_outputs};
 use crate::paper::{self, NOISE_STD, RUNS};
 use crate::Options;
 use jitterid::estimate::ml::{
-    attenuation_sigma, exact_fisher, fit_sine, gaussian_fisher, ml_estimate, ml_profile,
-    sine_least_squares, ExactMl, FisherOptions, LikelihoodCriterion, MlOptions, QuasiMl, SineFit,
+    attenuation_sigma, exact_fisher, fit_sine, gaussian_fisher, sine_least_squares, ExactMl,
+    FisherOptions, LikelihoodCriterion as _, QuasiMl, SineFit,
 };
 use jitterid::estimate::montecarlo::{run as mc_run, Summary};
-use jitterid::estimate::{profile, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid::estimate::solver::{Brent, BrentOrBfgs};
+use jitterid::estimate::{
+    fit, fit_profile, Bcls, FitCriterion, FitOptions, ModelStructure, Record, WhiteNoise,
+};
 use jitterid::prelude::*;
 use serde::Serialize;
 use serde_json::json;
@@ -128,15 +131,22 @@ fn bootstrap_mean_sigma(
         .with_noise_std(NOISE_STD)
         .ok()?;
     let boot_criterion = ExactMl::default().screening()?;
-    let mut boot_options = MlOptions::default();
-    boot_options.solver.brent.tolerance = BOOT_TOLERANCE;
+    let boot_options = FitOptions::default()
+        .with_covariance(false)
+        .with_solver(BrentOrBfgs {
+            brent: Brent {
+                tolerance: BOOT_TOLERANCE,
+                ..Brent::default()
+            },
+            ..BrentOrBfgs::default()
+        });
     let mut s = Summary::default();
     for b in 0..BOOT {
         // Streams disjoint from the realisations' (a different master seed).
         let mut rng = paper::rng(seed ^ 0xB00_75EED, r * BOOT + b);
         let data = simulate(signal, &fitted, &grid, NOISE_STD, &mut rng).ok()?;
         let record = Record::new(grid, data.y).ok()?;
-        if let Ok(p) = ml_profile(
+        if let Ok(p) = fit_profile(
             &structure,
             &record,
             &boot_criterion,
@@ -152,17 +162,14 @@ fn bootstrap_mean_sigma(
     (s.count >= BOOT / 2).then_some(s.mean)
 }
 
-fn profile_ml<C: LikelihoodCriterion>(
+fn profile_ml<C: FitCriterion<LtiResponse<Zpk>, UniformSum, WhiteNoise>>(
     structure: &ModelStructure<LtiResponse<Zpk>, UniformSum>,
     record: &Record,
     criterion: &C,
 ) -> Option<([f64; 3], Option<f64>)> {
-    let opts = MlOptions {
-        covariance: true,
-        ..Default::default()
-    };
+    let opts = FitOptions::default();
     let build = paper::uniform_sum_with_std(structure.jitter.std_dev());
-    let p = ml_profile(structure, record, criterion, &opts, 0..=9, build).ok()?;
+    let p = fit_profile(structure, record, criterion, &opts, 0..=9, build).ok()?;
     let sigma = |a: Option<f64>| a.map(|a| paper::uniform_sum_sigma(p.value, a));
     p.estimate.converged.then(|| {
         (
@@ -222,11 +229,11 @@ fn one_record(
     let start = paper::uniform_sum_with_std(s0)(0).ok()?;
     let structure = ModelStructure::oe(signal.clone(), start).with_estimated(false, true, false);
     let mut rec = Rec::default();
-    if let Ok(p) = profile(
+    if let Ok(p) = fit_profile(
         &structure,
         &record,
         &Bcls,
-        &EstimateOptions::default(),
+        &FitOptions::default(),
         0..=9,
         paper::uniform_sum_with_std(structure.jitter.std_dev()),
     ) {
@@ -257,11 +264,7 @@ fn one_record(
             .with_estimated(false, true, false)
             .with_noise_std(NOISE_STD)
             .ok()?;
-        let opts = MlOptions {
-            covariance: true,
-            ..Default::default()
-        };
-        if let Ok(e) = ml_estimate(&gs, &record, &ExactMl::default(), &opts) {
+        if let Ok(e) = fit(&gs, &record, &ExactMl::default(), &FitOptions::default()) {
             if e.converged {
                 rec.gauss = Some((e.params[0], e.std_errors.map(|s| s[0])));
             }
@@ -517,11 +520,8 @@ fn sine_record(record: &Record) -> Option<SineRec> {
     let classical = attenuation_sigma(ls.amplitude, SINE_A, SINE_F0);
     let jitter_known = Gaussian::new(SINE_JITTER).ok()?;
     let start = Gaussian::new(classical.unwrap_or(0.03).clamp(0.005, 0.2)).ok()?;
-    let cov = MlOptions {
-        covariance: true,
-        ..Default::default()
-    };
-    let plain = MlOptions::default();
+    let cov = FitOptions::default();
+    let plain = FitOptions::default().with_covariance(false);
     let full = fit_sine(record, &ls, SINE_F0, start, true, None, &exact, &cov)
         .ok()
         .filter(|f| f.estimate.converged)

@@ -20,13 +20,12 @@ use crate::outputs::{runs_range, write_outputs};
 use crate::paper::{self, NOISE_STD, RUNS};
 use crate::Options;
 use jitterid::estimate::montecarlo::run as mc_run;
-use jitterid::estimate::solver::{LevenbergMarquardt, MultiStart, Solver};
+use jitterid::estimate::solver::{AnySolver, DynSolver, LevenbergMarquardt, MultiStart};
 use jitterid::estimate::{
-    estimate, initialize, residual_flatness, Bcls, EstimateOptions, FitProblem, Frequencies,
-    InitOptions, ModelStructure, Record, WhiteNoise, FLATNESS_BANDS, FLATNESS_LIMIT,
+    initialize, residual_flatness, Bcls, FitOptions, InitOptions, ModelStructure, Record,
+    FLATNESS_BANDS, FLATNESS_LIMIT,
 };
 use jitterid::prelude::*;
-use jitterid::window::DirichletWindow;
 use rand::Rng;
 use serde::Serialize;
 use serde_json::json;
@@ -80,19 +79,11 @@ impl Outcome {
 
 type Structure = ModelStructure<LtiResponse<Zpk>, UniformSum>;
 
-fn fit<V>(structure: &Structure, record: &Record, solver: V) -> Outcome
-where
-    V: for<'a> Solver<
-        FitProblem<'a, LtiResponse<Zpk>, UniformSum, WhiteNoise, Bcls, DirichletWindow>,
-    >,
-{
-    let options = EstimateOptions {
-        frequencies: Frequencies::Dft,
-        window: DirichletWindow,
-        solver,
-        covariance: false,
-    };
-    match estimate(structure, record, &Bcls, &options) {
+fn fit(structure: &Structure, record: &Record, solver: impl DynSolver + 'static) -> Outcome {
+    let options = FitOptions::default()
+        .with_solver(solver)
+        .with_covariance(false);
+    match jitterid::estimate::fit(structure, record, &Bcls, &options) {
         Ok(e) => Outcome {
             converged: e.converged,
             cost: e.cost,
@@ -145,7 +136,12 @@ fn one_record(truth: [f64; 4], jitter: &UniformSum, rng: &mut rand::rngs::StdRng
             fit(
                 &start,
                 &record,
-                MultiStart::new(lm.clone(), MULTI_STARTS, MULTI_RADIUS, MULTI_SEED),
+                MultiStart::new(
+                    AnySolver::new(lm.clone()),
+                    MULTI_STARTS,
+                    MULTI_RADIUS,
+                    MULTI_SEED,
+                ),
             ),
             Some(start.params()),
         ),

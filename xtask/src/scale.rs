@@ -4,7 +4,7 @@ use crate::paper;
 use jitterid::estimate::montecarlo::realization_rng;
 use jitterid::estimate::solver::LeastSquares;
 use jitterid::estimate::{
-    estimate, Bcls, EstimateOptions, FitProblem, FrequencyData, ModelStructure, Record,
+    fit, Bcls, FitOptions, FitProblem, FrequencyData, ModelStructure, Record,
 };
 use jitterid::prelude::*;
 use jitterid::window::{DirichletWindow, FrequencySet};
@@ -85,23 +85,20 @@ pub fn run(sizes: &[usize]) -> Result<(), String> {
                 .collect(),
         );
         drop(data);
-        let no_cov = EstimateOptions {
-            covariance: false,
-            ..EstimateOptions::default()
-        };
+        let no_cov = FitOptions::default().with_covariance(false);
         let mut iters = 0;
         let fit = median(
             (0..reps)
                 .map(|_| {
                     let t = Instant::now();
-                    let e = estimate(&structure, &record, &Bcls, &no_cov).expect("fit runs");
+                    let e = fit(&structure, &record, &Bcls, &no_cov).expect("fit runs");
                     iters = e.iterations;
                     t.elapsed().as_secs_f64() * 1e3
                 })
                 .collect(),
         );
         let t = Instant::now();
-        let e = estimate(&structure, &record, &Bcls, &EstimateOptions::default())
+        let e = jitterid::estimate::fit(&structure, &record, &Bcls, &FitOptions::default())
             .map_err(|e| e.to_string())?;
         let full = t.elapsed().as_secs_f64() * 1e3;
         if !e.converged {
@@ -152,11 +149,11 @@ pub fn speedup() -> Result<(), String> {
             let s = paper::perturb(&[0.2, 0.5, -0.25, 0.3], 0.2, rng);
             let start = paper::eq17(s[0], s[1], s[2], s[3]).expect("stable start");
             let structure = ModelStructure::oe(LtiResponse::new(start, u), jitter);
-            estimate(
+            fit(
                 &structure,
                 &Record::new(grid, y).expect("finite"),
                 &Bcls,
-                &EstimateOptions::default(),
+                &FitOptions::default(),
             )
             .map(|e| e.params)
             .ok()

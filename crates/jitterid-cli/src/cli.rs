@@ -4,7 +4,7 @@
 // `[estimate]`), not rustdoc markup.
 #![allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 
-use crate::commands::{self, FitOptions, MonteCarloOptions, SimulateOptions};
+use crate::commands::{self, FitRequest, MonteCarloOptions, SimulateOptions};
 use crate::exit::{Outcome, BAD_INPUT};
 use clap::{Args, Parser, Subcommand};
 use jitterid_study::error::StudyResult;
@@ -224,7 +224,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             truth: a.truth,
         })
         .map(|s| Outcome::success(s + "\n")),
-        Command::Fit(a) => commands::fit(&FitOptions {
+        Command::Fit(a) => commands::fit(&FitRequest {
             experiment: a.experiment,
             data: a.data,
             input: a.input,

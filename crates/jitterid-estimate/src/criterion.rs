@@ -50,7 +50,7 @@ pub trait Criterion: fmt::Debug + Send + Sync {
 
     /// Whether the weighted residuals at the true parameters have the same variance at every
     /// frequency (white measurement noise for BCLS; the noise model's shape divided out for
-    /// Box–Jenkins), so that [`estimate`](crate::estimate) checks a converged fit with
+    /// Box–Jenkins), so that [`fit`](crate::fit) checks a converged fit with
     /// [`residual_flatness`](crate::residual_flatness). False by default (naive LS keeps the
     /// jitter's bias in its residuals; user weights can shape them arbitrarily); a criterion of
     /// your own that declares it gets the same check.
@@ -69,29 +69,37 @@ pub trait Criterion: fmt::Debug + Send + Sync {
     }
 }
 
-impl<C: Criterion + ?Sized> Criterion for Box<C> {
-    fn name(&self) -> &'static str {
-        (**self).name()
-    }
-    fn models_jitter(&self) -> bool {
-        (**self).models_jitter()
-    }
-    fn uses_noise_model(&self) -> bool {
-        (**self).uses_noise_model()
-    }
-    fn model_dependent_weights(&self) -> bool {
-        (**self).model_dependent_weights()
-    }
-    fn flat_residuals(&self) -> bool {
-        (**self).flat_residuals()
-    }
-    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
-        (**self).weights(context)
-    }
-    fn validate(&self, freqs: &FrequencySet) -> Result<(), EstimateError> {
-        (**self).validate(freqs)
-    }
+/// A criterion behind a pointer is the criterion it points to, so that `Box<dyn Criterion>`,
+/// `Arc<dyn Criterion>` and `&dyn Criterion` fit like the concrete type.
+macro_rules! forward_criterion {
+    ($($pointer:ty),*) => {$(
+        impl<C: Criterion + ?Sized> Criterion for $pointer {
+            fn name(&self) -> &'static str {
+                (**self).name()
+            }
+            fn models_jitter(&self) -> bool {
+                (**self).models_jitter()
+            }
+            fn uses_noise_model(&self) -> bool {
+                (**self).uses_noise_model()
+            }
+            fn model_dependent_weights(&self) -> bool {
+                (**self).model_dependent_weights()
+            }
+            fn flat_residuals(&self) -> bool {
+                (**self).flat_residuals()
+            }
+            fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
+                (**self).weights(context)
+            }
+            fn validate(&self, freqs: &FrequencySet) -> Result<(), EstimateError> {
+                (**self).validate(freqs)
+            }
+        }
+    )*};
 }
+
+forward_criterion!(Box<C>, std::sync::Arc<C>, &C);
 
 /// The parts of a model structure that weights may look at, without its type parameters.
 pub(crate) trait ModelView: Sync {

@@ -1,7 +1,7 @@
 //! The last evaluation of a fit problem, kept so that the same point is not evaluated twice.
 //!
 //! Levenberg–Marquardt asks for the residuals at a trial point and, once the step is accepted,
-//! for the normal equations at the same point; [`estimate`](crate::estimate) asks for the
+//! for the normal equations at the same point; [`fit`](crate::fit) asks for the
 //! residuals at the start (to check them) just before the solver does, and again at the
 //! solution. The time-domain sensitivities `∂m_k/∂θ` come out of the same pass over the
 //! jitter's expectations as `m_k` itself, so the residual evaluation keeps them for the normal

@@ -9,13 +9,13 @@ use crate::evaluation_memo::{EvaluationMemo, MEMO_MAX_SAMPLES};
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::result::{CostKind, Fit};
-use crate::solver::{LeastSquares, LevenbergMarquardt, NormalEquations, Solver, SolverError};
+use crate::solver::{LeastSquares, NormalEquations, Solver, SolverError};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::{SampleGrid, Signal};
-use jitterid_window::{DirichletWindow, FrequencySet, Window};
+use jitterid_window::{FrequencySet, Window};
 
 /// Which frequencies a criterion uses.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -45,9 +45,11 @@ impl Frequencies {
     }
 }
 
-/// How to estimate.
+/// The typed options of [`estimate`]: what [`FitOptions`](crate::FitOptions) resolves to
+/// for a first-moment criterion, with the solver and window as types so that the search is
+/// monomorphised.
 #[derive(Debug, Clone)]
-pub struct EstimateOptions<V = LevenbergMarquardt, W = DirichletWindow> {
+pub(crate) struct MomentOptions<V, W> {
     /// The frequency set.
     pub frequencies: Frequencies,
     /// The window (taper) of the DTFT.
@@ -56,17 +58,6 @@ pub struct EstimateOptions<V = LevenbergMarquardt, W = DirichletWindow> {
     pub solver: V,
     /// Whether to compute the asymptotic covariance.
     pub covariance: bool,
-}
-
-impl Default for EstimateOptions {
-    fn default() -> Self {
-        Self {
-            frequencies: Frequencies::Dft,
-            window: DirichletWindow,
-            solver: LevenbergMarquardt::default(),
-            covariance: true,
-        }
-    }
 }
 
 /// Relative residual size below which a fit is exact to rounding and not checked for flatness.
@@ -217,7 +208,8 @@ pub fn reach_beyond<J: JitterModel + ?Sized>(
 }
 
 /// Estimates the free parameters of `structure` from `record` by minimising `criterion` with
-/// `options.solver`, starting from the structure's current parameters.
+/// `options.solver`, starting from the structure's current parameters: what
+/// [`fit`](crate::fit) runs for a first-moment criterion.
 ///
 /// # Errors
 ///
@@ -228,11 +220,11 @@ pub fn reach_beyond<J: JitterModel + ?Sized>(
 ///
 /// `criterion` may be a trait object (`&dyn Criterion`, `Box<dyn Criterion>`); `options.solver`
 /// any solver of least-squares problems (see [`Solver`]).
-pub fn estimate<S, J, N, C, V, W>(
+pub(crate) fn estimate<S, J, N, C, V, W>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     criterion: &C,
-    options: &EstimateOptions<V, W>,
+    options: &MomentOptions<V, W>,
 ) -> Result<Fit, EstimateError>
 where
     S: Signal + Clone,

@@ -7,7 +7,7 @@
 //! Box–Jenkins residual is flat after division by the noise model's shape). A fit stuck in a
 //! local minimum, or a model that cannot describe the data, leaves its misfit where the input
 //! excites the system: some band of frequencies then carries several times the power of the
-//! others. The solvers' convergence tests cannot see this; [`estimate`](crate::estimate)
+//! others. The solvers' convergence tests cannot see this; [`fit`](crate::fit)
 //! reports such a fit as not converged ([`FitTermination::ResidualNotFlat`]).
 //!
 //! [`FitTermination::ResidualNotFlat`]: crate::FitTermination::ResidualNotFlat

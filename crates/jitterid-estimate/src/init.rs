@@ -30,7 +30,7 @@
 //!    fixed, the numerator (and the transient) is fitted again, linearly and in output-error
 //!    form, so that reflecting a pole does not leave a wrong gain behind.
 //!
-//! The result is a start for [`estimate`](crate::estimate), not an estimate: the midpoint
+//! The result is a start for [`fit`](crate::fit), not an estimate: the midpoint
 //! rule and the smoothed-input approximation are accurate to a few per cent at the frequencies
 //! used, which is what a start needs. The default robust fit runs
 //! [`MultiStart`](crate::solver::MultiStart) around it (see `cargo xtask reproduce starts`).
@@ -38,7 +38,7 @@
 //! # Example
 //!
 //! ```
-//! use jitterid_estimate::{estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record};
+//! use jitterid_estimate::{fit, initialize, Bcls, FitOptions, InitOptions, ModelStructure, Record};
 //! use jitterid_jitter::UniformSum;
 //! use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
 //! use rand::SeedableRng;
@@ -55,9 +55,9 @@
 //! let template = Zpk::new(1.0, vec![Root::Real(-1.0)], vec![Root::Pair { re: -1.0, im: 1.0 }])?;
 //! let structure = ModelStructure::oe(LtiResponse::new(template, u), jitter);
 //! let start = initialize(&structure, &record, &InitOptions::default())?;
-//! let fit = estimate(&start, &record, &Bcls, &EstimateOptions::default())?;
-//! assert!(fit.converged);
-//! assert!((fit.params[3] - 0.3).abs() < 0.02);
+//! let estimate = fit(&start, &record, &Bcls, &FitOptions::default())?;
+//! assert!(estimate.converged);
+//! assert!((estimate.params[3] - 0.3).abs() < 0.02);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 

@@ -11,10 +11,11 @@
 
 use crate::covariance::{sandwich_of, sandwich_parts};
 use crate::criterion::Criterion;
-use crate::fit::{EstimateOptions, FitProblem};
+use crate::fit::{FitProblem, MomentOptions};
 use crate::frequency_data::FrequencyData;
 use crate::measured::{InputLayout, MeasuredRecord};
 use crate::noise::NoiseModel;
+use crate::options::FitOptions;
 use crate::result::{CostKind, Fit};
 use crate::solver::{LeastSquares, NormalEquations, Solver, SolverError};
 use crate::structure::ModelStructure;
@@ -195,12 +196,27 @@ where
 ///
 /// # Errors
 ///
-/// Those of [`check_joint`]; those of [`estimate`](crate::estimate) for each record's set-up.
-pub fn estimate_joint<S, J, N, C, V, W>(
+/// Those of [`check_joint`]; those of [`fit`](crate::fit) for each record's set-up.
+pub fn estimate_joint<S, J, N, C>(
     structures: &[ModelStructure<S, J, N>],
     records: &[MeasuredRecord],
     criterion: &C,
-    options: &EstimateOptions<V, W>,
+    options: &FitOptions,
+) -> Result<Fit, EstimateError>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion + ?Sized,
+{
+    joint(structures, records, criterion, &options.moment())
+}
+
+fn joint<S, J, N, C, V, W>(
+    structures: &[ModelStructure<S, J, N>],
+    records: &[MeasuredRecord],
+    criterion: &C,
+    options: &MomentOptions<V, W>,
 ) -> Result<Fit, EstimateError>
 where
     S: Signal + Clone,

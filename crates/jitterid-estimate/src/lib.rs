@@ -7,10 +7,13 @@
 //! criterion; the likelihood criteria of `jitterid-likelihood` use the second moment. Every criterion is an
 //! [`Objective`] for one [`solver::Solver`] trait: Levenberg–Marquardt (written here as an
 //! argmin solver), Gauss–Newton with line search, Nelder–Mead, BFGS, Brent, multi-start.
-//! [`estimate`] (first moment) and `jitterid_likelihood::ml_estimate` (likelihoods) return the one result
-//! type, [`Fit`]: `θ̂` by name, standard errors and covariance (the sandwich form that accounts
-//! for the heteroscedastic jittered samples, or the inverse Hessian of `−log L`), the cost,
-//! the termination reason. An integer-valued jitter parameter is profiled ([`profile`]).
+//!
+//! There is one way to fit: [`fit`] a structure to a record with a [`FitCriterion`] (every
+//! [`Criterion`], and the likelihoods of `jitterid-likelihood`) and one [`FitOptions`]; it
+//! returns one result type, [`Fit`] — `θ̂` by name, standard errors and covariance (the
+//! sandwich form that accounts for the heteroscedastic jittered samples, or the inverse
+//! Hessian of `−log L`), the cost, the termination reason — or one error type,
+//! [`EstimateError`]. An integer-valued jitter parameter is profiled with [`fit_profile`].
 //!
 //! Measured data: a [`MeasuredRecord`] holds what a measurement holds (samples, requested
 //! instants, the input, an optional known noise level, a name), read from and written to the
@@ -26,7 +29,7 @@
 //! [`ParamSpec`].
 //!
 //! ```
-//! use jitterid_estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+//! use jitterid_estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 //! use jitterid_jitter::UniformSum;
 //! use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
 //! use rand::SeedableRng;
@@ -42,9 +45,9 @@
 //! // Start 10% off the truth; the jitter is known (an OE structure).
 //! let start = Zpk::new(0.22, vec![Root::Real(-0.45)], vec![Root::Pair { re: -0.27, im: 0.33 }])?;
 //! let structure = ModelStructure::oe(LtiResponse::new(start, u), jitter);
-//! let fit = estimate(&structure, &record, &Bcls, &EstimateOptions::default())?;
-//! assert!(fit.converged);
-//! assert!((fit.params[0] - 0.2).abs() < 5.0 * fit.std_errors.as_ref().unwrap()[0]);
+//! let estimate = fit(&structure, &record, &Bcls, &FitOptions::default())?;
+//! assert!(estimate.converged);
+//! assert!((estimate.params[0] - 0.2).abs() < 5.0 * estimate.std_errors.as_ref().unwrap()[0]);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
@@ -58,6 +61,7 @@ mod data;
 mod error;
 mod evaluation_memo;
 mod fit;
+mod fit_criterion;
 mod flatness;
 mod frequency_data;
 mod init;
@@ -67,6 +71,7 @@ mod likelihood_error;
 mod measured;
 pub mod montecarlo;
 mod noise;
+mod options;
 mod parseval;
 mod profile;
 pub mod registry;
@@ -81,7 +86,8 @@ pub use data::Record;
 pub use error::EstimateError;
 /// The dense matrix type of Jacobians ([`FrequencyData::jacobian`], [`solver::LeastSquares`]).
 pub use faer::Mat;
-pub use fit::{estimate, EstimateOptions, FitProblem, Frequencies};
+pub use fit::{FitProblem, Frequencies};
+pub use fit_criterion::{fit, fit_profile, FitCriterion};
 pub use flatness::{residual_flatness, FLATNESS_BANDS, FLATNESS_LIMIT, FLATNESS_MIN_PER_BAND};
 pub use frequency_data::FrequencyData;
 pub use init::{
@@ -95,7 +101,8 @@ pub use joint::{check_joint, estimate_joint, JointProblem};
 pub use likelihood_error::MlError;
 pub use measured::{InputLayout, MeasuredRecord};
 pub use noise::{ArmaNoise, NoiseModel, WhiteNoise, WithFloor};
-pub use profile::{profile, Profile};
+pub use options::FitOptions;
+pub use profile::Profile;
 pub use registry::{Entry, ParamSpec, Registry, RegistryError, SpecTable};
 pub use restricted_noise::{restricted_noise_fit, NoiseEstimate, RESTRICTED_NOISE_MAX_SAMPLES};
 pub use result::{CostKind, Fit};

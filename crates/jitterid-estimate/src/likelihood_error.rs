@@ -127,3 +127,22 @@ impl From<MlError> for EstimateError {
         }
     }
 }
+
+impl EstimateError {
+    /// The likelihood's typed reason, if a likelihood criterion failed
+    /// ([`EstimateError::Likelihood`]).
+    ///
+    /// ```
+    /// use jitterid_estimate::{EstimateError, MlError};
+    ///
+    /// let e = EstimateError::from(MlError::NoNoise { value: 0.0 });
+    /// assert!(matches!(e.likelihood(), Some(MlError::NoNoise { .. })));
+    /// assert!(EstimateError::NothingToEstimate.likelihood().is_none());
+    /// ```
+    pub fn likelihood(&self) -> Option<&MlError> {
+        match self {
+            EstimateError::Likelihood(e) => Some(e),
+            _ => None,
+        }
+    }
+}

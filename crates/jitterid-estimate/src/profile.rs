@@ -5,18 +5,18 @@
 //! over the continuous parameters for each value in a range, and the value with the best
 //! criterion wins. This is how the paper's `n̂` is defined (its mean `E[n̂] = 0.2145` is a mean
 //! of integers). The family enters only through a builder `Fn(i64) -> Result<J, E>` that makes
-//! the start jitter for a value, so any family with such a parameter can be profiled.
+//! the start jitter for a value, so any family with such a parameter can be profiled. The
+//! entry point is [`fit_profile`](crate::fit_profile).
 
-use crate::criterion::Criterion;
 use crate::data::Record;
-use crate::fit::{estimate, EstimateOptions, FitProblem};
+use crate::fit_criterion::FitCriterion;
 use crate::noise::NoiseModel;
+use crate::options::FitOptions;
 use crate::result::Fit;
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use jitterid_jitter::JitterModel;
 use jitterid_signal::Signal;
-use jitterid_window::Window;
 
 /// The result of a profile over an integer-valued family parameter.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -83,53 +83,36 @@ where
     Ok(jitter.with_params(&estimate.params[ns..ns + nj])?)
 }
 
-/// Fits `structure` with its jitter replaced by `build(v)` for every `v` in `values`, and
-/// returns the best converged fit (the best of all if none converged).
-///
-/// `build` makes the start jitter for a value: for the uniform-sum family with the standard
-/// deviation of the start kept, `|n| UniformSum::new(n as u32, σ √(3(n+1)))`. The covariance,
-/// if asked for, is computed for the winner only.
-///
-/// # Errors
-///
-/// The first error if no value could be fitted (including errors of `build`).
-pub fn profile<S, J, N, C, V, W, E>(
+/// The default profile of a [`FitCriterion`]: every value fitted without the covariance, the
+/// best converged fit kept (the best of all if none converged), and the winner fitted once
+/// more from its estimate for the covariance when `options` asks for it.
+pub(crate) fn refit_each<S, J, N, C>(
+    criterion: &C,
     structure: &ModelStructure<S, J, N>,
     record: &Record,
-    criterion: &C,
-    options: &EstimateOptions<V, W>,
-    values: impl IntoIterator<Item = i64>,
-    build: impl Fn(i64) -> Result<J, E>,
+    options: &FitOptions,
+    values: &[i64],
+    build: &(dyn Fn(i64) -> Result<J, EstimateError> + Sync),
 ) -> Result<Profile<J>, EstimateError>
 where
     S: Signal + Clone,
     J: JitterModel + Clone,
     N: NoiseModel,
-    C: Criterion + ?Sized,
-    V: for<'a> crate::solver::Solver<FitProblem<'a, S, J, N, C, W>>,
-    W: Window + Clone,
-    E: Into<EstimateError>,
+    C: FitCriterion<S, J, N> + ?Sized,
 {
     // The covariance is only wanted at the winner: fit every value without it.
-    let quick = EstimateOptions {
-        frequencies: options.frequencies.clone(),
-        window: options.window.clone(),
-        solver: &options.solver,
+    let quick = FitOptions {
         covariance: false,
+        ..options.clone()
     };
     let at = |v: i64| -> Result<ModelStructure<S, J, N>, EstimateError> {
         let mut s = structure.clone();
-        s.jitter = build(v).map_err(Into::into)?;
+        s.jitter = build(v)?;
         Ok(s)
     };
     let fits = values
-        .into_iter()
-        .map(|v| {
-            (
-                v,
-                at(v).and_then(|s| estimate(&s, record, criterion, &quick)),
-            )
-        })
+        .iter()
+        .map(|&v| (v, at(v).and_then(|s| criterion.fit(&s, record, &quick))))
         .collect();
     let (best, costs, first_error) = best_of(fits);
     let Some((value, mut winner)) = best else {
@@ -138,12 +121,7 @@ where
     let start = at(value)?;
     if options.covariance {
         // Restart at the winner: the solver stops at once and the covariance is computed there.
-        let refit = estimate(
-            &start.with_params(&winner.params)?,
-            record,
-            criterion,
-            options,
-        )?;
+        let refit = criterion.fit(&start.with_params(&winner.params)?, record, options)?;
         winner.covariance = refit.covariance;
         winner.std_errors = refit.std_errors;
         winner.noise_std = refit.noise_std;

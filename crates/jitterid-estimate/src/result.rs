@@ -14,9 +14,8 @@ pub enum CostKind {
 }
 
 /// An estimate: the free parameters by name, their standard errors and covariance, the final
-/// value of the criterion and how the solver stopped. Returned by [`estimate`](crate::estimate)
-/// (first-moment criteria), `jitterid_likelihood::ml_estimate` (likelihood criteria) and
-/// the profiles.
+/// value of the criterion and how the solver stopped. Returned by [`fit`](crate::fit) for
+/// every criterion (first-moment and likelihood alike) and by the profiles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
     /// The criterion's name.

@@ -17,7 +17,7 @@ pub enum FitTermination {
     /// The solver met a convergence test, but the residual spectrum is far from flat
     /// ([`residual_flatness`](crate::residual_flatness) above
     /// [`FLATNESS_LIMIT`](crate::FLATNESS_LIMIT)): a local minimum, or a model that does not
-    /// describe the data. Set by [`estimate`](crate::estimate), not by the solvers.
+    /// describe the data. Set by [`fit`](crate::fit), not by the solvers.
     ResidualNotFlat,
 }
 

@@ -6,8 +6,7 @@
 use jitterid_estimate::montecarlo::realization_rng;
 use jitterid_estimate::solver::{LeastSquares, LevenbergMarquardt, Solver, Termination};
 use jitterid_estimate::{
-    estimate, Bcls, EstimateOptions, Fit as Estimate, FitProblem, FrequencyData, ModelStructure,
-    Record,
+    fit, Bcls, Fit as Estimate, FitOptions, FitProblem, FrequencyData, ModelStructure, Record,
 };
 use jitterid_jitter::Gaussian;
 use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
@@ -47,9 +46,9 @@ fn setup(r: u64) -> (ModelStructure<LtiResponse<Zpk>, Gaussian>, Record) {
     (structure, Record::new(grid, y).expect("record"))
 }
 
-fn fit(r: u64) -> Estimate {
+fn fit_realisation(r: u64) -> Estimate {
     let (structure, record) = setup(r);
-    estimate(&structure, &record, &Bcls, &EstimateOptions::default()).expect("fit runs")
+    fit(&structure, &record, &Bcls, &FitOptions::default()).expect("fit runs")
 }
 
 /// Prints every realisation's termination (`cargo test -p jitterid-estimate --test boundary
@@ -58,7 +57,7 @@ fn fit(r: u64) -> Estimate {
 #[ignore = "a scan over 128 records that prints, for finding regression records"]
 fn scan_terminations() {
     for r in 0..128 {
-        let e = fit(r);
+        let e = fit_realisation(r);
         println!(
             "{r:3} converged {} σ̂ = {:.3e} ({})",
             e.converged, e.params[4], e.termination
@@ -94,7 +93,7 @@ fn a_width_at_zero_is_converged_at_the_bound() {
             stalled.params
         );
 
-        let fit = fit(r);
+        let fit = fit_realisation(r);
         assert!(fit.converged, "record {r}: {}", fit.termination);
         assert_eq!(fit.termination, Termination::AtBound { params: vec![4] });
         assert!(fit.params[4] > 0.0 && fit.params[4] < 1e-6 * start[4]);

@@ -4,8 +4,8 @@
 //! coefficient's bias towards white noise is much smaller than without the floor.
 
 use jitterid_estimate::{
-    estimate, mean_jitter_variance, ArmaNoise, BoxJenkins, EstimateOptions, ModelStructure,
-    NoiseModel, Record,
+    fit, mean_jitter_variance, ArmaNoise, BoxJenkins, FitOptions, ModelStructure, NoiseModel,
+    Record,
 };
 use jitterid_jitter::{NoJitter, UniformSum};
 use jitterid_signal::testing::eq17;
@@ -67,17 +67,17 @@ fn noise_estimates(with_floor: bool, runs: u64) -> (Vec<f64>, Vec<f64>) {
         let record = Record::new(grid, y).unwrap();
         let noise = ArmaNoise::new(Vec::new(), vec![D1]).unwrap();
         let s = ModelStructure::bj(truth, jitter, noise);
-        let options = EstimateOptions::default();
+        let options = FitOptions::default();
         let fit = if with_floor {
             let (fit, fitted) = s
                 .fit_with_jitter_floor(&record, Some(SIGMA_E), |floored| {
-                    estimate(floored, &record, &BoxJenkins, &options)
+                    fit(floored, &record, &BoxJenkins, &options)
                 })
                 .unwrap();
             assert!(fitted.noise.floor() > 0.0);
             fit
         } else {
-            estimate(&s, &record, &BoxJenkins, &options).unwrap()
+            fit(&s, &record, &BoxJenkins, &options).unwrap()
         };
         let i = fit.names.iter().position(|n| n == "noise.d1").unwrap();
         d1.push(fit.params[i]);

@@ -2,7 +2,7 @@
 //! and records of different systems are refused by name.
 
 use jitterid_estimate::{
-    check_joint, estimate, estimate_joint, Bcls, EstimateError, EstimateOptions, MeasuredRecord,
+    check_joint, estimate_joint, fit, Bcls, EstimateError, FitOptions, MeasuredRecord,
     ModelStructure, Record,
 };
 use jitterid_jitter::UniformSum;
@@ -68,9 +68,9 @@ fn the_joint_covariance_is_the_inverse_of_the_summed_information() {
     // is σ_v² (JᵀJ)⁻¹ and the information of the two records adds exactly (at one θ).
     let (s1, r1) = table2(11, 200, 1e-4);
     let (s2, r2) = table2(12, 150, 1e-4);
-    let options = EstimateOptions::default();
-    let f1 = estimate(&s1, r1.record(), &Bcls, &options).unwrap();
-    let f2 = estimate(&s2, r2.record(), &Bcls, &options).unwrap();
+    let options = FitOptions::default();
+    let f1 = fit(&s1, r1.record(), &Bcls, &options).unwrap();
+    let f2 = fit(&s2, r2.record(), &Bcls, &options).unwrap();
     let joint = estimate_joint(&[s1, s2], &[r1, r2], &Bcls, &options).unwrap();
     assert!(f1.converged && f2.converged && joint.converged);
     let c1 = f1.covariance.unwrap();
@@ -122,8 +122,8 @@ fn the_joint_covariance_is_the_inverse_of_the_summed_information() {
 #[test]
 fn one_record_twice_halves_the_covariance_exactly() {
     let (s1, r1) = table2(11, 200, 0.1);
-    let options = EstimateOptions::default();
-    let single = estimate(&s1, r1.record(), &Bcls, &options).unwrap();
+    let options = FitOptions::default();
+    let single = fit(&s1, r1.record(), &Bcls, &options).unwrap();
     let joint = estimate_joint(&[s1.clone(), s1], &[r1.clone(), r1], &Bcls, &options).unwrap();
     let (c1, cj) = (single.covariance.unwrap(), joint.covariance.unwrap());
     for i in 0..4 {

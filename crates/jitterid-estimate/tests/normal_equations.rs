@@ -4,8 +4,8 @@
 
 use jitterid_estimate::solver::{LeastSquares, NormalEquations};
 use jitterid_estimate::{
-    estimate, Bcls, Criterion, EstimateOptions, FitProblem, Frequencies, FrequencyData, Ls,
-    ModelStructure, Record,
+    fit, Bcls, Criterion, FitOptions, FitProblem, Frequencies, FrequencyData, Ls, ModelStructure,
+    Record,
 };
 use jitterid_jitter::Gaussian;
 use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
@@ -143,15 +143,12 @@ fn covariance_by_sums_over_samples_matches_the_projected_jacobian() {
     let grid = *record.grid();
     let mut list: Vec<f64> = FrequencySet::dft(&grid).frequencies().to_vec();
     list.reverse();
-    let by_sums = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).expect("fit");
-    let explicit = estimate(
+    let by_sums = fit(&structure, &record, &Bcls, &FitOptions::default()).expect("fit");
+    let explicit = fit(
         &structure,
         &record,
         &Bcls,
-        &EstimateOptions {
-            frequencies: Frequencies::List(list),
-            ..EstimateOptions::default()
-        },
+        &FitOptions::default().with_frequencies(Frequencies::List(list)),
     )
     .expect("fit");
     assert!(by_sums.converged && explicit.converged);

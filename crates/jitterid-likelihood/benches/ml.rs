@@ -14,14 +14,11 @@
 //!   with the samples in parallel and serially.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jitterid_estimate::{ModelStructure, Objective, Record};
+use jitterid_estimate::{fit, fit_profile, FitOptions, ModelStructure, Objective, Record};
 use jitterid_jitter::registry::JitterRegistry;
 use jitterid_jitter::{Gaussian, UniformSum};
 use jitterid_jitter::{JitterError, JitterModel};
-use jitterid_likelihood::{
-    fit_sine, ml_estimate, ml_profile, sine_least_squares, ExactMl, LikelihoodObjective, MlOptions,
-    QuasiMl,
-};
+use jitterid_likelihood::{fit_sine, sine_least_squares, ExactMl, LikelihoodObjective, QuasiMl};
 use jitterid_signal::{
     simulate, LtiResponse, RandomBinary, Root, SampleGrid, Signal, Sinusoid, Zpk,
 };
@@ -113,13 +110,13 @@ fn ls_bias_setup() -> (ModelStructure<LtiResponse<Zpk>, UniformSum>, Record) {
 
 fn table1(c: &mut Criterion) {
     let (structure, record) = table1_setup(11);
-    let opts = MlOptions::default();
+    let opts = FitOptions::default().with_covariance(false);
     let mut group = c.benchmark_group("table1-record");
     group.sample_size(30);
     group.bench_function("exact-ml profile n=0..=9", |b| {
         b.iter(|| {
             black_box(
-                ml_profile(
+                fit_profile(
                     &structure,
                     &record,
                     &ExactMl::default(),
@@ -132,12 +129,12 @@ fn table1(c: &mut Criterion) {
         })
     });
     group.bench_function("exact-ml n=0", |b| {
-        b.iter(|| black_box(ml_estimate(&structure, &record, &ExactMl::default(), &opts).unwrap()))
+        b.iter(|| black_box(fit(&structure, &record, &ExactMl::default(), &opts).unwrap()))
     });
     group.bench_function("quasi-ml profile n=0..=9", |b| {
         b.iter(|| {
             black_box(
-                ml_profile(
+                fit_profile(
                     &structure,
                     &record,
                     &QuasiMl,
@@ -153,12 +150,12 @@ fn table1(c: &mut Criterion) {
 }
 
 fn system(c: &mut Criterion) {
-    let opts = MlOptions::default();
+    let opts = FitOptions::default().with_covariance(false);
     let mut group = c.benchmark_group("system-estimated");
     group.sample_size(10);
     let (structure, record) = table2_setup();
     group.bench_function("table2 record, exact ml", |b| {
-        b.iter(|| black_box(ml_estimate(&structure, &record, &ExactMl::default(), &opts).unwrap()))
+        b.iter(|| black_box(fit(&structure, &record, &ExactMl::default(), &opts).unwrap()))
     });
     let (structure, record) = ls_bias_setup();
     let criterion = ExactMl::default();
@@ -171,7 +168,7 @@ fn system(c: &mut Criterion) {
         b.iter(|| black_box(objective.cost_gradient(&theta)))
     });
     group.bench_function("ls-bias record, exact ml", |b| {
-        b.iter(|| black_box(ml_estimate(&structure, &record, &criterion, &opts).unwrap()))
+        b.iter(|| black_box(fit(&structure, &record, &criterion, &opts).unwrap()))
     });
     group.finish();
 }
@@ -209,11 +206,11 @@ fn table1_per_n(c: &mut Criterion) {
             })
         });
     }
-    let opts = MlOptions::default();
+    let opts = FitOptions::default().with_covariance(false);
     group.bench_function("exact-ml profile n=0..=9, serial samples", |b| {
         b.iter(|| {
             black_box(
-                ml_profile(
+                fit_profile(
                     &structure,
                     &record,
                     &serial(),
@@ -260,7 +257,7 @@ fn sine(c: &mut Criterion) {
                         false,
                         None,
                         &e,
-                        &MlOptions::default(),
+                        &FitOptions::default().with_covariance(false),
                     )
                     .unwrap(),
                 )

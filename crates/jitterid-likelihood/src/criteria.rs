@@ -1,227 +1,102 @@
-//! The one run-time criterion type, [`AnyCriterion`] (a first-moment criterion behind a trait
-//! object, or a likelihood criterion), one fit entry point for it, and the registry of criteria
-//! by name.
+//! The one run-time criterion type, [`AnyCriterion`] (any [`FitCriterion`] of the run-time
+//! model types behind a shared trait object), and the registry of criteria by name.
 
-use crate::{ml_estimate, ml_profile, ExactMl, MlOptions, QuasiMl};
-use jitterid_estimate::solver::AnySolver;
-use jitterid_estimate::EstimateError;
-use jitterid_estimate::Fit;
-use jitterid_estimate::ModelStructure;
-use jitterid_estimate::NoiseModel;
-use jitterid_estimate::Record;
-use jitterid_estimate::{estimate, EstimateOptions, Frequencies};
-use jitterid_estimate::{profile, Profile};
-use jitterid_estimate::{Bcls, BoxJenkins, Criterion, Ls, WeightedBcls};
-use jitterid_jitter::JitterModel;
+use crate::fit_criterion::Likelihood;
+use crate::{ExactMl, LikelihoodCriterion, QuasiMl};
+use jitterid_estimate::{
+    AnyNoise, Bcls, BoxJenkins, CostKind, Criterion, EstimateError, Fit, FitCriterion, FitOptions,
+    Ls, ModelStructure, Profile, Record, WeightedBcls,
+};
+use jitterid_jitter::AnyJitter;
 use jitterid_registry::keys::{number, numbers, real};
 use jitterid_registry::{Builtin, Entry, Registry, RegistryError};
-use jitterid_signal::Signal;
-use jitterid_window::DirichletWindow;
+use jitterid_signal::AnySignal;
 use std::sync::Arc;
 
-/// A criterion chosen at run time. Cheap to clone.
+/// The model structure of run-time choices: a signal, a jitter family and a noise model each
+/// chosen by name.
+pub type AnyStructure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
+
+/// A criterion chosen at run time: any [`FitCriterion`] of the run-time model types
+/// ([`AnyStructure`]). Cheap to clone.
 ///
-/// First-moment criteria are any [`Criterion`] behind a trait object; the likelihood
-/// criteria ([`QuasiMl`], [`ExactMl`]) are generic over the model and held by value. Both fit
-/// through [`AnyCriterion::fit`] and return the one result type, [`Fit`].
+/// A first-moment [`Criterion`], a shipped likelihood ([`QuasiMl`], [`ExactMl`]) or a
+/// [`LikelihoodCriterion`] of one's own ([`AnyCriterion::likelihood`]) alike: each fits through
+/// [`fit`](jitterid_estimate::fit) (this type is itself a [`FitCriterion`]) and returns the one
+/// result type, [`Fit`].
 #[derive(Clone, Debug)]
-pub struct AnyCriterion(Kind);
-
-#[derive(Clone, Debug)]
-enum Kind {
-    FirstMoment(Arc<dyn Criterion>),
-    QuasiMl(QuasiMl),
-    ExactMl(ExactMl),
-}
-
-/// How [`AnyCriterion::fit`] runs.
-#[derive(Clone, Debug)]
-pub struct FitOptions {
-    /// The frequency set of a first-moment criterion (ignored by the likelihoods).
-    pub frequencies: Frequencies,
-    /// The solver; `None` for the criterion's default (Levenberg–Marquardt for first-moment
-    /// criteria, [`BrentOrBfgs`](jitterid_estimate::solver::BrentOrBfgs) for likelihoods).
-    pub solver: Option<AnySolver>,
-    /// Whether to compute the covariance of the estimate.
-    pub covariance: bool,
-    /// Start of `σ_v` for a likelihood that estimates it (default from the residuals).
-    pub noise_std_start: Option<f64>,
-}
-
-impl Default for FitOptions {
-    fn default() -> Self {
-        FitOptions {
-            frequencies: Frequencies::Dft,
-            solver: None,
-            covariance: true,
-            noise_std_start: None,
-        }
-    }
-}
+pub struct AnyCriterion(Arc<dyn FitCriterion<AnySignal, AnyJitter, AnyNoise>>);
 
 impl AnyCriterion {
+    /// Any criterion of the run-time model types.
+    pub fn new(criterion: impl FitCriterion<AnySignal, AnyJitter, AnyNoise> + 'static) -> Self {
+        AnyCriterion(Arc::new(criterion))
+    }
+
     /// A first-moment criterion.
     pub fn first_moment(criterion: impl Criterion + 'static) -> Self {
-        AnyCriterion(Kind::FirstMoment(Arc::new(criterion)))
+        AnyCriterion::new(criterion)
+    }
+
+    /// A likelihood criterion (one's own; see [`Likelihood`]).
+    pub fn likelihood(criterion: impl LikelihoodCriterion + 'static) -> Self {
+        AnyCriterion::new(Likelihood(criterion))
     }
 
     /// The Gaussian quasi-likelihood of the first two moments.
     pub fn quasi_ml() -> Self {
-        AnyCriterion(Kind::QuasiMl(QuasiMl))
+        AnyCriterion::new(QuasiMl)
     }
 
     /// The exact likelihood with the given quadrature settings.
     pub fn exact_ml(criterion: ExactMl) -> Self {
-        AnyCriterion(Kind::ExactMl(criterion))
+        AnyCriterion::new(criterion)
     }
 
     /// The criterion's name.
     pub fn name(&self) -> &'static str {
-        use crate::LikelihoodCriterion;
-        match &self.0 {
-            Kind::FirstMoment(c) => c.name(),
-            Kind::QuasiMl(c) => c.name(),
-            Kind::ExactMl(c) => c.name(),
-        }
+        self.0.name()
     }
 
     /// Whether this is a likelihood criterion (its cost is `−log L`).
     pub fn is_likelihood(&self) -> bool {
-        !matches!(self.0, Kind::FirstMoment(_))
+        self.0.cost_kind() == CostKind::NegLogLikelihood
     }
 
     /// The first-moment criterion, if it is one.
     pub fn as_first_moment(&self) -> Option<&dyn Criterion> {
-        match &self.0 {
-            Kind::FirstMoment(c) => Some(c.as_ref()),
-            _ => None,
-        }
+        self.0.as_first_moment()
     }
+}
 
-    /// Estimates the free parameters of `structure` from `record` (see
-    /// [`estimate`](jitterid_estimate::estimate) and [`ml_estimate`](crate::ml_estimate)).
-    ///
-    /// # Errors
-    ///
-    /// Those of the estimator; a likelihood's errors as [`EstimateError::Likelihood`].
-    pub fn fit<S, J, N>(
+impl FitCriterion<AnySignal, AnyJitter, AnyNoise> for AnyCriterion {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn cost_kind(&self) -> CostKind {
+        self.0.cost_kind()
+    }
+    fn as_first_moment(&self) -> Option<&dyn Criterion> {
+        self.0.as_first_moment()
+    }
+    fn fit(
         &self,
-        structure: &ModelStructure<S, J, N>,
+        structure: &AnyStructure,
         record: &Record,
         options: &FitOptions,
-    ) -> Result<Fit, EstimateError>
-    where
-        S: Signal + Clone,
-        J: JitterModel + Clone,
-        N: NoiseModel,
-    {
-        match &self.0 {
-            Kind::FirstMoment(c) => {
-                estimate(structure, record, c.as_ref(), &moment_options(options))
-            }
-            Kind::QuasiMl(c) => likelihood_fit(structure, record, c, options),
-            Kind::ExactMl(c) => likelihood_fit(structure, record, c, options),
-        }
+    ) -> Result<Fit, EstimateError> {
+        self.0.fit(structure, record, options)
     }
-
-    /// Profiles an integer-valued jitter parameter (see [`profile`](jitterid_estimate::profile) and
-    /// [`ml_profile`](crate::ml_profile)).
-    ///
-    /// # Errors
-    ///
-    /// The first error if no value could be fitted.
-    pub fn profile<S, J, N, E>(
+    fn profile(
         &self,
-        structure: &ModelStructure<S, J, N>,
+        structure: &AnyStructure,
         record: &Record,
         options: &FitOptions,
-        values: impl IntoIterator<Item = i64>,
-        build: impl Fn(i64) -> Result<J, E> + Sync,
-    ) -> Result<Profile<J>, EstimateError>
-    where
-        S: Signal + Clone,
-        J: JitterModel + Clone,
-        N: NoiseModel,
-        E: Into<EstimateError>,
-    {
-        let build = |v| build(v).map_err(Into::into);
-        match &self.0 {
-            Kind::FirstMoment(c) => profile(
-                structure,
-                record,
-                c.as_ref(),
-                &moment_options(options),
-                values,
-                build,
-            ),
-            Kind::QuasiMl(c) => likelihood_profile(structure, record, c, options, values, build),
-            Kind::ExactMl(c) => likelihood_profile(structure, record, c, options, values, build),
-        }
+        values: &[i64],
+        build: &(dyn Fn(i64) -> Result<AnyJitter, EstimateError> + Sync),
+    ) -> Result<Profile<AnyJitter>, EstimateError> {
+        self.0.profile(structure, record, options, values, build)
     }
-}
-
-fn moment_options(options: &FitOptions) -> EstimateOptions<AnySolver, DirichletWindow> {
-    EstimateOptions {
-        frequencies: options.frequencies.clone(),
-        window: DirichletWindow,
-        solver: options.solver.clone().unwrap_or_default(),
-        covariance: options.covariance,
-    }
-}
-
-fn ml_options(options: &FitOptions) -> MlOptions {
-    MlOptions {
-        covariance: options.covariance,
-        noise_std_start: options.noise_std_start,
-        ..MlOptions::default()
-    }
-}
-
-fn likelihood_fit<S, J, N, C>(
-    structure: &ModelStructure<S, J, N>,
-    record: &Record,
-    criterion: &C,
-    options: &FitOptions,
-) -> Result<Fit, EstimateError>
-where
-    S: Signal + Clone,
-    J: JitterModel + Clone,
-    N: NoiseModel,
-    C: crate::LikelihoodCriterion,
-{
-    let base = ml_options(options);
-    Ok(match &options.solver {
-        None => ml_estimate(structure, record, criterion, &base)?,
-        Some(s) => ml_estimate(structure, record, criterion, &base.with_solver(s.clone()))?,
-    })
-}
-
-fn likelihood_profile<S, J, N, C>(
-    structure: &ModelStructure<S, J, N>,
-    record: &Record,
-    criterion: &C,
-    options: &FitOptions,
-    values: impl IntoIterator<Item = i64>,
-    build: impl Fn(i64) -> Result<J, EstimateError> + Sync,
-) -> Result<Profile<J>, EstimateError>
-where
-    S: Signal + Clone,
-    J: JitterModel + Clone,
-    N: NoiseModel,
-    C: crate::LikelihoodCriterion,
-{
-    let base = ml_options(options);
-    Ok(match &options.solver {
-        None => ml_profile(structure, record, criterion, &base, values, build)?,
-        Some(s) => ml_profile(
-            structure,
-            record,
-            criterion,
-            &base.with_solver(s.clone()),
-            values,
-            build,
-        )?,
-    })
 }
 
 /// The key of a spec table that names the criterion.

@@ -76,7 +76,7 @@ pub trait LikelihoodCriterion: fmt::Debug + Send + Sync {
     }
 
     /// A cheaper form of this criterion for screening: the loose first pass of
-    /// [`ml_profile`](super::ml_profile), which needs each value only to well within its cost
+    /// [`fit_profile`](jitterid_estimate::fit_profile), which needs each value only to well within its cost
     /// tolerance. It is evaluated on the data [`prepare`](Self::prepare) made for `self`.
     /// `None` (the default): the criterion itself screens.
     fn screening(&self) -> Option<Self>
@@ -91,7 +91,7 @@ pub trait LikelihoodCriterion: fmt::Debug + Send + Sync {
     /// # Errors
     ///
     /// Typed errors where the criterion is not defined (see [`MlError`]): the objective
-    /// turns them into an infinite cost during a search, [`ml_estimate`](super::ml_estimate)
+    /// turns them into an infinite cost during a search, [`fit`](jitterid_estimate::fit)
     /// reports them at the start.
     fn evaluate<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
         &self,

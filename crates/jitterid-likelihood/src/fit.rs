@@ -1,6 +1,8 @@
 //! Maximum-likelihood estimation: [`ml_estimate`] and the integer profile [`ml_profile`],
 //! with the covariance of the estimate from the inverse Hessian of the negative
-//! log-likelihood.
+//! log-likelihood. They are what [`fit`](jitterid_estimate::fit) and
+//! [`fit_profile`](jitterid_estimate::fit_profile) run for a likelihood (see
+//! `fit_criterion.rs`), with the solver and window as types.
 
 use super::criterion::{LikelihoodCriterion, LikelihoodData};
 use super::fisher::{gaussian_fisher, spd_inverse};
@@ -27,7 +29,7 @@ use std::any::Any;
 
 /// How [`ml_estimate`] runs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MlOptions<V = BrentOrBfgs> {
+pub(crate) struct MlOptions<V = BrentOrBfgs> {
     /// The minimiser (default: Brent for one parameter, BFGS otherwise, with the inverse of
     /// the Gaussian information at the start as BFGS's first metric).
     pub solver: V,
@@ -54,7 +56,7 @@ impl Default for MlOptions {
 
 impl<V> MlOptions<V> {
     /// The same options with another solver.
-    pub fn with_solver<U>(&self, solver: U) -> MlOptions<U> {
+    pub(crate) fn with_solver<U>(&self, solver: U) -> MlOptions<U> {
         MlOptions {
             solver,
             covariance: self.covariance,
@@ -102,7 +104,7 @@ fn noise_start<S: Signal + Clone, J: JitterModel + Clone, N: NoiseModel>(
 /// [`MlError::VanishingVariance`], [`MlError::ReachExceedsRecord`], …); a start outside the
 /// constraints; invalid solver options. A search that stops without converging is not an
 /// error: see [`Fit::converged`] and [`Fit::termination`].
-pub fn ml_estimate<S, J, N, C, V>(
+pub(crate) fn ml_estimate<S, J, N, C, V>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     criterion: &C,
@@ -307,7 +309,7 @@ fn brent_hook<V: Any>(solver: &V) -> Option<ProgressHook> {
 /// # Errors
 ///
 /// The first error if no value could be fitted (including errors of `build`).
-pub fn ml_profile<S, J, N, C, V, E>(
+pub(crate) fn ml_profile<S, J, N, C, V, E>(
     structure: &ModelStructure<S, J, N>,
     record: &Record,
     criterion: &C,

@@ -15,7 +15,10 @@
 //!   Both take any [`ModelStructure`](jitterid_estimate::ModelStructure) (signal, jitter, noise each fixed
 //!   or estimated); `σ_v` is known (`structure.noise_std`) or estimated jointly as the last
 //!   parameter ([`likelihood_param_names`]).
-//! * Minimisation ([`ml_estimate`]): the criteria are general cost + gradient objectives
+//! * Minimisation: [`ExactMl`] and [`QuasiMl`] are [`FitCriterion`](jitterid_estimate::FitCriterion)s,
+//!   fitted by the workspace's one entry point, [`fit`](jitterid_estimate::fit), with its one
+//!   [`FitOptions`](jitterid_estimate::FitOptions) (a likelihood of one's own: wrap it in
+//!   [`Likelihood`]). The criteria are general cost + gradient objectives
 //!   ([`Objective`](jitterid_estimate::Objective)), not sums of squares, so any solver of the one
 //!   [`Solver`](jitterid_estimate::solver::Solver) trait that needs no residuals applies: by default
 //!   [`BrentOrBfgs`](jitterid_estimate::solver::BrentOrBfgs) (Brent's method for one parameter, dense BFGS
@@ -24,7 +27,8 @@
 //!   `σ`, `σ_v`) is a [`Transform::Positive`](jitterid_estimate::solver::Transform) reparametrisation
 //!   ([`default_transforms`]); other invalid trial points are rejected (infinite cost).
 //!   An integer-valued jitter parameter (the `n` of the uniform sum) is profiled
-//!   ([`ml_profile`]). The result is the crate's one result type, [`Fit`](jitterid_estimate::Fit).
+//!   ([`fit_profile`](jitterid_estimate::fit_profile), screened first with a cheaper form of
+//!   the criterion). The result is the crate's one result type, [`Fit`](jitterid_estimate::Fit).
 //!   The covariance of the estimate is the inverse of the Hessian of `−log L`.
 //! * Bounds: [`gaussian_fisher`] (Slepian–Bangs) and [`exact_fisher`] (the exact model's
 //!   information by integration over `y`); [`FisherInformation::crb`].
@@ -53,8 +57,8 @@
 //! conditions are infinite costs that the minimisers step back from.
 //!
 //! ```
-//! use jitterid_likelihood::{ml_estimate, ExactMl, MlOptions};
-//! use jitterid_estimate::{ModelStructure, Record};
+//! use jitterid_likelihood::ExactMl;
+//! use jitterid_estimate::{fit, FitOptions, ModelStructure, Record};
 //! use jitterid_jitter::UniformSum;
 //! use jitterid_signal::{simulate, LtiResponse, RandomBinary, Root, SampleGrid, Zpk};
 //! use rand::SeedableRng;
@@ -71,12 +75,11 @@
 //! let structure = ModelStructure::oe(signal, UniformSum::new(0, 0.4)?)
 //!     .with_estimated(false, true, false)
 //!     .with_noise_std(0.01)?;
-//! let opts = MlOptions { covariance: true, ..MlOptions::default() };
-//! let fit = ml_estimate(&structure, &record, &ExactMl::default(), &opts)?;
-//! assert!(fit.converged);
+//! let estimate = fit(&structure, &record, &ExactMl::default(), &FitOptions::default())?;
+//! assert!(estimate.converged);
 //! // Within four standard errors (from the inverse Hessian) of the truth.
-//! let se = fit.std_errors.as_ref().unwrap()[0];
-//! assert!((fit.params[0] - 0.5).abs() < 4.0 * se);
+//! let se = estimate.std_errors.as_ref().unwrap()[0];
+//! assert!((estimate.params[0] - 0.5).abs() < 4.0 * se);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
@@ -89,6 +92,7 @@ mod exact;
 mod fastexp;
 mod fisher;
 mod fit;
+mod fit_criterion;
 mod moments;
 mod objective;
 mod param;
@@ -98,13 +102,14 @@ mod simd;
 pub mod sine;
 pub mod validation;
 
-pub use criteria::{AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions, CRITERION_KEY};
+pub use criteria::{AnyCriterion, AnyStructure, CriterionEntry, CriterionRegistry, CRITERION_KEY};
 pub use criterion::{Evaluation, GradientRequest, LikelihoodCriterion, LikelihoodData};
 pub use exact::{ExactMl, MAX_SAMPLE_NODES};
 pub use fisher::{
     delta_method_std, exact_fisher, gaussian_fisher, FisherInformation, FisherOptions,
 };
-pub use fit::{ml_estimate, ml_profile, MlOptions, PROFILE_MARGIN};
+pub use fit::PROFILE_MARGIN;
+pub use fit_criterion::Likelihood;
 pub use jitterid_estimate::MlError;
 pub use moments::{
     dtft_covariance, expected_squares_gradient, second_moments, second_moments_of, DtftCovariance,

@@ -20,12 +20,13 @@
 //! tone sharing it, tells the aliases apart.
 
 use super::criterion::LikelihoodCriterion;
-use super::fit::{ml_estimate, MlOptions};
 use super::MlError;
+use crate::fit_criterion::likelihood_fit;
 use jitterid_estimate::solver::{Brent, Solver};
 use jitterid_estimate::Fit;
 use jitterid_estimate::ModelStructure;
 use jitterid_estimate::Record;
+use jitterid_estimate::{EstimateError, FitOptions};
 use jitterid_jitter::JitterModel;
 use jitterid_optim::Objective;
 use jitterid_signal::{Signal, Sinusoid};
@@ -318,7 +319,7 @@ fn canonical_amplitude_phase(amplitude: f64, phase: f64) -> (f64, f64) {
 ///
 /// # Errors
 ///
-/// Those of [`alias_start`] and [`ml_estimate`].
+/// Those of [`alias_start`] and of the likelihood's [`fit`](jitterid_estimate::fit).
 #[allow(clippy::too_many_arguments)]
 pub fn fit_sine<J, C>(
     record: &Record,
@@ -328,7 +329,7 @@ pub fn fit_sine<J, C>(
     estimate_jitter: bool,
     noise_std: Option<f64>,
     criterion: &C,
-    options: &MlOptions,
+    options: &FitOptions,
 ) -> Result<SineFit, MlError>
 where
     J: JitterModel + Clone,
@@ -345,7 +346,10 @@ where
     if opts.noise_std_start.is_none() && noise_std.is_none() {
         opts.noise_std_start = Some((0.5 * ls.residual_rms).max(1e-6 * ls.amplitude.abs()));
     }
-    let estimate = ml_estimate(&structure, record, criterion, &opts)?;
+    let estimate = likelihood_fit(criterion, &structure, record, &opts).map_err(|e| match e {
+        EstimateError::Likelihood(e) => *e,
+        other => MlError::Estimate(other),
+    })?;
     let (model, sigma) = super::param::split(&structure, &estimate.params)?;
     let p = model.signal.params();
     let (amplitude, phase) = canonical_amplitude_phase(p[0], p[2]);

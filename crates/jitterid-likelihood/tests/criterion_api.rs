@@ -4,11 +4,14 @@
 
 use jitterid_estimate::solver::{fd_jacobian, SolverRegistry, DEFAULT_FD_STEP};
 use jitterid_estimate::{
-    estimate, Bcls, Criterion, EstimateOptions, FitProblem, Frequencies, FrequencyData,
-    ModelStructure, Record, WeightContext,
+    fit, Bcls, Criterion, FitOptions, FitProblem, Frequencies, FrequencyData, ModelStructure,
+    Record, WeightContext,
 };
+use jitterid_estimate::{AnyNoise, WhiteNoise};
+use jitterid_jitter::AnyJitter;
 use jitterid_jitter::UniformSum;
-use jitterid_likelihood::{CriterionRegistry, FitOptions};
+use jitterid_likelihood::{AnyStructure, CriterionRegistry};
+use jitterid_signal::AnySignal;
 use jitterid_signal::{
     simulate, LtiResponse, PiecewiseConstant, RandomBinary, Root, SampleGrid, Zpk,
 };
@@ -92,11 +95,11 @@ impl Criterion for ModelWeighted {
 #[test]
 fn boxed_criteria_fit_like_the_concrete_type_and_keep_the_flatness_guard() {
     let (structure, record, _) = table2(11);
-    let opts = EstimateOptions::default();
-    let concrete = estimate(&structure, &record, &Bcls, &opts).unwrap();
+    let opts = FitOptions::default();
+    let concrete = fit(&structure, &record, &Bcls, &opts).unwrap();
     let criteria: Vec<Box<dyn Criterion>> = vec![Box::new(Bcls), Box::new(MyBcls)];
     for c in &criteria {
-        let fit = estimate(&structure, &record, c, &opts).unwrap();
+        let fit = fit(&structure, &record, c, &opts).unwrap();
         // The same arithmetic behind a trait object: identical to the last bit.
         assert_eq!(fit.params, concrete.params, "{}", c.name());
         assert_eq!(fit.cost, concrete.cost);
@@ -173,8 +176,18 @@ fn registries_build_what_a_front_end_asks_for_and_fit_through_one_entry() {
         solver: Some(lm),
         ..FitOptions::default()
     };
-    let any = bcls.fit(&structure, &record, &options).unwrap();
-    let direct = estimate(&structure, &record, &Bcls, &EstimateOptions::default()).unwrap();
+    // What a front end fits: the same model behind the run-time types.
+    let any_structure =
+        |s: &Structure| -> AnyStructure {
+            let signal = AnySignal::new("zpk", s.signal.clone(), |_| serde_json::Map::new());
+            let jitter = AnyJitter::new("uniform-sum", s.jitter, |_| serde_json::Map::new());
+            let mut a = ModelStructure::bj(signal, jitter, AnyNoise::new(WhiteNoise))
+                .with_estimated(s.estimate_signal, s.estimate_jitter, false);
+            a.noise_std = s.noise_std;
+            a
+        };
+    let any = fit(&any_structure(&structure), &record, &bcls, &options).unwrap();
+    let direct = fit(&structure, &record, &Bcls, &FitOptions::default()).unwrap();
     assert_eq!(any.params, direct.params);
     assert_eq!(any.std_errors, direct.std_errors);
     // A likelihood with a residual-only solver: a typed error, not a panic.
@@ -182,7 +195,7 @@ fn registries_build_what_a_front_end_asks_for_and_fit_through_one_entry() {
         .build(&table(serde_json::json!({ "criterion": "quasi-ml" })))
         .unwrap();
     let known = structure.clone().with_noise_std(0.01).unwrap();
-    let err = ml.fit(&known, &record, &options).unwrap_err();
+    let err = fit(&any_structure(&known), &record, &ml, &options).unwrap_err();
     assert!(err.to_string().contains("lm"), "{err}");
     // Errors name the key.
     let e = criteria
@@ -208,5 +221,9 @@ fn registries_build_what_a_front_end_asks_for_and_fit_through_one_entry() {
         frequencies: Frequencies::Band { min: 0.0, max: 0.2 },
         ..FitOptions::default()
     };
-    assert!(bcls.fit(&structure, &record, &band).unwrap().converged);
+    assert!(
+        fit(&any_structure(&structure), &record, &bcls, &band)
+            .unwrap()
+            .converged
+    );
 }

@@ -3,8 +3,8 @@
 
 use jitterid_estimate::montecarlo::Summary;
 use jitterid_estimate::solver::{Bfgs, Brent, NelderMead, Solver, SolverError, Termination};
+use jitterid_estimate::{fit, fit_profile, ArmaNoise, FitOptions, ModelStructure, Record};
 use jitterid_estimate::{ArgminObjective, Objective};
-use jitterid_estimate::{ArmaNoise, ModelStructure, Record};
 use jitterid_jitter::{Gaussian, JitterError, JitterModel, NoJitter, TwoPoint, UniformSum};
 use jitterid_likelihood::*;
 use jitterid_signal::{
@@ -429,11 +429,8 @@ fn exact_ml_is_unbiased_and_its_hessian_predicts_the_spread() {
             .with_estimated(false, true, false)
             .with_noise_std(0.01)
             .unwrap();
-        let opts = MlOptions {
-            covariance: true,
-            ..Default::default()
-        };
-        let fit = ml_estimate(&structure, &record, &ExactMl::default(), &opts).unwrap();
+        let opts = FitOptions::default();
+        let fit = fit(&structure, &record, &ExactMl::default(), &opts).unwrap();
         assert!(fit.converged, "{:?}", fit.termination);
         est.push(fit.params[0]);
         se.push(fit.std_errors.unwrap()[0]);
@@ -461,13 +458,10 @@ fn uniform_sum_profile_finds_sigma() {
         .with_estimated(false, true, false)
         .with_noise_std(0.01)
         .unwrap();
-    let opts = MlOptions {
-        covariance: true,
-        ..Default::default()
-    };
+    let opts = FitOptions::default();
     for crit in ["exact", "quasi"] {
         let p = if crit == "exact" {
-            ml_profile(
+            fit_profile(
                 &structure,
                 &record,
                 &ExactMl::default(),
@@ -476,7 +470,7 @@ fn uniform_sum_profile_finds_sigma() {
                 keep_std_dev(&structure.jitter),
             )
         } else {
-            ml_profile(
+            fit_profile(
                 &structure,
                 &record,
                 &QuasiMl,
@@ -500,10 +494,12 @@ fn uniform_sum_profile_finds_sigma() {
 #[test]
 fn staged_profile_equals_full_refinement() {
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
-    let full = MlOptions::default().with_solver(Brent {
-        bracket_step: 0.01,
-        ..Brent::default()
-    });
+    let full = FitOptions::default()
+        .with_covariance(false)
+        .with_solver(Brent {
+            bracket_step: 0.01,
+            ..Brent::default()
+        });
     for (r, truth) in [
         (0u64, UniformSum::new(0, 0.5).unwrap()),
         (1, UniformSum::new(2, 0.5).unwrap()),
@@ -519,16 +515,16 @@ fn staged_profile_equals_full_refinement() {
             .with_noise_std(0.01)
             .unwrap();
         let e = ExactMl::default();
-        let staged = ml_profile(
+        let staged = fit_profile(
             &structure,
             &record,
             &e,
-            &MlOptions::default(),
+            &FitOptions::default().with_covariance(false),
             0..=9,
             keep_std_dev(&structure.jitter),
         )
         .unwrap();
-        let every = ml_profile(
+        let every = fit_profile(
             &structure,
             &record,
             &e,
@@ -634,8 +630,15 @@ fn bad_input_gives_typed_errors() {
         Err(MlError::LikelihoodUnderflow { index: 7, .. })
     ));
     assert!(matches!(
-        ml_estimate(&structure, &record, &exact, &MlOptions::default()),
-        Err(MlError::LikelihoodUnderflow { index: 7, .. })
+        fit(
+            &structure,
+            &record,
+            &exact,
+            &FitOptions::default().with_covariance(false)
+        )
+        .unwrap_err()
+        .likelihood(),
+        Some(&MlError::LikelihoodUnderflow { index: 7, .. })
     ));
     let record = Record::new(grid, data.y.clone()).unwrap();
     // λ_k → 0: no noise, and samples where the jittered signal does not move (before the
@@ -649,12 +652,26 @@ fn bad_input_gives_typed_errors() {
         .with_noise_std(0.0)
         .unwrap();
     assert!(matches!(
-        ml_estimate(&quiet, &record, &QuasiMl, &MlOptions::default()),
-        Err(MlError::VanishingVariance { .. })
+        fit(
+            &quiet,
+            &record,
+            &QuasiMl,
+            &FitOptions::default().with_covariance(false)
+        )
+        .unwrap_err()
+        .likelihood(),
+        Some(&MlError::VanishingVariance { .. })
     ));
     assert!(matches!(
-        ml_estimate(&quiet, &record, &exact, &MlOptions::default()),
-        Err(MlError::NoNoise { .. })
+        fit(
+            &quiet,
+            &record,
+            &exact,
+            &FitOptions::default().with_covariance(false)
+        )
+        .unwrap_err()
+        .likelihood(),
+        Some(&MlError::NoNoise { .. })
     ));
     // A reach wider than the record.
     let wide = ModelStructure::oe(signal.clone(), UniformSum::new(0, 30.0).unwrap())
@@ -662,18 +679,35 @@ fn bad_input_gives_typed_errors() {
         .with_noise_std(0.01)
         .unwrap();
     for res in [
-        ml_estimate(&wide, &record, &exact, &MlOptions::default()),
-        ml_estimate(&wide, &record, &QuasiMl, &MlOptions::default()),
+        fit(
+            &wide,
+            &record,
+            &exact,
+            &FitOptions::default().with_covariance(false),
+        ),
+        fit(
+            &wide,
+            &record,
+            &QuasiMl,
+            &FitOptions::default().with_covariance(false),
+        ),
     ] {
         assert!(
-            matches!(res, Err(MlError::ReachExceedsRecord { duration, .. }) if duration == 20.0)
+            matches!(res.unwrap_err().likelihood(), Some(MlError::ReachExceedsRecord { duration, .. }) if *duration == 20.0)
         );
     }
     // Coloured noise with the exact criterion.
     let bj = ModelStructure::bj(signal, jitter, ArmaNoise::new(vec![0.5], vec![]).unwrap());
     assert!(matches!(
-        ml_estimate(&bj, &record, &exact, &MlOptions::default()),
-        Err(MlError::ColouredNoise { .. })
+        fit(
+            &bj,
+            &record,
+            &exact,
+            &FitOptions::default().with_covariance(false)
+        )
+        .unwrap_err()
+        .likelihood(),
+        Some(&MlError::ColouredNoise { .. })
     ));
     // Invalid quadrature options.
     let bad = ExactMl {
@@ -741,7 +775,7 @@ fn sine_aliases_are_told_apart_by_a_known_jitter_and_not_by_an_estimated_one() {
                     false,
                     None,
                     &exact,
-                    &MlOptions::default(),
+                    &FitOptions::default().with_covariance(false),
                 )
                 .unwrap()
             })
@@ -806,11 +840,8 @@ fn quasi_ml_with_coloured_noise() {
         .with_estimated(false, false, true);
     let o = LikelihoodObjective::new(&structure, &QuasiMl, &record);
     check_gradient(&o, &[0.3, 0.03], 1e-5);
-    let opts = MlOptions {
-        covariance: true,
-        ..Default::default()
-    };
-    let fit = ml_estimate(&structure, &record, &QuasiMl, &opts).unwrap();
+    let opts = FitOptions::default();
+    let fit = fit(&structure, &record, &QuasiMl, &opts).unwrap();
     assert!(fit.converged, "{:?}", fit.termination);
     assert_eq!(fit.names, vec!["noise.c1", "noise.std"]);
     let se = fit.std_errors.unwrap();
@@ -934,13 +965,19 @@ fn diag_uniform_bias() {
             .with_estimated(false, true, false)
             .with_noise_std(0.01)
             .unwrap();
-        let e = ml_estimate(&s, &record, &ExactMl::default(), &MlOptions::default()).unwrap();
-        fixed.push(e.params[0]);
-        let p = ml_profile(
+        let e = fit(
             &s,
             &record,
             &ExactMl::default(),
-            &MlOptions::default(),
+            &FitOptions::default().with_covariance(false),
+        )
+        .unwrap();
+        fixed.push(e.params[0]);
+        let p = fit_profile(
+            &s,
+            &record,
+            &ExactMl::default(),
+            &FitOptions::default().with_covariance(false),
             0..=9,
             keep_std_dev(&s.jitter),
         )
@@ -1051,8 +1088,15 @@ fn an_overlarge_quadrature_is_a_typed_error() {
         "{tiny:?}"
     );
     assert!(matches!(
-        ml_estimate(&structure, &record, &exact, &MlOptions::default()),
-        Err(MlError::QuadratureTooLarge { .. })
+        fit(
+            &structure,
+            &record,
+            &exact,
+            &FitOptions::default().with_covariance(false)
+        )
+        .unwrap_err()
+        .likelihood(),
+        Some(&MlError::QuadratureTooLarge { .. })
     ));
     // At a noise level of the signal's scale every sample's rule is small.
     let structure = structure.with_noise_std(1.0).unwrap();

@@ -2,7 +2,7 @@
 //! residual whiteness on true and wrong-order models, delta-method bands against the Monte
 //! Carlo spread of fitted models.
 
-use jitterid_estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid_estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid_jitter::UniformSum;
 use jitterid_likelihood::validation::{
     bode, cross_correlation, default_max_lag, fit_initial_state, log_response_gradient,
@@ -178,7 +178,7 @@ fn whiteness_passes_at_the_truth_and_fails_for_a_wrong_order() {
     let start = Zpk::new(0.3, vec![], vec![Root::Real(-0.4)]).unwrap();
     let structure = ModelStructure::oe(LtiResponse::new(start.clone(), u.clone()), s.jitter);
     let data = Record::new(s.grid, y.clone()).unwrap();
-    let fit = estimate(&structure, &data, &Bcls, &EstimateOptions::default()).unwrap();
+    let fit = fit(&structure, &data, &Bcls, &FitOptions::default()).unwrap();
     let fitted = start.with_params(&fit.params).unwrap();
     let (white, cross) = verdicts(&s, fitted, &u, &y);
     assert!(
@@ -209,7 +209,7 @@ fn delta_method_band_matches_the_monte_carlo_spread() {
             .with_noise_std(s.noise)
             .unwrap();
         let data = Record::new(s.grid, y).unwrap();
-        let fit = estimate(&structure, &data, &Bcls, &EstimateOptions::default()).unwrap();
+        let fit = fit(&structure, &data, &Bcls, &FitOptions::default()).unwrap();
         assert!(fit.converged, "seed {seed}: {}", fit.termination);
         let fitted = truth.with_params(&fit.params).unwrap();
         let cov = fit.covariance.clone().unwrap();

@@ -6,6 +6,7 @@ use super::{
 };
 use crate::LeastSquares;
 use crate::Objective;
+use std::any::Any;
 use std::fmt;
 use std::sync::Arc;
 
@@ -33,6 +34,12 @@ pub trait DynSolver: fmt::Debug + Send + Sync {
     /// iteration, or `None` for a solver that has no progress reports (the default).
     fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
         let _ = hook;
+        None
+    }
+
+    /// The solver as [`Any`], so that a caller can recognise a solver it has a faster
+    /// schedule for ([`AnySolver::downcast_ref`]); `None` (the default) hides the type.
+    fn as_any(&self) -> Option<&dyn Any> {
         None
     }
 }
@@ -79,6 +86,19 @@ impl AnySolver {
             .with_progress_dyn(hook)
             .unwrap_or_else(|| self.clone())
     }
+
+    /// The wrapped solver if it is a `T` (every solver of this crate shows its type).
+    ///
+    /// ```
+    /// use jitterid_optim::{AnySolver, Bfgs, BrentOrBfgs};
+    ///
+    /// let solver = AnySolver::new(BrentOrBfgs::default());
+    /// assert!(solver.downcast_ref::<BrentOrBfgs>().is_some());
+    /// assert!(solver.downcast_ref::<Bfgs>().is_none());
+    /// ```
+    pub fn downcast_ref<T: Any>(&self) -> Option<&T> {
+        self.0.as_any()?.downcast_ref()
+    }
 }
 
 impl Default for AnySolver {
@@ -111,6 +131,9 @@ impl DynSolver for AnySolver {
     }
     fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
         self.0.with_progress_dyn(hook)
+    }
+    fn as_any(&self) -> Option<&dyn Any> {
+        self.0.as_any()
     }
 }
 
@@ -155,6 +178,9 @@ impl DynSolver for LevenbergMarquardt {
     fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
         Some(AnySolver::new(self.clone().with_progress(hook)))
     }
+    fn as_any(&self) -> Option<&dyn Any> {
+        Some(self)
+    }
 }
 
 impl DynSolver for GaussNewtonLineSearch {
@@ -163,6 +189,9 @@ impl DynSolver for GaussNewtonLineSearch {
     }
     fn minimize_dyn(&self, p: &dyn Objective, start: &[f64]) -> Result<SolverReport, SolverError> {
         Solver::minimize(self, residual_form(p, "gauss-newton")?, start)
+    }
+    fn as_any(&self) -> Option<&dyn Any> {
+        Some(self)
     }
 }
 
@@ -184,6 +213,9 @@ macro_rules! objective_solver {
             }
             fn with_progress_dyn(&self, hook: ProgressHook) -> Option<AnySolver> {
                 ($hooked)(self, hook)
+            }
+            fn as_any(&self) -> Option<&dyn Any> {
+                Some(self)
             }
         }
     };

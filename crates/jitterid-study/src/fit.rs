@@ -5,10 +5,10 @@ use crate::experiment::{name_table, Experiment, Method};
 use crate::export::{self, reported_covariance, CovarianceSource};
 use crate::study_err;
 use crate::Watch;
-use jitterid::estimate::solver::AnySolver;
+use jitterid::estimate::solver::{AnySolver, BrentOrBfgs};
 use jitterid::estimate::{
-    AnyCriterion, AnyNoise, EstimateError, Fit as Estimate, FitOptions, ModelStructure, NoiseModel,
-    Record,
+    fit as fit_criterion, fit_profile, AnyCriterion, AnyNoise, EstimateError, Fit as Estimate,
+    FitOptions, ModelStructure, NoiseModel, Record,
 };
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, UniformSum};
@@ -228,18 +228,48 @@ pub fn truth_values(
     Ok(out)
 }
 
+/// The options of a fit of `criterion`. A first-moment criterion runs the experiment's
+/// solver on its frequency set. A likelihood runs the likelihood's default solver (Brent's
+/// method for one parameter, BFGS otherwise), with the wall-clock budget given to BFGS
+/// (Brent's method is bounded by its iteration limit).
 fn options(
     exp: &Experiment,
+    criterion: &AnyCriterion,
     seed: u64,
     covariance: bool,
     watch: &Watch,
 ) -> StudyResult<FitOptions> {
+    let solver = if criterion.is_likelihood() {
+        let mut s = BrentOrBfgs::default();
+        if let Some(max_seconds) = exp.estimate.max_seconds {
+            s.bfgs.max_seconds = max_seconds;
+        }
+        let s = AnySolver::new(s);
+        match &watch.iterations {
+            Some(hook) => s.with_progress(hook.clone()),
+            None => s,
+        }
+    } else {
+        solver(exp, seed, watch)?
+    };
     Ok(FitOptions {
         frequencies: exp.estimate.frequencies.clone(),
-        solver: Some(solver(exp, seed, watch)?),
+        solver: Some(solver),
         covariance,
-        noise_std_start: None,
+        ..FitOptions::default()
     })
+}
+
+/// The criterion `method` names, as the experiment fits it: `"ml"`, the exact likelihood of
+/// white noise, is the Gaussian (quasi) likelihood of the first two moments for an ARMA noise
+/// model.
+fn criterion_of(exp: &Experiment, s: &Structure, method: Method) -> AnyCriterion {
+    let criterion = method.criterion_in(&exp.registries.criteria);
+    if method.as_str() == "ml" && !s.noise.is_white() {
+        AnyCriterion::quasi_ml()
+    } else {
+        criterion
+    }
 }
 
 /// `j`, a uniform sum, with its whole number `n` replaced (rebuilt through the registry).
@@ -249,6 +279,10 @@ fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
     JitterRegistry::builtin().build(&spec)
 }
 
+/// Runs `criterion` on `s` as the experiment asks: the uniform-sum order profiled when it is
+/// estimated over a range, the jitter's white floor beside an ARMA shape for a criterion that
+/// weights by the noise model. Returns the estimate, the fitted structure (with `σ_v` when the
+/// criterion estimated it) and the profiled `n`.
 fn run_criterion(
     exp: &Experiment,
     s: &Structure,
@@ -262,11 +296,11 @@ fn run_criterion(
         {
             let values = i64::from(lo)..=i64::from(hi);
             let build = uniform_sum_with_std(u.std_dev());
-            let p = criterion.profile(s, record, opts, values, build)?;
+            let p = fit_profile(s, record, criterion, opts, values, build)?;
             let n = p.value as u32;
             let mut base = s.clone();
             base.jitter = with_n(&s.jitter, n)?;
-            let fitted = base.with_params(&p.estimate.params)?;
+            let fitted = fitted_structure(&base, criterion, &p.estimate)?;
             return Ok((p.estimate, fitted, Some(n)));
         }
     }
@@ -278,13 +312,29 @@ fn run_criterion(
     if sees_noise {
         let guess = (exp.noise.std > 0.0).then_some(exp.noise.std);
         let (e, fitted) = s.fit_with_jitter_floor(record, guess, |floored| {
-            criterion.fit(floored, record, opts)
+            fit_criterion(floored, record, criterion, opts)
         })?;
         return Ok((e, fitted, None));
     }
-    let e = criterion.fit(s, record, opts)?;
-    let fitted = s.with_params(&e.params)?;
+    let e = fit_criterion(s, record, criterion, opts)?;
+    let fitted = fitted_structure(s, criterion, &e)?;
     Ok((e, fitted, None))
+}
+
+/// `base` at the estimate `e`: a likelihood's parameters are the structure's followed by the
+/// `σ_v` it estimated, which becomes the structure's noise level.
+fn fitted_structure(
+    base: &Structure,
+    criterion: &AnyCriterion,
+    e: &Estimate,
+) -> Result<Structure, EstimateError> {
+    if !criterion.is_likelihood() {
+        return base.with_params(&e.params);
+    }
+    let k = base.num_params();
+    let mut fitted = base.with_params(e.params.get(..k).unwrap_or(&e.params))?;
+    fitted.noise_std = Some(e.noise_std);
+    Ok(fitted)
 }
 
 /// The raw outcome of one estimator, before the parameters are arranged for the report.
@@ -333,18 +383,14 @@ pub fn fit(
     covariance: bool,
     watch: &Watch,
 ) -> Result<Fit, String> {
-    let opts = options(exp, seed, covariance, watch).map_err(|e| e.to_string())?;
-    let raw =
-        |r: Result<(Estimate, Structure, Option<u32>), EstimateError>| -> Result<Raw, String> {
-            let (e, fitted, n) = r.map_err(|e| e.to_string())?;
-            Ok(Raw::of(e, fitted, n))
-        };
-    let criterion = method.criterion_in(&exp.registries.criteria);
-    let e = if criterion.is_likelihood() {
-        fit_ml(exp, s, record, method, covariance, watch)?
-    } else {
-        raw(run_criterion(exp, s, record, &criterion, &opts))?
-    };
+    let criterion = criterion_of(exp, s, method);
+    if criterion.is_likelihood() && !cfg!(feature = "ml") {
+        return Err("maximum likelihood is not available in this build of jitterid".into());
+    }
+    let opts = options(exp, &criterion, seed, covariance, watch).map_err(|e| e.to_string())?;
+    let (e, fitted, n) =
+        run_criterion(exp, s, record, &criterion, &opts).map_err(|e| e.to_string())?;
+    let e = Raw::of(e, fitted, n);
     let names = report_names(exp, s);
     let se = |i: usize| {
         e.std_errors
@@ -412,81 +458,6 @@ pub fn fit(
         estimated: e.names,
         estimator_covariance: e.covariance,
     })
-}
-
-#[cfg(not(feature = "ml"))]
-fn fit_ml(
-    _: &Experiment,
-    _: &Structure,
-    _: &Record,
-    _: Method,
-    _: bool,
-    _: &Watch,
-) -> Result<Raw, String> {
-    Err("maximum likelihood is not available in this build of jitterid".into())
-}
-
-/// Maximum likelihood: `"ml"` is the exact likelihood for white noise and the Gaussian (quasi)
-/// likelihood of the first two moments for an ARMA noise model; `"quasi-ml"` is the latter.
-#[cfg(feature = "ml")]
-fn fit_ml(
-    exp: &Experiment,
-    s: &Structure,
-    record: &Record,
-    method: Method,
-    covariance: bool,
-    watch: &Watch,
-) -> Result<Raw, String> {
-    use jitterid::estimate::ml::{
-        ml_estimate, ml_profile, ExactMl, LikelihoodCriterion, MlOptions, QuasiMl,
-    };
-    fn go<C: LikelihoodCriterion>(
-        exp: &Experiment,
-        s: &Structure,
-        record: &Record,
-        c: &C,
-        opts: &MlOptions,
-    ) -> Result<(Estimate, Option<u32>, Structure), String> {
-        let e = |e: jitterid::estimate::ml::MlError| e.to_string();
-        if profiled(exp) {
-            if let (Some(u), Some((lo, hi))) =
-                (s.jitter.downcast_ref::<UniformSum>(), exp.jitter.n_range)
-            {
-                let values = i64::from(lo)..=i64::from(hi);
-                let build = uniform_sum_with_std(u.std_dev());
-                let p = ml_profile(s, record, c, opts, values, build).map_err(e)?;
-                let n = p.value as u32;
-                let mut base = s.clone();
-                base.jitter = with_n(&s.jitter, n).map_err(|x| x.to_string())?;
-                return Ok((p.estimate, Some(n), base));
-            }
-        }
-        Ok((ml_estimate(s, record, c, opts).map_err(e)?, None, s.clone()))
-    }
-    let mut opts = MlOptions {
-        covariance,
-        ..MlOptions::default()
-    };
-    // The wall-clock budget is BFGS's (several parameters); Brent's method for a single
-    // parameter is bounded by its iteration limit.
-    if let Some(max_seconds) = exp.estimate.max_seconds {
-        opts.solver.bfgs.max_seconds = max_seconds;
-    }
-    if let Some(hook) = &watch.iterations {
-        opts.solver.bfgs.progress = Some(hook.clone());
-        opts.solver.brent.progress = Some(hook.clone());
-    }
-    let (e, n, base) = if s.noise.is_white() && method.as_str() == "ml" {
-        go(exp, s, record, &ExactMl::default(), &opts)?
-    } else {
-        go(exp, s, record, &QuasiMl, &opts)?
-    };
-    let k = base.num_params();
-    let mut fitted = base
-        .with_params(e.params.get(..k).unwrap_or(&e.params))
-        .map_err(|x| x.to_string())?;
-    fitted.noise_std = Some(e.noise_std);
-    Ok(Raw::of(e, fitted, n))
 }
 
 /// `θ ∘ (1 + U(−r, r))`, componentwise, drawn from `rng`.

@@ -42,6 +42,23 @@ pub trait Window: Debug + Send + Sync {
     }
 }
 
+/// A shared window is the window it shares: run-time choices (a window held as
+/// `Arc<dyn Window>` in fit options) work wherever a window type does.
+impl<W: Window + ?Sized> Window for std::sync::Arc<W> {
+    fn weight(&self, k: usize, n: usize) -> f64 {
+        (**self).weight(k, n)
+    }
+    fn weights(&self, n: usize) -> Vec<f64> {
+        (**self).weights(n)
+    }
+    fn kernel(&self, grid: &SampleGrid, nu: f64) -> Complex64 {
+        (**self).kernel(grid, nu)
+    }
+    fn is_rectangular(&self) -> bool {
+        (**self).is_rectangular()
+    }
+}
+
 /// The rectangular window `w_k = 1`: the plain DTFT, with the Dirichlet kernel
 /// `Γ_N(ν) = e^{-iπν(N-1)T} sin(πνNT)/sin(πνT)` as its kernel. This is the paper's choice.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

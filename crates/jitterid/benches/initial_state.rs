@@ -17,7 +17,7 @@
 //! `cargo bench -p jitterid --bench initial_state`
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jitterid::estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid::estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid::prelude::*;
 use jitterid::signal::{PiecewiseConstant, WithInitialState};
 use rand::SeedableRng;
@@ -50,10 +50,7 @@ fn benches(c: &mut Criterion) {
     let y = simulate(&truth, &jitter, &grid, 0.01, &mut rng).unwrap().y;
     let record = Record::new(grid, y).unwrap();
     let start = LtiResponse::new(eq17(0.21, 0.45, -0.27, 0.33), seen);
-    let options = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
+    let options = FitOptions::default().with_covariance(false);
     let at_rest = ModelStructure::oe(start.clone(), jitter);
     let with_state = WithInitialState::at_rest(start.clone(), 0.0).unwrap();
     let free = ModelStructure::oe(with_state.clone(), jitter);
@@ -76,25 +73,21 @@ fn benches(c: &mut Criterion) {
     for (name, iterations) in [
         (
             "history, model from rest",
-            estimate(&at_rest, &record, &Bcls, &options)
-                .unwrap()
-                .iterations,
+            fit(&at_rest, &record, &Bcls, &options).unwrap().iterations,
         ),
         (
             "history, initial state estimated",
-            estimate(&free, &record, &Bcls, &options)
-                .unwrap()
-                .iterations,
+            fit(&free, &record, &Bcls, &options).unwrap().iterations,
         ),
         (
             "input from t0, model from rest",
-            estimate(&fresh_rest, &fresh_record, &Bcls, &options)
+            fit(&fresh_rest, &fresh_record, &Bcls, &options)
                 .unwrap()
                 .iterations,
         ),
         (
             "input from t0, initial state estimated",
-            estimate(&fresh_free, &fresh_record, &Bcls, &options)
+            fit(&fresh_free, &fresh_record, &Bcls, &options)
                 .unwrap()
                 .iterations,
         ),
@@ -104,16 +97,16 @@ fn benches(c: &mut Criterion) {
 
     let mut g = c.benchmark_group("initial-state");
     g.bench_function("BCLS fit, model from rest", |b| {
-        b.iter(|| estimate(&at_rest, &record, &Bcls, &options).unwrap())
+        b.iter(|| fit(&at_rest, &record, &Bcls, &options).unwrap())
     });
     g.bench_function("BCLS fit, initial state estimated", |b| {
-        b.iter(|| estimate(&free, &record, &Bcls, &options).unwrap())
+        b.iter(|| fit(&free, &record, &Bcls, &options).unwrap())
     });
     g.bench_function("BCLS fit (input from t0), model from rest", |b| {
-        b.iter(|| estimate(&fresh_rest, &fresh_record, &Bcls, &options).unwrap())
+        b.iter(|| fit(&fresh_rest, &fresh_record, &Bcls, &options).unwrap())
     });
     g.bench_function("BCLS fit (input from t0), initial state estimated", |b| {
-        b.iter(|| estimate(&fresh_free, &fresh_record, &Bcls, &options).unwrap())
+        b.iter(|| fit(&fresh_free, &fresh_record, &Bcls, &options).unwrap())
     });
     g.bench_function("one evaluation, model from rest", |b| {
         b.iter(|| black_box(&start).expected_values_and_gradient(&grid, &jitter))

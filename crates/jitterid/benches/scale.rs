@@ -6,7 +6,7 @@
 //! same sweep as a table, with `N = 10^6` and the peak memory.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use jitterid::estimate::{estimate, Bcls, EstimateOptions, FrequencyData, ModelStructure, Record};
+use jitterid::estimate::{fit, Bcls, FitOptions, FrequencyData, ModelStructure, Record};
 use jitterid::prelude::*;
 use jitterid::window::{DirichletWindow, FrequencySet};
 use rand::SeedableRng;
@@ -40,10 +40,7 @@ fn setup(n: usize) -> Setup {
 }
 
 fn benches(c: &mut Criterion) {
-    let no_cov = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
+    let no_cov = FitOptions::default().with_covariance(false);
     let mut group = c.benchmark_group("scale");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(10));
@@ -63,7 +60,7 @@ fn benches(c: &mut Criterion) {
             })
         });
         group.bench_with_input(BenchmarkId::new("fit", n), &n, |b, _| {
-            b.iter(|| estimate(&structure, black_box(&record), &Bcls, &no_cov).unwrap())
+            b.iter(|| fit(&structure, black_box(&record), &Bcls, &no_cov).unwrap())
         });
     }
     group.finish();

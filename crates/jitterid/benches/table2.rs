@@ -5,7 +5,7 @@
 //! `cargo bench -p jitterid --bench table2`
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jitterid::estimate::{estimate, Bcls, EstimateOptions, ModelStructure, Record};
+use jitterid::estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid::prelude::*;
 use jitterid::window::{
     first_moment, first_moment_integral, DirichletWindow, FrequencySet, IntegralOptions,
@@ -78,16 +78,13 @@ fn benches(c: &mut Criterion) {
     let record = Record::new(grid, y).unwrap();
     let start = LtiResponse::new(eq17(0.21, 0.45, -0.27, 0.33), signal.input().clone());
     let structure = ModelStructure::oe(start, jitter);
-    let with_cov = EstimateOptions::default();
-    let no_cov = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
+    let with_cov = FitOptions::default();
+    let no_cov = FitOptions::default().with_covariance(false);
     c.bench_function("table2/BCLS fit from a perturbed start", |b| {
-        b.iter(|| estimate(&structure, &record, &Bcls, &no_cov).unwrap())
+        b.iter(|| fit(&structure, &record, &Bcls, &no_cov).unwrap())
     });
     c.bench_function("table2/BCLS fit + sandwich covariance", |b| {
-        b.iter(|| estimate(&structure, &record, &Bcls, &with_cov).unwrap())
+        b.iter(|| fit(&structure, &record, &Bcls, &with_cov).unwrap())
     });
 }
 

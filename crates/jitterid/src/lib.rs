@@ -53,7 +53,8 @@ pub mod estimate {
     /// The likelihood layer (`jitterid-likelihood`).
     pub use jitterid_likelihood as ml;
     pub use jitterid_likelihood::{
-        selection, validation, AnyCriterion, CriterionEntry, CriterionRegistry, FitOptions,
+        selection, validation, AnyCriterion, AnyStructure, CriterionEntry, CriterionRegistry,
+        ExactMl, Likelihood, QuasiMl,
     };
     /// The optimisation layer (`jitterid-optim`).
     pub use jitterid_optim as solver;

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 /// Options of `fit`.
 #[derive(Debug, Clone)]
-pub struct FitOptions {
+pub struct FitRequest {
     /// The experiment file.
     pub experiment: PathBuf,
     /// The data file.
@@ -46,7 +46,7 @@ pub struct FitOptions {
 
 /// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
 /// not converge (unless `accept_unconverged`).
-pub fn fit(o: &FitOptions) -> StudyResult<Outcome> {
+pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let exp = read_experiment(
         &o.experiment,
         Purpose::Estimate(o.method),

@@ -9,7 +9,7 @@ mod select;
 mod simulate;
 mod validate;
 
-pub use fit::{fit, FitOptions};
+pub use fit::{fit, FitRequest};
 pub use merge::merge;
 pub use montecarlo::{emit, montecarlo, MonteCarloOptions};
 pub use select::{select, SelectOptions};

@@ -14,7 +14,8 @@
 //! picks the order within a family reliably.
 
 use super::{structure_of, Candidate, Structure};
-use crate::{ml_estimate, ExactMl, MlOptions};
+use crate::fit::{ml_estimate, MlOptions};
+use crate::ExactMl;
 use jitterid_estimate::Record;
 use jitterid_jitter::registry::JitterRegistry;
 use jitterid_jitter::{AnyJitter, JitterModel};

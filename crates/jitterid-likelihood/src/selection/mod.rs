@@ -43,9 +43,7 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use crate::validation::{fit_percent, on_record};
-use jitterid_estimate::{
-    estimate, initialize, Bcls, EstimateOptions, InitOptions, ModelStructure, Record,
-};
+use jitterid_estimate::{fit, initialize, Bcls, FitOptions, InitOptions, ModelStructure, Record};
 
 mod likelihood;
 
@@ -308,12 +306,9 @@ fn fit_from(
         .map_err(|e| format!("candidate system: {e}"))?;
     let structure = structure_of(family, signal, rational.jitter);
     // The ranking needs the cost only; the sandwich covariance would dominate the time.
-    let options = EstimateOptions {
-        covariance: false,
-        ..EstimateOptions::default()
-    };
-    let fit = estimate(&structure, record, &Bcls, &options).map_err(|e| format!("fit: {e}"))?;
-    Ok((structure, fit))
+    let options = FitOptions::default().with_covariance(false);
+    let estimate = fit(&structure, record, &Bcls, &options).map_err(|e| format!("fit: {e}"))?;
+    Ok((structure, estimate))
 }
 
 fn fit_candidate(
