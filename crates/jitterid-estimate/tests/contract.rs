@@ -50,6 +50,38 @@ fn check_criterion_builds_its_own_fixture() {
     check_criterion(&BoxJenkins, 3).unwrap_or_else(|e| panic!("{e}"));
 }
 
+/// The out-of-tree criterion of `docs/extending.md`: BCLS weighted by 1/f below a cutoff.
+#[derive(Debug)]
+struct InverseFrequency {
+    cutoff: f64,
+}
+
+impl Criterion for InverseFrequency {
+    fn name(&self) -> &'static str {
+        "bcls-1/f"
+    }
+    fn models_jitter(&self) -> bool {
+        true
+    }
+    fn weights(&self, context: &WeightContext<'_>) -> Vec<f64> {
+        let f = context.frequencies().frequencies();
+        f.iter()
+            .map(|&f| {
+                if f > 0.0 && f <= self.cutoff {
+                    1.0 / f
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+}
+
+#[test]
+fn the_criterion_of_the_extending_guide_meets_the_contract() {
+    check_criterion(&InverseFrequency { cutoff: 0.2 }, 1).unwrap_or_else(|e| panic!("{e}"));
+}
+
 /// A criterion with ones as weights, changed by `f` at the context.
 struct Broken<F> {
     name: &'static str,
