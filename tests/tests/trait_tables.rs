@@ -6,9 +6,10 @@
 //! body), then compares them with
 //!
 //! * its row of the "Traits" table of `docs/architecture.md` (`| `Trait` | crate | required |
-//!   provided |`): every backticked name in a cell is a method (a call such as `weight(k, n)`
-//!   counts as `weight`), and the word "parameters" stands for `param_names`, `params` and
-//!   `with_params`;
+//!   provided |`, or `` `Trait<P>` `` for a generic trait): every backticked snake-case name in
+//!   a cell is a method (a call such as `weight(k, n)` counts as `weight`; a capitalised name
+//!   such as `LeastSquares` is a type), and the word "parameters" stands for `param_names`,
+//!   `params` and `with_params`;
 //! * the tables of the other pages marked by a comment `<!-- trait-table: Trait required -->`
 //!   or `<!-- trait-table: Trait provided -->` on the line before them, whose first column
 //!   lists the methods the same way.
@@ -23,6 +24,10 @@ const TRAITS: &[(&str, &str)] = &[
     ("JitterModel", "crates/jitterid-jitter/src/model.rs"),
     ("Signal", "crates/jitterid-signal/src/signal.rs"),
     ("Window", "crates/jitterid-window/src/window.rs"),
+    ("Criterion", "crates/jitterid-estimate/src/criterion.rs"),
+    ("Solver", "crates/jitterid-optim/src/lib.rs"),
+    ("Objective", "crates/jitterid-optim/src/objective.rs"),
+    ("LeastSquares", "crates/jitterid-optim/src/problem.rs"),
 ];
 
 /// The pages whose marked tables are checked, besides `docs/architecture.md`'s row.
@@ -81,8 +86,17 @@ fn trait_methods(source: &str, name: &str) -> (BTreeSet<String>, BTreeSet<String
         code.push_str(&out);
         code.push('\n');
     }
+    // `pub trait Name` followed by its generics, bounds or body (not `pub trait NameMore`).
+    let head = format!("pub trait {name}");
     let start = code
-        .find(&format!("pub trait {name}"))
+        .match_indices(&head)
+        .map(|(i, _)| i)
+        .find(|&i| {
+            code[i + head.len()..]
+                .chars()
+                .next()
+                .is_some_and(|c| !(c.is_alphanumeric() || c == '_'))
+        })
         .unwrap_or_else(|| panic!("no `pub trait {name}` in its source"));
     let body = start + code[start..].find('{').expect("a trait body");
     let bytes: Vec<char> = code[body..].chars().collect();
@@ -132,7 +146,8 @@ fn trait_methods(source: &str, name: &str) -> (BTreeSet<String>, BTreeSet<String
     (required, provided)
 }
 
-/// Method names in a table cell: every backticked name (up to a `(`), and "parameters".
+/// Method names in a table cell: every backticked name (up to a `(`) in snake case (a name
+/// with a capital, such as `P` or `LeastSquares`, is a type), and "parameters".
 fn cell_methods(cell: &str) -> BTreeSet<String> {
     let mut names = BTreeSet::new();
     for (k, span) in cell.split('`').enumerate() {
@@ -141,7 +156,7 @@ fn cell_methods(cell: &str) -> BTreeSet<String> {
                 .chars()
                 .take_while(|c| c.is_alphanumeric() || *c == '_')
                 .collect();
-            if !ident.is_empty() {
+            if !ident.is_empty() && !ident.chars().any(|c| c.is_uppercase()) {
                 names.insert(ident);
             }
         } else if span.contains("parameters") {
@@ -160,12 +175,19 @@ fn cells(line: &str) -> Vec<&str> {
         .collect()
 }
 
-/// The architecture page's row for `name`: (required, provided).
+/// The architecture page's row for `name` (its first cell `` `Name` `` or, for a generic
+/// trait, `` `Name<P>` ``): (required, provided).
 fn architecture_row(page: &str, name: &str) -> (BTreeSet<String>, BTreeSet<String>) {
     let key = format!("`{name}`");
+    let generic = format!("`{name}<");
     let row = page
         .lines()
-        .find(|l| l.trim_start().starts_with('|') && cells(l).first() == Some(&key.as_str()))
+        .find(|l| {
+            l.trim_start().starts_with('|')
+                && cells(l)
+                    .first()
+                    .is_some_and(|c| *c == key || (c.starts_with(&generic) && c.ends_with('`')))
+        })
         .unwrap_or_else(|| panic!("docs/architecture.md has no Traits row for {name}"));
     let c = cells(row);
     assert!(c.len() >= 4, "the row of {name} has {} cells", c.len());
@@ -245,6 +267,7 @@ fn trait_tables_match_the_trait_definitions() {
 #[test]
 fn the_parser_sorts_required_from_provided() {
     let source = r#"
+        pub trait DemoMore { fn six(&self); }
         /// A doc comment with braces e^{zτ} and a fn word.
         pub trait Demo: Send {
             /// `γ(f)`
@@ -258,10 +281,23 @@ fn the_parser_sorts_required_from_provided() {
             fn four(&self) {}
         }
         pub trait Other { fn five(&self); }
+        pub trait Generic<P: ?Sized> { fn seven(&self, p: &P); }
     "#;
     let (r, p) = trait_methods(source, "Demo");
     assert_eq!(r, ["one", "two"].map(String::from).into());
     assert_eq!(p, ["four", "three"].map(String::from).into());
+    let (r, p) = trait_methods(source, "Generic");
+    assert_eq!(r, ["seven"].map(String::from).into());
+    assert!(p.is_empty());
+    assert_eq!(
+        cell_methods("— ; each implementation states what it needs of `P`; every `LeastSquares`"),
+        BTreeSet::new()
+    );
+    let row = "| `Generic<P>` | crate | `seven(&P, start)` | — |";
+    assert_eq!(
+        architecture_row(row, "Generic"),
+        (["seven"].map(String::from).into(), BTreeSet::new())
+    );
     assert_eq!(
         cell_methods("`name`, `weight(k, n)`, parameters"),
         ["name", "param_names", "params", "with_params", "weight"]

@@ -79,6 +79,7 @@ mod restricted_noise;
 mod result;
 mod structure;
 mod termination;
+pub mod testing;
 
 pub use any_noise::{AnyNoise, DynNoise, NoiseEntry, NoiseRegistry};
 pub use criterion::{Bcls, BoxJenkins, Criterion, Ls, WeightContext, WeightedBcls};

@@ -99,6 +99,66 @@ fn shifted() {
     assert_contract(&nested, 608);
 }
 
+#[test]
+fn periodic() {
+    for (k, a) in [1e-7, 0.04, 0.37, 9.0].into_iter().enumerate() {
+        assert_contract(&Periodic::new(a).unwrap(), 700 + k as u64);
+    }
+}
+
+#[test]
+fn sum() {
+    assert_contract(
+        &Sum::new(Gaussian::new(0.03).unwrap(), TwoPoint::new(0.11).unwrap()),
+        800,
+    );
+    assert_contract(
+        &Sum::new(Periodic::new(0.07).unwrap(), TwoPoint::new(0.023).unwrap()),
+        801,
+    );
+    assert_contract(
+        &Sum::new(
+            Shifted::new(Laplace::new(0.013).unwrap(), 0.2).unwrap(),
+            TwoPoint::new(0.05).unwrap(),
+        ),
+        802,
+    );
+}
+
+#[test]
+fn mixture() {
+    // Asymmetric weights and arbitrary (not round) parameters, of one family and of several.
+    let g = |s: f64| Gaussian::new(s).unwrap();
+    let two = Mixture::new(vec![g(0.0137), g(0.0561)], vec![0.3, 0.7]).unwrap();
+    assert_contract(&two, 900);
+    assert_contract(&two.with_fixed_weights(), 901);
+    fn wrap<T: JitterModel + Clone + PartialEq + 'static>(label: &str, t: T) -> AnyJitter {
+        AnyJitter::new(label.to_string(), t, |_| Default::default())
+    }
+    let mixed = Mixture::new(
+        vec![
+            wrap(
+                "shifted",
+                Shifted::new(ExponentialDelay::new(0.043).unwrap(), -0.061).unwrap(),
+            ),
+            wrap("laplace", Laplace::new(0.029).unwrap()),
+        ],
+        vec![0.3, 0.7],
+    )
+    .unwrap();
+    assert_contract(&mixed, 902);
+    let three = Mixture::new(
+        vec![
+            wrap("uniform-sum", UniformSum::new(3, 0.071).unwrap()),
+            wrap("two-point", TwoPoint::new(0.019).unwrap()),
+            wrap("periodic", Periodic::new(0.087).unwrap()),
+        ],
+        vec![0.17, 0.52, 0.31],
+    )
+    .unwrap();
+    assert_contract(&three, 903);
+}
+
 /// Log-uniform value in `[10^lo, 10^hi]`.
 fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     (lo..hi).prop_map(|e| 10f64.powf(e))
