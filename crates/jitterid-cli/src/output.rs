@@ -111,6 +111,14 @@ impl OutputSet {
         self.dirs.push(dir.to_path_buf());
     }
 
+    /// Adds the figures `figures` (file name, SVG) in the directory `dir`, created if needed.
+    pub fn figures(&mut self, dir: &Path, figures: Vec<(String, String)>) {
+        self.dir(dir);
+        for (name, svg) in figures {
+            self.file(&dir.join(name), svg);
+        }
+    }
+
     /// Checks every destination, then writes every file; on failure nothing is changed (no new
     /// file, no temporary, no directory created, previous files as they were).
     pub fn commit(self) -> StudyResult<()> {

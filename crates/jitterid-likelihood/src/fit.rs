@@ -7,7 +7,7 @@
 use super::criterion::{LikelihoodCriterion, LikelihoodData};
 use super::fisher::{gaussian_fisher, spd_inverse};
 use super::moments::second_moments;
-use super::objective::{LikelihoodObjective, TransformedObjective};
+use super::objective::LikelihoodObjective;
 use super::param::{default_transforms, likelihood_param_names, likelihood_params, Layout};
 use super::MlError;
 use faer::Mat;
@@ -21,6 +21,7 @@ use jitterid_estimate::Record;
 use jitterid_estimate::{CostKind, Fit};
 use jitterid_jitter::JitterModel;
 use jitterid_optim::finite_diff::hessian;
+use jitterid_optim::TransformedObjective;
 use jitterid_optim::{Objective, WithMetric};
 use jitterid_signal::Signal;
 use rayon::prelude::*;

@@ -111,11 +111,13 @@ pub use fisher::{
 pub use fit::PROFILE_MARGIN;
 pub use fit_criterion::Likelihood;
 pub use jitterid_estimate::MlError;
+/// The constrained form of any objective, from the optimisation layer.
+pub use jitterid_optim::TransformedObjective;
 pub use moments::{
     dtft_covariance, expected_squares_gradient, second_moments, second_moments_of, DtftCovariance,
     SecondMoments,
 };
-pub use objective::{LikelihoodObjective, TransformedObjective};
+pub use objective::LikelihoodObjective;
 pub use param::{default_transforms, likelihood_param_names, likelihood_params, NOISE_STD_NAME};
 pub use quasi::{noise_autocovariance, QuasiMl};
 pub use sine::{alias_start, attenuation_sigma, fit_sine, sine_least_squares, SineFit, SineLs};

@@ -1,10 +1,8 @@
-//! The likelihood criteria as [`Objective`]s in the likelihood's parameter vector, and the
-//! constrained form of any objective in unconstrained coordinates.
+//! The likelihood criteria as [`Objective`]s in the likelihood's parameter vector.
 
 use super::criterion::{GradientRequest, LikelihoodCriterion, LikelihoodData};
 use super::param::{split, Layout};
 use super::MlError;
-use jitterid_estimate::solver::{SolverError, Transform};
 use jitterid_estimate::ModelStructure;
 use jitterid_estimate::NoiseModel;
 use jitterid_jitter::JitterModel;
@@ -165,96 +163,5 @@ where
             g[i] = d;
         }
         (ev.nll, g)
-    }
-}
-
-/// An objective in unconstrained coordinates `φ`, `θ_j = T_j(φ_j)` (see [`Transform`]).
-#[derive(Debug)]
-pub struct TransformedObjective<'a, O: ?Sized> {
-    inner: &'a O,
-    transforms: Vec<Transform>,
-}
-
-impl<'a, O: Objective + ?Sized> TransformedObjective<'a, O> {
-    /// Wraps `inner` with one transform per parameter.
-    ///
-    /// # Errors
-    ///
-    /// A wrong number of transforms, or invalid bounds.
-    pub fn new(inner: &'a O, transforms: Vec<Transform>) -> Result<Self, SolverError> {
-        if transforms.len() != inner.num_params() {
-            return Err(SolverError::WrongTransformCount {
-                expected: inner.num_params(),
-                got: transforms.len(),
-            });
-        }
-        for (index, t) in transforms.iter().enumerate() {
-            if let Transform::Bounded { lo, hi } = *t {
-                if !t.is_valid() {
-                    return Err(SolverError::InvalidBounds { index, lo, hi });
-                }
-            }
-        }
-        Ok(TransformedObjective { inner, transforms })
-    }
-
-    /// The transforms, one per parameter.
-    pub fn transforms(&self) -> &[Transform] {
-        &self.transforms
-    }
-
-    /// `θ(φ)`.
-    pub fn to_external(&self, phi: &[f64]) -> Vec<f64> {
-        phi.iter()
-            .zip(&self.transforms)
-            .map(|(&p, t)| t.to_external(p))
-            .collect()
-    }
-
-    /// `φ(θ)`.
-    ///
-    /// # Errors
-    ///
-    /// [`SolverError::OutsideConstraint`] for the first parameter that violates its
-    /// constraint.
-    pub fn to_internal(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
-        theta
-            .iter()
-            .zip(&self.transforms)
-            .enumerate()
-            .map(|(index, (&value, &t))| {
-                t.to_internal(value).ok_or(SolverError::OutsideConstraint {
-                    index,
-                    value,
-                    constraint: t,
-                })
-            })
-            .collect()
-    }
-}
-
-impl<O: Objective + ?Sized> Objective for TransformedObjective<'_, O> {
-    fn num_params(&self) -> usize {
-        self.inner.num_params()
-    }
-
-    fn cost(&self, phi: &[f64]) -> f64 {
-        let theta = self.to_external(phi);
-        if theta.iter().any(|v| !v.is_finite()) {
-            return f64::INFINITY;
-        }
-        self.inner.cost(&theta)
-    }
-
-    fn cost_gradient(&self, phi: &[f64]) -> (f64, Vec<f64>) {
-        let theta = self.to_external(phi);
-        if theta.iter().any(|v| !v.is_finite()) {
-            return (f64::INFINITY, vec![f64::NAN; phi.len()]);
-        }
-        let (f, mut g) = self.inner.cost_gradient(&theta);
-        for ((gj, &p), t) in g.iter_mut().zip(phi).zip(&self.transforms) {
-            *gj *= t.derivative(p);
-        }
-        (f, g)
     }
 }

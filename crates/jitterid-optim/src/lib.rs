@@ -92,6 +92,7 @@ mod progress;
 mod registry;
 pub mod testing;
 mod transform;
+mod transformed_objective;
 
 pub use any::{AnySolver, DynSolver};
 pub use bfgs::Bfgs;
@@ -108,6 +109,7 @@ pub use problem::{fd_jacobian, ArgminFaerProblem, ArgminProblem, LeastSquares, D
 pub use progress::{Progress, ProgressHook};
 pub use registry::{SolverEntry, SolverRegistry, SOLVER_KEY};
 pub use transform::{Transform, Transformed};
+pub use transformed_objective::TransformedObjective;
 
 /// A minimiser of problems of type `P`.
 ///

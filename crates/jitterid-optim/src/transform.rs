@@ -129,6 +129,79 @@ impl fmt::Display for Transform {
     }
 }
 
+/// One valid transform per parameter: the map between external `θ` and internal `φ` that
+/// [`Transformed`] (a least-squares problem) and
+/// [`TransformedObjective`](crate::TransformedObjective) (any objective) share.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Coordinates(Vec<Transform>);
+
+impl Coordinates {
+    /// `transforms` for a problem of `expected` parameters.
+    ///
+    /// # Errors
+    ///
+    /// [`SolverError::WrongTransformCount`] if the lengths differ,
+    /// [`SolverError::InvalidBounds`] for a `Bounded` transform without finite `lo < hi`.
+    pub(crate) fn new(expected: usize, transforms: Vec<Transform>) -> Result<Self, SolverError> {
+        if transforms.len() != expected {
+            return Err(SolverError::WrongTransformCount {
+                expected,
+                got: transforms.len(),
+            });
+        }
+        for (index, t) in transforms.iter().enumerate() {
+            if let Transform::Bounded { lo, hi } = *t {
+                if !t.is_valid() {
+                    return Err(SolverError::InvalidBounds { index, lo, hi });
+                }
+            }
+        }
+        Ok(Coordinates(transforms))
+    }
+
+    /// The transforms, one per parameter.
+    pub(crate) fn transforms(&self) -> &[Transform] {
+        &self.0
+    }
+
+    /// `θ(φ)`.
+    pub(crate) fn external(&self, phi: &[f64]) -> Vec<f64> {
+        phi.iter()
+            .zip(&self.0)
+            .map(|(&p, t)| t.to_external(p))
+            .collect()
+    }
+
+    /// `φ(θ)`.
+    ///
+    /// # Errors
+    ///
+    /// [`SolverError::OutsideConstraint`] for the first parameter that violates its
+    /// constraint.
+    pub(crate) fn internal(&self, theta: &[f64]) -> Result<Vec<f64>, SolverError> {
+        theta
+            .iter()
+            .zip(&self.0)
+            .enumerate()
+            .map(|(index, (&value, &t))| {
+                t.to_internal(value).ok_or(SolverError::OutsideConstraint {
+                    index,
+                    value,
+                    constraint: t,
+                })
+            })
+            .collect()
+    }
+
+    /// `dθⱼ/dφⱼ` for every parameter.
+    pub(crate) fn derivatives(&self, phi: &[f64]) -> Vec<f64> {
+        phi.iter()
+            .zip(&self.0)
+            .map(|(&p, t)| t.derivative(p))
+            .collect()
+    }
+}
+
 /// A problem in unconstrained internal coordinates `φ`: `r̃(φ) = r(θ(φ))`, with the chain rule
 /// `∂r̃/∂φⱼ = ∂r/∂θⱼ · dθⱼ/dφⱼ` for the Jacobian.
 ///
@@ -166,7 +239,7 @@ impl fmt::Display for Transform {
 #[derive(Clone, Debug)]
 pub struct Transformed<P> {
     problem: P,
-    transforms: Vec<Transform>,
+    coordinates: Coordinates,
 }
 
 impl<P: LeastSquares> Transformed<P> {
@@ -178,23 +251,10 @@ impl<P: LeastSquares> Transformed<P> {
     /// parameters, [`SolverError::InvalidBounds`] for a `Bounded` transform without finite
     /// `lo < hi`.
     pub fn new(problem: P, transforms: Vec<Transform>) -> Result<Self, SolverError> {
-        let expected = problem.num_params();
-        if transforms.len() != expected {
-            return Err(SolverError::WrongTransformCount {
-                expected,
-                got: transforms.len(),
-            });
-        }
-        for (index, t) in transforms.iter().enumerate() {
-            if let Transform::Bounded { lo, hi } = *t {
-                if !t.is_valid() {
-                    return Err(SolverError::InvalidBounds { index, lo, hi });
-                }
-            }
-        }
+        let coordinates = Coordinates::new(problem.num_params(), transforms)?;
         Ok(Transformed {
             problem,
-            transforms,
+            coordinates,
         })
     }
 
@@ -205,7 +265,7 @@ impl<P: LeastSquares> Transformed<P> {
 
     /// The transforms, one per parameter.
     pub fn transforms(&self) -> &[Transform] {
-        &self.transforms
+        self.coordinates.transforms()
     }
 
     /// Internal coordinates `φ` of external parameters `θ`.
@@ -219,18 +279,7 @@ impl<P: LeastSquares> Transformed<P> {
         if let Some((index, value)) = first_non_finite(theta) {
             return Err(SolverError::NonFiniteStart { index, value });
         }
-        theta
-            .iter()
-            .zip(&self.transforms)
-            .enumerate()
-            .map(|(index, (&value, &t))| {
-                t.to_internal(value).ok_or(SolverError::OutsideConstraint {
-                    index,
-                    value,
-                    constraint: t,
-                })
-            })
-            .collect()
+        self.coordinates.internal(theta)
     }
 
     /// External parameters `θ` of internal coordinates `φ`.
@@ -261,16 +310,14 @@ impl<P: LeastSquares> Transformed<P> {
     }
 
     fn external(&self, phi: &[f64]) -> Vec<f64> {
-        phi.iter()
-            .zip(&self.transforms)
-            .map(|(&p, t)| t.to_external(p))
-            .collect()
+        self.coordinates.external(phi)
     }
 
     fn check_len(&self, v: &[f64]) -> Result<(), SolverError> {
-        if v.len() != self.transforms.len() {
+        let expected = self.coordinates.transforms().len();
+        if v.len() != expected {
             return Err(SolverError::WrongStartLength {
-                expected: self.transforms.len(),
+                expected,
                 got: v.len(),
             });
         }
@@ -295,11 +342,7 @@ impl<P: LeastSquares> LeastSquares for Transformed<P> {
     fn jacobian(&self, phi: &[f64]) -> Result<Mat<f64>, SolverError> {
         self.check_len(phi)?;
         let j = checked_jacobian(&self.problem, &self.external(phi))?;
-        let d: Vec<f64> = phi
-            .iter()
-            .zip(&self.transforms)
-            .map(|(&p, t)| t.derivative(p))
-            .collect();
+        let d = self.coordinates.derivatives(phi);
         Ok(Mat::from_fn(j.nrows(), j.ncols(), |r, c| j[(r, c)] * d[c]))
     }
 }

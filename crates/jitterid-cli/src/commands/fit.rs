@@ -143,10 +143,7 @@ fn write_fit_figures(
         tau: table.optional("tau"),
     })?;
     let mut outputs = OutputSet::new();
-    outputs.dir(dir);
-    for (name, svg) in figs {
-        outputs.file(&dir.join(name), svg);
-    }
+    outputs.figures(dir, figs);
     outputs.commit()?;
     Ok(())
 }

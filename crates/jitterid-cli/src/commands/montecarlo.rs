@@ -140,10 +140,7 @@ pub fn montecarlo(o: &MonteCarloOptions) -> StudyResult<Outcome> {
             true_signal: &study.signal0,
             fitted,
         });
-        outputs.dir(dir);
-        for (name, svg) in figs {
-            outputs.file(&dir.join(name), svg);
-        }
+        outputs.figures(dir, figs);
     }
     let text = emit(j, o.json, o.out.as_deref(), outputs)?;
     Ok(Outcome {

@@ -67,10 +67,7 @@ fn stage_figures(
         bode: bode.as_deref(),
         step: step.as_deref(),
     });
-    outputs.dir(dir);
-    for (name, svg) in figs {
-        outputs.file(&dir.join(name), svg);
-    }
+    outputs.figures(dir, figs);
     Ok(())
 }
 
