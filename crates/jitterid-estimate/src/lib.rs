@@ -16,8 +16,9 @@
 //! [`EstimateError`]. An integer-valued jitter parameter is profiled with [`fit_profile`].
 //!
 //! Measured data: a [`MeasuredRecord`] holds what a measurement holds (samples, requested
-//! instants, the input, an optional known noise level, a name), read from and written to the
-//! command line's CSV files by [`csv`]; a fitted run-time signal is moved to another record's
+//! instants, the input, an optional known noise level, a name; the study layer,
+//! `jitterid-study`, reads and writes its CSV files), as a [`Record`] holds what an estimator
+//! needs (the samples on their grid); a fitted run-time signal is moved to another record's
 //! input with [`AnySignal::with_input`](jitterid_signal::AnySignal::with_input). Several records
 //! of one system are fitted together by [`estimate_joint`]. Box–Jenkins noise models of jittered
 //! data carry the jitter's white floor ([`ModelStructure::with_jitter_floor`]).
@@ -56,7 +57,6 @@ mod any_noise;
 mod boundary;
 mod covariance;
 mod criterion;
-pub mod csv;
 mod data;
 mod error;
 mod evaluation_memo;

@@ -3,7 +3,6 @@
 
 use crate::csvio;
 use crate::error::StudyResult;
-use jitterid::estimate::csv;
 use jitterid::signal::{PiecewiseConstant, SampleGrid, SignalError};
 
 /// The span `[t0, t0 + (N+1)T)` on which a random binary input is drawn.
@@ -12,16 +11,16 @@ pub fn input_span(grid: &SampleGrid) -> (f64, f64) {
     (t0, t0 + (grid.len() as f64 + 1.0) * grid.interval())
 }
 
-/// A piecewise-constant input from switch times and levels (see [`csv::piecewise`]).
+/// A piecewise-constant input from switch times and levels (see [`csvio::piecewise`]).
 pub fn piecewise(
     times: &[f64],
     values: &[f64],
     grid: &SampleGrid,
 ) -> Result<PiecewiseConstant, String> {
-    csv::piecewise(times, values, grid)
+    csvio::piecewise(times, values, grid)
 }
 
-/// A piecewise-constant input from two columns of a CSV table (see [`csv::input_from_table`]);
+/// A piecewise-constant input from two columns of a CSV table (see [`csvio::input_from_table`]);
 /// a last row with level 0 ends the input at its time.
 pub fn piecewise_from_table(
     table: &csvio::Table,
@@ -29,7 +28,7 @@ pub fn piecewise_from_table(
     value_column: &str,
     grid: &SampleGrid,
 ) -> StudyResult<PiecewiseConstant> {
-    Ok(csv::input_from_table(
+    Ok(csvio::input_from_table(
         table,
         time_column,
         value_column,

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// The side file holding the input of a simulated record: `data.csv` → `data.input.csv`.
 pub fn input_side_file(data: &Path) -> PathBuf {
-    jitterid::estimate::csv::input_side_file(data)
+    csvio::input_side_file(data)
 }
 
 /// The samples of a data file, checked against the experiment's grid.

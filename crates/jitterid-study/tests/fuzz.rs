@@ -72,7 +72,7 @@ fn check_csv(text: &str) {
             assert!(t.values.iter().flatten().all(|v| v.is_finite()));
         }
         Err(e) => {
-            let m = e.message();
+            let m = e.to_string();
             assert!(
                 !m.contains('\n') && !m.contains('\r'),
                 "not one line: {m:?}"

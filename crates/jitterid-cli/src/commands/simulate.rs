@@ -71,7 +71,7 @@ pub fn simulate(o: &SimulateOptions) -> StudyResult<String> {
         } else {
             let side = input_side_file(&o.out);
             let edges = p.edges();
-            outputs.file(&side, jitterid::estimate::csv::input_to_csv(p));
+            outputs.file(&side, csvio::input_to_csv(p));
             let _ = write!(
                 report,
                 "; {}: the input's {} switch times and levels",

@@ -9,9 +9,8 @@
 
 use super::error::CsvError;
 use super::table::{self, Column, Table};
-use crate::data::Record;
-use crate::measured::MeasuredRecord;
-use jitterid_signal::{Input, PiecewiseConstant, SampleGrid};
+use jitterid::estimate::{MeasuredRecord, Record};
+use jitterid::signal::{Input, PiecewiseConstant, SampleGrid};
 use std::path::{Path, PathBuf};
 
 /// Relative tolerance (in units of `T`) of a `t` column against the grid.

@@ -1,12 +1,12 @@
 //! Measured records: CSV round trips, malformed files named by line and column, and a model
 //! evaluated on another record's input.
 
-use jitterid_estimate::csv::{
+use jitterid::estimate::{InputLayout, MeasuredRecord, Record};
+use jitterid::signal::registry::SignalRegistry;
+use jitterid::signal::{Input, PiecewiseConstant, SampleGrid, Signal};
+use jitterid_study::csvio::{
     input_to_csv, load_record, parse, record_from_table, record_to_csv, save_record, CsvError,
 };
-use jitterid_estimate::{InputLayout, MeasuredRecord, Record};
-use jitterid_signal::registry::SignalRegistry;
-use jitterid_signal::{Input, PiecewiseConstant, SampleGrid, Signal};
 use proptest::prelude::*;
 
 fn scratch(name: &str) -> std::path::PathBuf {
@@ -48,7 +48,7 @@ proptest! {
         }
         // The input file: switch times and levels exactly.
         let side = parse("r.input.csv", &input_to_csv(&input)).unwrap();
-        let p = jitterid_estimate::csv::input_from_table(&side, "t", "u", &grid).unwrap();
+        let p = jitterid_study::csvio::input_from_table(&side, "t", "u", &grid).unwrap();
         prop_assert_eq!(p.edges(), input.edges());
         prop_assert_eq!(p.levels(), input.levels());
     }
@@ -75,7 +75,7 @@ fn save_and_load_through_files() {
     assert_eq!(rec.noise_std(), Some(0.01));
     assert!(matches!(
         rec.clone().with_noise_std(-1.0),
-        Err(jitterid_estimate::EstimateError::BadNoiseStd { .. })
+        Err(jitterid::estimate::EstimateError::BadNoiseStd { .. })
     ));
 }
 
@@ -110,7 +110,7 @@ fn malformed_files_name_the_line_and_the_column() {
     assert!(e.to_string().contains("expected 3"), "{e}");
     // An input file whose times go back.
     let t = parse("u.csv", "t,u\n0,1\n2,0.5\n1,0\n").unwrap();
-    let e = jitterid_estimate::csv::input_from_table(&t, "t", "u", &grid).unwrap_err();
+    let e = jitterid_study::csvio::input_from_table(&t, "t", "u", &grid).unwrap_err();
     assert_eq!(e.line(), Some(4));
     // A file that is not there.
     let e = load_record(&scratch("none").join("none.csv"), None, None).unwrap_err();
