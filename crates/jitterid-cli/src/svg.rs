@@ -6,6 +6,10 @@
 //! per dash, 50 for a ±bound line), no `<path>` (bands are `<polygon>`), integer stroke widths
 //! and coordinates, and upper-case colours; the figure tests (`tests/validate.rs`) find the
 //! dashed 99 % bounds, the stems, the bands and the solid model lines by exactly those marks.
+//!
+//! Why one file of about 900 lines (a tenth of them its tests): the plotter is one concept, and
+//! its axes, ticks, panels and legend share private geometry (plot-area transforms, tick
+//! spacing, text metrics) that a split would have to make public.
 
 use std::fmt::Write as _;
 

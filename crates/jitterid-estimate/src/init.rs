@@ -60,6 +60,10 @@
 //! assert!((estimate.params[3] - 0.3).abs() < 0.02);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! Why one file of about 820 lines (its method documented above, a sixth of them and the tests
+//! another eighth): the three steps share the model's private coefficient layout and are only
+//! meaningful in order.
 
 use crate::data::Record;
 use crate::noise::NoiseModel;

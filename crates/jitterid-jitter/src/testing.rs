@@ -21,6 +21,10 @@
 //! ones do) can also run [`check_overrides`], which holds them against the trait's defaults
 //! through [`ProvidedDefaults`], and [`check_distribution`], a Kolmogorov–Smirnov test of the
 //! sampler.
+//!
+//! Why one file of about 790 lines (an eighth of them its own tests): the contract is one list of
+//! promises, and its checks share the private quadrature reference against which every
+//! provided method is held.
 
 use crate::{JitterError, JitterModel};
 use num_complex::Complex64;

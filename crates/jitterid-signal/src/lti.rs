@@ -1,4 +1,9 @@
 //! The exact response of a rational model to a known input, and its exact jittered moments.
+//!
+//! Why one file of about 1 070 lines (a tenth of them documentation, a tenth tests): the response
+//! and its jittered moments walk the input's steps with one shared modal recursion (the carry of
+//! the steps before a sample's reach); the parts inside the reach are in `reach.rs`, repeated
+//! poles in `confluent.rs`.
 
 use crate::confluent::Confluent;
 use crate::input::Input;

@@ -35,6 +35,10 @@
 //! [`SquaresRule`] applies the same windowed refinement to the quadrature rules of the second
 //! moment `E[s(t_k + τ)²]`, and tells when they would still be too large (the response then
 //! expands the square and uses [`InReach`] at sums of poles).
+//!
+//! Why one file of about 940 lines (a sixth of them documentation, a quarter tests): the rules
+//! for the first and the second moment share the windowing, the knot sweep and the Filon
+//! switch described above, and are checked against each other.
 
 use jitterid_jitter::JitterModel;
 use jitterid_numeric::chebyshev::ChebyshevBasis;

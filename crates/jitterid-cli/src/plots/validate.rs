@@ -1,0 +1,284 @@
+//! The figures of `validate --plot`: the records against the model, the correlation tests, the Bode
+//! diagram and the step response with their bands.
+
+use crate::svg::{figure, Panel, Series, Style, BLUE, GREY, RED};
+use jitterid::estimate::validation::{BodePoint, CorrelationTest, StepPoint};
+use jitterid::signal::SampleGrid;
+
+/// One record of `validate --plot`: its samples, the model's expected samples and the checks.
+pub struct RecordPlot<'a> {
+    /// Which record (`estimation` or `validation`).
+    pub role: &'a str,
+    /// The record's file.
+    pub name: &'a str,
+    /// The record's sampling grid.
+    pub grid: &'a SampleGrid,
+    /// The samples `y_k`.
+    pub y: &'a [f64],
+    /// The model's expected samples `m_k`.
+    pub expected: &'a [f64],
+    /// Normalised fit of `m_k` to `y_k`, in percent.
+    pub fit_percent: f64,
+    /// Autocorrelation of the standardised residuals.
+    pub whiteness: &'a CorrelationTest,
+    /// Their cross-correlation with the input, if there is one.
+    pub cross: Option<&'a CorrelationTest>,
+}
+
+/// Everything `validate --plot` draws from.
+pub struct ValidatePlots<'a> {
+    /// The experiment's title (or file).
+    pub title: String,
+    /// The estimation record.
+    pub estimation: RecordPlot<'a>,
+    /// The validation record, if given.
+    pub validation: Option<RecordPlot<'a>>,
+    /// The fitted system's frequency response (the `--bode` CSV's points), if rational.
+    pub bode: Option<&'a [BodePoint]>,
+    /// Its unit-step response, if rational.
+    pub step: Option<&'a [StepPoint]>,
+}
+
+/// The `validate` figures: model vs data in time, residual correlations, and for a rational
+/// system the Bode diagram and the step response with their bands.
+pub fn validate_figures(p: &ValidatePlots<'_>) -> Vec<(String, String)> {
+    let records: Vec<&RecordPlot<'_>> = std::iter::once(&p.estimation)
+        .chain(p.validation.as_ref())
+        .collect();
+    let mut out = vec![
+        ("time.svg".to_string(), time_figure(&records, &p.title)),
+        (
+            "correlations.svg".to_string(),
+            correlation_figure(&records, &p.title),
+        ),
+    ];
+    if let Some(b) = p.bode {
+        out.push(("bode.svg".to_string(), validate_bode(b, &p.title)));
+    }
+    if let Some(s) = p.step {
+        out.push(("step.svg".to_string(), step_figure(s, &p.title)));
+    }
+    out
+}
+
+/// `y_k` as points and `m_k` as a line against time, one panel per record.
+fn time_figure(records: &[&RecordPlot<'_>], title: &str) -> String {
+    let panels: Vec<Panel> = records
+        .iter()
+        .map(|r| {
+            let t: Vec<f64> = r.grid.times().collect();
+            let pts = |v: &[f64]| t.iter().copied().zip(v.iter().copied()).collect();
+            let dense = r.y.len() > 400;
+            // Room above the data for the legend, which would hide samples in any corner.
+            let (lo, hi) =
+                r.y.iter()
+                    .chain(r.expected)
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                        (a.min(v), b.max(v))
+                    });
+            let span = if hi > lo { hi - lo } else { 1.0 };
+            Panel {
+                yrange: (lo <= hi).then_some((lo - 0.04 * span, hi + 0.3 * span)),
+                title: format!("{} record {}: fit {:.1} %", r.role, r.name, r.fit_percent),
+                xlabel: "time (s)".into(),
+                ylabel: "y".into(),
+                series: vec![
+                    Series::markers("data y_k", GREY, pts(r.y)).with_opacity(0.6),
+                    Series::line(
+                        &format!("model m_k (fit {:.1} %)", r.fit_percent),
+                        BLUE,
+                        pts(r.expected),
+                    )
+                    .with_width(if dense { 1.0 } else { 1.6 }),
+                ],
+                ..Default::default()
+            }
+        })
+        .collect();
+    figure(
+        "Model vs data: samples y_k and the model's expected samples m_k",
+        title,
+        &panels,
+        1,
+    )
+}
+
+/// The ±bound lines of a correlation test across its lags (the label on the upper one).
+fn bound_lines(c: &CorrelationTest, from: f64) -> [Series; 2] {
+    let to = c.lags.last().map_or(1.0, |&l| l as f64);
+    let line = |label: &str, b: f64| Series::dashed(label, RED, vec![(from, b), (to, b)]);
+    [
+        line(&format!("99 % bounds ±{:.3}", c.bound), c.bound),
+        line("", -c.bound),
+    ]
+}
+
+/// One correlation test as stems by lag with its 99 % bounds; `skip_zero` leaves out lag 0
+/// (of an autocorrelation: 1 by construction, not tested).
+fn correlation_panel(c: &CorrelationTest, heading: &str, skip_zero: bool) -> Panel {
+    let pts: Vec<(f64, f64)> = c
+        .lags
+        .iter()
+        .zip(&c.values)
+        .filter(|(l, _)| !(skip_zero && **l == 0))
+        .map(|(&l, &v)| (l as f64, v))
+        .collect();
+    let from = pts.first().map_or(0.0, |p| p.0);
+    let verdict = if c.passed { "passed" } else { "failed" };
+    let mut series = vec![Series {
+        label: format!(
+            "{} of {} lags outside (≤ {} allowed): {verdict}",
+            c.outside,
+            pts.len(),
+            c.allowed
+        ),
+        color: BLUE,
+        opacity: 1.0,
+        style: Style::Stems,
+        points: pts,
+    }];
+    series.extend(bound_lines(c, from));
+    let b = c.bound;
+    let top = c
+        .values
+        .iter()
+        .skip(usize::from(skip_zero))
+        .fold(1.6 * b, |m, v| m.max(v.abs()));
+    Panel {
+        title: heading.into(),
+        xlabel: "lag (samples)".into(),
+        ylabel: "correlation".into(),
+        yrange: Some((-1.15 * top, 1.15 * top)),
+        series,
+        ..Default::default()
+    }
+}
+
+/// Autocorrelation of the standardised residuals and their cross-correlation with the input,
+/// one row per record.
+fn correlation_figure(records: &[&RecordPlot<'_>], title: &str) -> String {
+    let with_input = records.iter().any(|r| r.cross.is_some());
+    let mut panels = Vec::new();
+    for r in records {
+        panels.push(correlation_panel(
+            r.whiteness,
+            &format!("autocorrelation of ε_k, {} ({})", r.name, r.role),
+            true,
+        ));
+        if with_input {
+            panels.push(match r.cross {
+                Some(c) => correlation_panel(
+                    c,
+                    &format!("cross-correlation of ε_k with u_k, {}", r.name),
+                    false,
+                ),
+                None => Panel {
+                    title: format!("no input for {}", r.name),
+                    ..Default::default()
+                },
+            });
+        }
+    }
+    figure(
+        "Correlations of the standardised residuals ε_k (99 % bounds)",
+        title,
+        &panels,
+        if with_input { 2 } else { 1 },
+    )
+}
+
+/// A central curve and, when every point has both edges, its band.
+fn with_band(
+    label: &str,
+    centre: Vec<(f64, f64)>,
+    band: Option<Vec<(f64, f64, f64)>>,
+) -> Vec<Series> {
+    let mut v = Vec::new();
+    if let Some(b) = band {
+        v.push(Series::band("±2σ band (parameter covariance)", BLUE, &b));
+    }
+    v.push(Series::line(label, BLUE, centre));
+    v
+}
+
+/// The edges `(x, lo, hi)` of a band, `None` when a point has none (no covariance).
+fn band_edges(
+    points: impl Iterator<Item = (f64, Option<f64>, Option<f64>)>,
+) -> Option<Vec<(f64, f64, f64)>> {
+    points.map(|(x, lo, hi)| Some((x, lo?, hi?))).collect()
+}
+
+/// The note on a figure whose bands are missing.
+fn band_note(has_band: bool, title: &str) -> String {
+    if has_band {
+        title.to_string()
+    } else {
+        format!("{title} — no covariance, so no bands")
+    }
+}
+
+/// Magnitude (dB) and phase (degrees) of the fitted system with their ±2σ bands.
+fn validate_bode(points: &[BodePoint], title: &str) -> String {
+    let mag_band = band_edges(
+        points
+            .iter()
+            .map(|p| (p.f_hz, p.magnitude_db_lo, p.magnitude_db_hi)),
+    );
+    let ph_band = band_edges(
+        points
+            .iter()
+            .map(|p| (p.f_hz, p.phase_deg_lo, p.phase_deg_hi)),
+    );
+    let has_band = mag_band.is_some();
+    let mag = with_band(
+        "fitted model",
+        points.iter().map(|p| (p.f_hz, p.magnitude_db)).collect(),
+        mag_band,
+    );
+    let ph = with_band(
+        "fitted model",
+        points.iter().map(|p| (p.f_hz, p.phase_deg)).collect(),
+        ph_band,
+    );
+    let panel = |title: &str, ylabel: &str, series| Panel {
+        title: title.into(),
+        xlabel: "frequency (Hz)".into(),
+        ylabel: ylabel.into(),
+        xlog: true,
+        series,
+        ..Default::default()
+    };
+    figure(
+        "Bode diagram of the fitted system",
+        &band_note(has_band, title),
+        &[
+            panel("magnitude 20 log10|G(i2πf)|", "magnitude (dB)", mag),
+            panel("phase", "phase (degrees)", ph),
+        ],
+        1,
+    )
+}
+
+/// The unit-step response of the fitted system with its ±2σ band.
+fn step_figure(points: &[StepPoint], title: &str) -> String {
+    let band = band_edges(points.iter().map(|p| (p.t, p.lo, p.hi)));
+    let has_band = band.is_some();
+    let series = with_band(
+        "fitted model",
+        points.iter().map(|p| (p.t, p.value)).collect(),
+        band,
+    );
+    figure(
+        "Unit-step response of the fitted system",
+        &band_note(has_band, title),
+        &[Panel {
+            title: "response to a unit step at t = 0".into(),
+            xlabel: "time after the step (s)".into(),
+            ylabel: "output".into(),
+            series,
+            ..Default::default()
+        }],
+        1,
+    )
+}
