@@ -116,10 +116,7 @@ impl<T, C, E> Entry<T, C, E> {
     /// [`Registry::build_scaled`]).
     pub fn with_scaled(
         mut self,
-        scaled: impl Fn(f64, &SpecReader<'_, E>, Option<&C>) -> Result<T, E>
-            + Send
-            + Sync
-            + 'static,
+        scaled: impl Fn(f64, &SpecReader<'_, E>, Option<&C>) -> Result<T, E> + Send + Sync + 'static,
     ) -> Self {
         self.scaled = Some(Arc::new(scaled));
         self

@@ -1,6 +1,8 @@
 //! A registry entry: a family's name, its keys, and how to build it.
 
-use super::{FamilyEntry, JitterRegistry, ParamSpec, SpecReader, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
+use super::{
+    FamilyEntry, JitterRegistry, ParamSpec, SpecReader, FAMILY_KEY, OFFSET_KEY, TERMS_KEY,
+};
 use crate::{AnyJitter, JitterError};
 use jitterid_registry::Entry;
 use std::fmt;
@@ -69,8 +71,10 @@ impl Family {
             + 'static,
     ) -> Self {
         Family(
-            Entry::with_context(name, summary, params, move |r, cx| build(r, registry_of(cx)))
-                .needs_context(),
+            Entry::with_context(name, summary, params, move |r, cx| {
+                build(r, registry_of(cx))
+            })
+            .needs_context(),
         )
     }
 

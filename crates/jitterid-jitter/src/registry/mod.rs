@@ -73,8 +73,8 @@ pub struct JitterRegistry {
 impl Default for JitterRegistry {
     fn default() -> Self {
         let offset = ParamSpec::new(OFFSET_KEY, "constant added to the jitter", "s", "finite");
-        let families = Registry::empty(FAMILY_KEY, "jitter family", vec![offset], None)
-            .with_wrap(shift);
+        let families =
+            Registry::empty(FAMILY_KEY, "jitter family", vec![offset], None).with_wrap(shift);
         JitterRegistry { families }
     }
 }
@@ -144,10 +144,12 @@ impl JitterRegistry {
         sigma: f64,
         spec: &SpecTable,
     ) -> Result<AnyJitter, JitterError> {
-        let family = self.family(name).ok_or_else(|| JitterError::UnknownFamily {
-            family: name.to_string(),
-            known: self.names(),
-        })?;
+        let family = self
+            .family(name)
+            .ok_or_else(|| JitterError::UnknownFamily {
+                family: name.to_string(),
+                known: self.names(),
+            })?;
         // A family without keys (`none`) has no spread to set: any σ, even 0, gives it.
         if !family.params().is_empty() || family.takes_terms() {
             crate::kernels::validate::positive("sigma", sigma)?;

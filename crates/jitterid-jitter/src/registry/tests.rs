@@ -107,7 +107,9 @@ fn from_std_dev_gives_the_requested_spread() {
         }
     }
     assert_eq!(
-        r.from_std_dev("none", 0.1, &SpecTable::new()).unwrap().std_dev(),
+        r.from_std_dev("none", 0.1, &SpecTable::new())
+            .unwrap()
+            .std_dev(),
         0.0
     );
     assert!(matches!(
