@@ -6,7 +6,7 @@ use crate::arrays::{map_reals, RealsIn};
 use crate::errors::{json_text, spec_table, value_error};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{TfForm, ZpkForm};
-use jitterid::signal::registry::{SignalRegistry, Spec};
+use jitterid::signal::registry::{SignalRegistry, SpecTable};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
 use jitterid_study::export::{delay_of, tf_of};
 use numpy::ndarray::Array2;
@@ -26,7 +26,7 @@ type Matrix<'py> = Bound<'py, PyArray2<f64>>;
 #[pyclass(module = "jitterid._jitterid", subclass, frozen, skip_from_py_object)]
 #[derive(Debug, Clone)]
 pub struct System {
-    pub(crate) spec: Spec,
+    pub(crate) spec: SpecTable,
     /// The model built on a unit step at 0 (kinds that take no input ignore it).
     model: AnySignal,
     tf: Option<TfForm>,
@@ -34,7 +34,7 @@ pub struct System {
 
 impl System {
     /// The model of `spec`, checked by building it through the registry.
-    pub fn of(spec: Spec) -> PyResult<Self> {
+    pub fn of(spec: SpecTable) -> PyResult<Self> {
         let model = build(&spec, Some(&unit_step(1.0)?))?;
         let tf = tf_of(&model);
         Ok(System { spec, model, tf })
@@ -55,7 +55,7 @@ impl System {
     }
 }
 
-fn build(spec: &Spec, input: Option<&Input>) -> PyResult<AnySignal> {
+fn build(spec: &SpecTable, input: Option<&Input>) -> PyResult<AnySignal> {
     SignalRegistry::builtin()
         .build(spec, input)
         .map_err(value_error)
@@ -111,7 +111,7 @@ impl System {
     ) -> PyResult<Self> {
         let form = ZpkForm::new(gain, complex_in(py, zeros)?, complex_in(py, poles)?)
             .map_err(value_error)?;
-        let mut spec = Spec::new();
+        let mut spec = SpecTable::new();
         spec.insert("kind".into(), "zpk".into());
         spec.insert("gain".into(), json!(form.gain()));
         spec.insert("zeros".into(), roots_spec(form.zeros()));

@@ -35,10 +35,10 @@ use jitterid::estimate::{
     Frequencies, InitOptions, InitialModel, Ls, ModelStructure, NoiseModel, NoiseRegistry, Record,
     Registry,
 };
-use jitterid::jitter::registry::{JitterRegistry, Spec};
+use jitterid::jitter::registry::{JitterRegistry, SpecTable};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel};
 use jitterid::prelude::*;
-use jitterid::signal::registry::{SignalRegistry, SpecReader, KIND_KEY};
+use jitterid::signal::registry::{KindReader, SignalRegistry, KIND_KEY};
 use jitterid::signal::{AnySignal, SignalError, Tone};
 use jitterid::window::HannWindow;
 use proptest::prelude::*;
@@ -296,7 +296,7 @@ fn entry_table(
     name_key: &'static str,
     entries: Vec<(String, Vec<ParamSpec>)>,
     common: Vec<ParamSpec>,
-) -> BoxedStrategy<Spec> {
+) -> BoxedStrategy<SpecTable> {
     let count = entries.len();
     (0..count)
         .prop_flat_map(move |i| {
@@ -304,7 +304,7 @@ fn entry_table(
             let mut keys = keys_of(&params);
             keys.extend(keys_of(&common));
             (keys, corruption()).prop_map(move |(pairs, corruption)| {
-                let mut table = Spec::new();
+                let mut table = SpecTable::new();
                 table.insert(name_key.into(), name.clone().into());
                 table.extend(pairs.into_iter().flatten());
                 if let Some(c) = corruption {
@@ -339,7 +339,7 @@ fn entries<T>(registry: &Registry<T>) -> Vec<(String, Vec<ParamSpec>)> {
 
 /// A signal as a spec table of the signal registry: any kind it lists (`zpk`, `tf`,
 /// `sinusoid`, `pulse-response`, and whatever is added), with its keys.
-fn signal() -> BoxedStrategy<Spec> {
+fn signal() -> BoxedStrategy<SpecTable> {
     entry_table(KIND_KEY, signal_kinds(), Vec::new())
 }
 
@@ -448,7 +448,7 @@ fn first_moment_criteria() -> Vec<(String, Vec<ParamSpec>)> {
     entries(&registry)
         .into_iter()
         .filter(|(name, _)| {
-            let mut t = Spec::new();
+            let mut t = SpecTable::new();
             t.insert(registry.key().into(), name.as_str().into());
             registry
                 .build(&t)
@@ -458,20 +458,20 @@ fn first_moment_criteria() -> Vec<(String, Vec<ParamSpec>)> {
 }
 
 /// A first-moment criterion as a spec table of the criterion registry.
-fn criterion() -> BoxedStrategy<Spec> {
+fn criterion() -> BoxedStrategy<SpecTable> {
     let key = CriterionRegistry::builtin().key();
     entry_table(key, first_moment_criteria(), Vec::new())
 }
 
 /// A noise model as a spec table of the noise registry (used by the BJ and JBJ structures).
-fn noise() -> BoxedStrategy<Spec> {
+fn noise() -> BoxedStrategy<SpecTable> {
     let registry = NoiseRegistry::builtin();
     entry_table(registry.key(), entries(&registry), Vec::new())
 }
 
 /// A solver as a spec table of the solver registry: any entry, with its keys and the
 /// multi-start keys every solver takes.
-fn solver() -> BoxedStrategy<Spec> {
+fn solver() -> BoxedStrategy<SpecTable> {
     let registry = SolverRegistry::builtin();
     let common = registry.common_keys().to_vec();
     entry_table(registry.key(), entries(&registry), common)
@@ -509,19 +509,19 @@ struct Case {
     interval: f64,
     start: f64,
     data: Vec<f64>,
-    signal: Spec,
+    signal: SpecTable,
     input: Result<Input, String>,
     jitter: JitterSpec,
     /// 0 OE, 1 JOE, 2 BJ, 3 JBJ; then what is estimated (when not the structure's default), the
     /// noise model (BJ and JBJ), a known noise level.
     structure: u8,
     estimated: Option<(bool, bool, bool)>,
-    noise: Spec,
+    noise: SpecTable,
     noise_std: Option<f64>,
-    criterion: Spec,
+    criterion: SpecTable,
     frequencies: Frequencies,
     hann: bool,
-    solver: Spec,
+    solver: SpecTable,
     covariance: bool,
 }
 
@@ -646,7 +646,7 @@ fn note_error(e: &dyn std::fmt::Display) {
 }
 
 fn build_jitter(spec: &JitterSpec) -> Result<AnyJitter, JitterError> {
-    let mut table = Spec::new();
+    let mut table = SpecTable::new();
     table.insert("family".into(), spec.family.clone().into());
     for (key, v) in &spec.values {
         table.insert(key.clone(), v.clone());
@@ -747,8 +747,8 @@ where
 /// Runs the initializer on `structure`'s model when the initializer has a type for its kind.
 /// The initializer is typed: it fits the rational models that implement [`InitialModel`]
 /// (`Zpk`, `TransferFunction`), so the registry's `zpk` and `tf` tables are read back into
-/// those types with the registry's own [`SpecReader`]. Every other kind, including one added
-/// to the registry, is fuzzed through [`estimate`] only.
+/// those types with the registry's own reader (`SignalKind::reader`). Every other kind,
+/// including one added to the registry, is fuzzed through [`estimate`] only.
 fn run_initializer_for<N: NoiseModel + Clone>(
     structure: &ModelStructure<AnySignal, AnyJitter, N>,
     input: &Input,
@@ -758,7 +758,7 @@ fn run_initializer_for<N: NoiseModel + Clone>(
     let Some(kind) = SignalRegistry::builtin().kind(structure.signal.kind()) else {
         return Ok(());
     };
-    let reader = match SpecReader::new(kind, &spec) {
+    let reader = match kind.reader(&spec) {
         Ok(r) => r,
         Err(e) => {
             return Err(TestCaseError::fail(format!(

@@ -1,7 +1,7 @@
 //! [`AnyJitter`]: one run-time jitter type for every family, built by the
 //! [registry](crate::registry).
 
-use crate::registry::{JitterRegistry, Spec};
+use crate::registry::{JitterRegistry, SpecTable};
 use crate::{Atom, JitterError, JitterModel, QuadratureRule};
 use num_complex::Complex64;
 use rand::RngCore;
@@ -11,13 +11,13 @@ use std::fmt;
 use std::sync::Arc;
 
 /// Writes a model's keys to a spec table (without the `"family"` key).
-pub type ToSpec<T> = Arc<dyn Fn(&T) -> Spec + Send + Sync>;
+pub type ToSpec<T> = Arc<dyn Fn(&T) -> SpecTable + Send + Sync>;
 
 /// What [`AnyJitter`] needs of the model inside it beyond [`JitterModel`].
 trait DynJitter: Send + Sync {
     fn model(&self) -> &dyn JitterModel;
     fn family(&self) -> &str;
-    fn spec(&self) -> Spec;
+    fn spec(&self) -> SpecTable;
     fn with_params(&self, params: &[f64]) -> Result<AnyJitter, JitterError>;
     fn as_any(&self) -> &dyn Any;
     fn same_as(&self, other: &dyn DynJitter) -> bool;
@@ -36,7 +36,7 @@ impl<T: JitterModel + Clone + PartialEq + 'static> DynJitter for Entry<T> {
     fn family(&self) -> &str {
         &self.family
     }
-    fn spec(&self) -> Spec {
+    fn spec(&self) -> SpecTable {
         (self.to_spec)(&self.model)
     }
     fn with_params(&self, params: &[f64]) -> Result<AnyJitter, JitterError> {
@@ -85,7 +85,7 @@ impl AnyJitter {
     pub fn new<T: JitterModel + Clone + PartialEq + 'static>(
         family: impl Into<Arc<str>>,
         model: T,
-        to_spec: impl Fn(&T) -> Spec + Send + Sync + 'static,
+        to_spec: impl Fn(&T) -> SpecTable + Send + Sync + 'static,
     ) -> Self {
         AnyJitter(Arc::new(Entry {
             family: family.into(),
@@ -100,8 +100,8 @@ impl AnyJitter {
     }
 
     /// The spec table that rebuilds this model: `"family"` and the family's keys.
-    pub fn spec(&self) -> Spec {
-        let mut spec = Spec::new();
+    pub fn spec(&self) -> SpecTable {
+        let mut spec = SpecTable::new();
         spec.insert("family".into(), self.family().into());
         spec.extend(self.0.spec());
         spec
@@ -138,7 +138,7 @@ impl Serialize for AnyJitter {
 
 impl<'de> Deserialize<'de> for AnyJitter {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let spec = Spec::deserialize(deserializer)?;
+        let spec = SpecTable::deserialize(deserializer)?;
         JitterRegistry::builtin()
             .build(&spec)
             .map_err(serde::de::Error::custom)

@@ -91,7 +91,7 @@ pub use model::{
 pub use num_complex;
 pub use periodic::Periodic;
 pub use rule::QuadratureRule;
-/// Re-exported: spec tables ([`registry::Spec`]) are `serde_json` maps.
+/// Re-exported: spec tables ([`registry::SpecTable`]) are `serde_json` maps.
 pub use serde_json;
 pub use shifted::Shifted;
 pub use sum::Sum;

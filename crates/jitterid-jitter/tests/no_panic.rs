@@ -2,7 +2,7 @@
 //! deserialisable type and to the registry either fails with an error or gives a model whose
 //! methods all return.
 
-use jitterid_jitter::registry::{JitterRegistry, Spec};
+use jitterid_jitter::registry::{JitterRegistry, SpecTable};
 use jitterid_jitter::{
     AnyJitter, Atom, ExponentialDelay, Gaussian, JitterModel, Laplace, Mixture, NoJitter, Periodic,
     Shifted, Sum, TwoPoint, UniformSum,
@@ -156,7 +156,7 @@ proptest! {
         name in prop::sample::select(NAMES),
         kv in prop::collection::vec((prop::sample::select(KEYS), json()), 0..4),
     ) {
-        let mut spec: Spec = Map::new();
+        let mut spec: SpecTable = Map::new();
         spec.insert("family".into(), name.into());
         for (k, v) in kv {
             if k != "family" {

@@ -10,10 +10,18 @@
 //!   it is a whole number or a boolean). Help texts and generated docs are written from these.
 //! * [`Registry`] of [`Entry`]s: named constructors; [`Registry::build`] checks the table's keys
 //!   against the entry's [`ParamSpec`]s before the constructor sees it.
+//!   An entry may take a *build context* ([`Entry::with_context`]: the jitter registry hands
+//!   itself to composite families whose terms are spec tables, the signal registry the known
+//!   input), keys whose values are spec tables ([`Entry::with_nested`]), and a second
+//!   constructor from one number ([`Entry::with_scaled`], [`Registry::build_scaled`]: a jitter
+//!   family's member of a given standard deviation). [`Registry::markdown_table`] writes the
+//!   entries and their keys for the docs.
 //! * [`RegistryError`]: every error names the offending key ([`RegistryError::key`]), so a
-//!   front end can point at it in its own input.
-//! * [`keys`]: helpers that read numbers, whole numbers and lists from a table with those
-//!   errors.
+//!   front end can point at it in its own input. A registry may report in its crate's own
+//!   error type instead: one that implements [`SpecError`].
+//! * [`SpecReader`]: the typed reader of a checked table that an entry's constructor gets
+//!   (numbers with their defaults, whole numbers, booleans), its errors in the registry's error
+//!   type; [`keys`] also holds helpers that read a bare table with [`RegistryError`]s.
 //!
 //! Conventions: a key absent from the table takes its [`ParamSpec::default`]; a key without a
 //! default is required; whole numbers and booleans are carried as `f64` defaults (0/1 for
@@ -46,9 +54,10 @@ pub mod keys;
 mod param_spec;
 mod registry;
 
-pub use error::RegistryError;
+pub use error::{RegistryError, SpecError};
+pub use keys::SpecReader;
 pub use param_spec::ParamSpec;
-pub use registry::{Build, Builtin, Entry, Registry, Wrap};
+pub use registry::{Build, BuildScaled, Builtin, Entry, Registry, Wrap};
 
 /// A spec table: key/value construction input.
 pub type SpecTable = serde_json::Map<String, serde_json::Value>;

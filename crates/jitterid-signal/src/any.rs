@@ -1,7 +1,7 @@
 //! One run-time signal type: any [`Signal`] behind a shared pointer, with its registry kind and
 //! the spec table that rebuilds it.
 
-use crate::registry::Spec;
+use crate::registry::SpecTable;
 use crate::{Jacobian, SampleGrid, Signal, SignalError, SpectralLine, Spectrum};
 use jitterid_jitter::JitterModel;
 use num_complex::Complex64;
@@ -36,7 +36,7 @@ impl AnySignal {
     pub fn new<T: Signal + Clone + 'static>(
         kind: impl Into<Arc<str>>,
         model: T,
-        to_spec: impl Fn(&T) -> Spec + Send + Sync + 'static,
+        to_spec: impl Fn(&T) -> SpecTable + Send + Sync + 'static,
     ) -> Self {
         Self::wrap(kind.into(), model, Arc::new(to_spec), None)
     }
@@ -46,7 +46,7 @@ impl AnySignal {
     pub fn with_spectrum<T: Spectrum + Clone + 'static>(
         kind: impl Into<Arc<str>>,
         model: T,
-        to_spec: impl Fn(&T) -> Spec + Send + Sync + 'static,
+        to_spec: impl Fn(&T) -> SpecTable + Send + Sync + 'static,
     ) -> Self {
         Self::wrap(
             kind.into(),
@@ -76,8 +76,8 @@ impl AnySignal {
     }
 
     /// The spec table that rebuilds this model (with the same input): `"kind"` and its keys.
-    pub fn spec(&self) -> Spec {
-        let mut spec = Spec::new();
+    pub fn spec(&self) -> SpecTable {
+        let mut spec = SpecTable::new();
         spec.insert("kind".into(), self.kind().into());
         spec.extend(self.0.spec());
         spec
@@ -122,7 +122,7 @@ impl PartialEq for AnySignal {
 }
 
 /// Turns a model into the spec table's keys.
-type ToSpec<T> = Arc<dyn Fn(&T) -> Spec + Send + Sync>;
+type ToSpec<T> = Arc<dyn Fn(&T) -> SpecTable + Send + Sync>;
 
 struct Entry<T> {
     kind: Arc<str>,
@@ -135,7 +135,7 @@ trait DynSignal: Send + Sync {
     fn kind(&self) -> &str;
     fn model(&self) -> &dyn Signal;
     fn spectrum(&self) -> Option<&dyn Spectrum>;
-    fn spec(&self) -> Spec;
+    fn spec(&self) -> SpecTable;
     fn with_params(&self, params: &[f64]) -> Result<Arc<dyn DynSignal>, SignalError>;
 }
 
@@ -149,7 +149,7 @@ impl<T: Signal + Clone + 'static> DynSignal for Entry<T> {
     fn spectrum(&self) -> Option<&dyn Spectrum> {
         self.spectrum.map(|f| f(&self.model))
     }
-    fn spec(&self) -> Spec {
+    fn spec(&self) -> SpecTable {
         (self.to_spec)(&self.model)
     }
     fn with_params(&self, params: &[f64]) -> Result<Arc<dyn DynSignal>, SignalError> {

@@ -28,9 +28,9 @@
 //! steps inside the reach. The quadrature is exact for these integrands up to rounding (each is
 //! analytic between the cuts), as for every signal without a closed form.
 
+use crate::coefficients::Coefficients;
 use crate::expm::{expm, mat_vec, vec_mat};
 use crate::poly;
-use crate::rational::Rational;
 use crate::signal::Jacobian;
 use crate::SampleGrid;
 use jitterid_jitter::rule::QuadratureRule;
@@ -76,13 +76,13 @@ const POWERS: usize = 63;
 
 impl Confluent {
     /// The realisation of `r` and its derivatives.
-    pub(crate) fn new(r: &Rational) -> Self {
-        let den = r.den();
+    pub(crate) fn new(r: &Coefficients<'_>) -> Self {
+        let den = r.den;
         let n = den.len() - 1;
         let a2 = poly::mul(den, den);
         let m = 2 * n;
         let dim = m + 1;
-        let rho = r.poles().iter().map(|p| p.norm()).fold(0.0, f64::max);
+        let rho = r.poles.iter().map(|p| p.norm()).fold(0.0, f64::max);
         let scale = if rho > 0.0 && rho.is_finite() {
             rho
         } else {
@@ -99,12 +99,12 @@ impl Confluent {
             generator[i * dim + i - 1] = scale;
         }
         let readout = |p: &[f64]| readout(&a2, scale, p);
-        let num = r.num();
+        let num = r.num;
         let value = readout(&poly::mul(num, den));
         let grads = r
-            .d_num()
+            .d_num
             .iter()
-            .zip(r.d_den())
+            .zip(r.d_den)
             .map(|(dn, da)| {
                 let a = poly::pad(&poly::mul(dn, den), dim);
                 let b = poly::pad(&poly::mul(num, da), dim);
@@ -135,7 +135,7 @@ impl Confluent {
             }
             step_taylor.push(v.clone());
         }
-        let zones = crate::reach::zones(r.poles(), 1.0);
+        let zones = crate::reach::zones(r.poles, 1.0);
         Self {
             dim,
             generator,
@@ -278,11 +278,11 @@ impl Confluent {
     /// `q_0 … q_{n−1}`, lowest power first), from the [`impulse_state`](Self::impulse_state):
     /// the response, its derivative with respect to each of `r`'s parameters
     /// (`−q A'_j/A²`), and with respect to each `q_i` (`s^i A/A²`).
-    pub(crate) fn free_rows(&self, r: &Rational, q: &[f64]) -> FreeRows {
+    pub(crate) fn free_rows(&self, r: &Coefficients<'_>, q: &[f64]) -> FreeRows {
         let q_desc: Vec<f64> = q.iter().rev().copied().collect();
         let value = readout(&self.den2, self.scale, &poly::mul(&q_desc, &self.den));
         let grads = r
-            .d_den()
+            .d_den
             .iter()
             .map(|da| {
                 let p: Vec<f64> = poly::mul(&q_desc, da).iter().map(|c| -c).collect();
@@ -633,7 +633,7 @@ mod tests {
             TransferFunction::new(&[2.0], &[1.0, 3.0, 3.0, 1.0]).unwrap(),
         ];
         for r in &models {
-            let cf = Confluent::new(r.rational());
+            let cf = Confluent::new(&r.rational().coefficients());
             let d = cf.dim;
             for seed in 0..50u32 {
                 let v: Vec<f64> = (0..d)

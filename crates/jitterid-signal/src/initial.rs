@@ -134,8 +134,8 @@ impl<S: ModalSignal> WithInitialState<S> {
         match self.inner.modal() {
             Some(_) => Free::Modes(self.modes()),
             None => {
-                let cf = Confluent::new(self.inner.rational());
-                let rows = cf.free_rows(self.inner.rational(), &self.initial);
+                let cf = Confluent::new(&self.inner.rational().coefficients());
+                let rows = cf.free_rows(&self.inner.rational().coefficients(), &self.initial);
                 Free::Confluent(Box::new((cf, rows)))
             }
         }

@@ -39,6 +39,7 @@
 #![warn(missing_docs)]
 
 mod any;
+mod coefficients;
 mod confluent;
 mod delay;
 mod error;

@@ -77,7 +77,7 @@ impl<M: RationalModel> LtiResponse<M> {
     /// state right after every step.
     fn confluent_prefix(&self) -> &(Confluent, Vec<f64>) {
         self.confluent.get_or_init(|| {
-            let cf = Confluent::new(self.model.rational());
+            let cf = Confluent::new(&self.model.rational().coefficients());
             let prefix = cf.prefix(&self.steps);
             (cf, prefix)
         })

@@ -2,6 +2,7 @@
 //! their modal (partial-fraction) form with parameter derivatives where the poles are distinct
 //! and strictly stable.
 
+use crate::coefficients::Coefficients;
 use crate::confluent::Confluent;
 use crate::error::{all_finite, finite, tf_coefficients, SignalError};
 use crate::poly;
@@ -292,6 +293,17 @@ impl Rational {
         &self.poles
     }
 
+    /// The coefficients the confluent realisation reads.
+    pub(crate) fn coefficients(&self) -> Coefficients<'_> {
+        Coefficients {
+            num: self.num(),
+            den: self.den(),
+            d_num: self.d_num(),
+            d_den: self.d_den(),
+            poles: self.poles(),
+        }
+    }
+
     /// `∂N/∂θ_j`, coefficients padded to the denominator's length.
     pub(crate) fn d_num(&self) -> &[Vec<f64>] {
         &self.d_num
@@ -306,7 +318,7 @@ impl Rational {
     /// (one entry per parameter).
     pub fn step_response(&self, t: f64, grad: &mut [f64]) -> f64 {
         let Some(m) = &self.modal else {
-            return Confluent::new(self).step_response(t, grad);
+            return Confluent::new(&self.coefficients()).step_response(t, grad);
         };
         let mut value = Complex64::new(m.dc_gain, 0.0);
         for (j, g) in grad.iter_mut().enumerate() {
@@ -336,7 +348,7 @@ impl Rational {
                     .sum::<Complex64>()
                     .re
             }
-            None => Confluent::new(self).impulse_response(t),
+            None => Confluent::new(&self.coefficients()).impulse_response(t),
         }
     }
 

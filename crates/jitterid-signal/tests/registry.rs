@@ -2,12 +2,12 @@
 //! `AnySignal`, rebuilds from its own spec, and bad tables name the offending key.
 
 use jitterid_jitter::UniformSum;
-use jitterid_signal::registry::{SignalKind, SignalRegistry, Spec};
+use jitterid_signal::registry::{SignalKind, SignalRegistry, SpecTable};
 use jitterid_signal::testing::{binary, check_contract};
 use jitterid_signal::{AnySignal, Input, SampleGrid, Signal, SignalError, Sinusoid, Spectrum};
 use serde_json::json;
 
-fn table(v: serde_json::Value) -> Spec {
+fn table(v: serde_json::Value) -> SpecTable {
     v.as_object().cloned().unwrap()
 }
 
@@ -15,7 +15,7 @@ fn input() -> Input {
     binary(4, 4.0, -5.0, 35.0).unwrap().into()
 }
 
-fn specs() -> Vec<Spec> {
+fn specs() -> Vec<SpecTable> {
     vec![
         table(json!({"kind": "zpk", "gain": 0.2, "zeros": [-0.5], "poles": [[-0.25, 0.3]]})),
         table(json!({"kind": "tf", "num": [0.3, 1.0], "den": [1.0, 1.5, 0.9]})),
@@ -137,7 +137,7 @@ fn a_kind_registered_at_run_time_builds() {
         false,
         |_, _| {
             let s = Sinusoid::new(1.0, 0.1, 0.0)?;
-            Ok(AnySignal::new("tone", s, |_| Spec::new()))
+            Ok(AnySignal::new("tone", s, |_| SpecTable::new()))
         },
     );
     registry.register(kind.clone()).unwrap();

@@ -6,7 +6,7 @@
 use jitterid::estimate::validation::{BodePoint, StepPoint};
 use jitterid::estimate::{validation, EstimateError};
 use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
-use jitterid::signal::registry::{SignalRegistry, SpecReader};
+use jitterid::signal::registry::{KindReader, SignalRegistry};
 use jitterid::signal::RationalModel;
 use jitterid::signal::{AnySignal, SignalError, TransferFunction, Zpk};
 use serde::Serialize;
@@ -40,7 +40,7 @@ pub fn tf_of(signal: &AnySignal) -> Option<TfForm> {
     let spec = signal.spec();
     let kind = SignalRegistry::builtin().kind(signal.kind())?;
     let rebuilt = || -> Result<Option<TfForm>, SignalError> {
-        let r = SpecReader::new(kind, &spec)?;
+        let r = kind.reader(&spec)?;
         Ok(match signal.kind() {
             "zpk" => Some(TfForm::of(&Zpk::new(
                 r.f64("gain")?,
@@ -95,7 +95,7 @@ pub fn reported_covariance(
 fn zpk_of(signal: &AnySignal) -> Option<Zpk> {
     let kind = SignalRegistry::builtin().kind("zpk")?;
     let spec = signal.spec();
-    let r = SpecReader::new(kind, &spec).ok()?;
+    let r = kind.reader(&spec).ok()?;
     (signal.kind() == "zpk")
         .then(|| {
             Zpk::new(
@@ -112,7 +112,7 @@ fn zpk_of(signal: &AnySignal) -> Option<Zpk> {
 fn transfer_function_of(signal: &AnySignal) -> Option<TransferFunction> {
     let kind = SignalRegistry::builtin().kind("tf")?;
     let spec = signal.spec();
-    let r = SpecReader::new(kind, &spec).ok()?;
+    let r = kind.reader(&spec).ok()?;
     (signal.kind() == "tf")
         .then(|| TransferFunction::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok())
         .flatten()
@@ -186,7 +186,7 @@ mod tests {
     /// `2 (s − z) / ((s − a)² + b²)` with input delay `d` (none when `d` is `None`), for
     /// `θ = [gain, z, a, b]`.
     fn signal(theta: &[f64], delay: Option<f64>) -> AnySignal {
-        let mut spec: jitterid::signal::registry::Spec = json!({
+        let mut spec: jitterid::signal::registry::SpecTable = json!({
             "kind": "zpk",
             "gain": theta[0],
             "zeros": [theta[1]],

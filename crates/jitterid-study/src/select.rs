@@ -15,7 +15,7 @@ use crate::study_err;
 use jitterid::estimate::selection::{select as run_select, Candidate, SelectionOptions};
 use jitterid::estimate::{initial_model, InitError, InitOptions};
 use jitterid::jitter::JitterModel;
-use jitterid::signal::registry::{roots_json, Spec};
+use jitterid::signal::registry::{roots_json, SpecTable};
 use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -177,7 +177,7 @@ impl InitChoice {
     }
 }
 
-fn roots_of(spec: &Spec, key: &str) -> Option<Vec<Root>> {
+fn roots_of(spec: &SpecTable, key: &str) -> Option<Vec<Root>> {
     let Some(v) = spec.get(key) else {
         return Some(Vec::new());
     };
@@ -196,7 +196,7 @@ fn roots_of(spec: &Spec, key: &str) -> Option<Vec<Root>> {
         .collect()
 }
 
-fn f64s(spec: &Spec, key: &str) -> Option<Vec<f64>> {
+fn f64s(spec: &SpecTable, key: &str) -> Option<Vec<f64>> {
     spec.get(key)?
         .as_array()?
         .iter()

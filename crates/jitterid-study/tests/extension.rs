@@ -104,8 +104,8 @@ impl JitterModel for Triangle {
     }
 }
 
-fn spec_of(t: &Triangle) -> jitterid::jitter::registry::Spec {
-    let mut s = jitterid::jitter::registry::Spec::new();
+fn spec_of(t: &Triangle) -> jitterid::jitter::registry::SpecTable {
+    let mut s = jitterid::jitter::registry::SpecTable::new();
     s.insert("a".into(), t.a.into());
     s
 }

@@ -1,6 +1,6 @@
 //! The registry entries of this crate's families.
 
-use super::{Family, JitterRegistry, ParamSpec, Spec, SpecReader};
+use super::{Family, FamilyReader, JitterRegistry, ParamSpec, SpecReader, SpecTable};
 use crate::{
     AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, Mixture, NoJitter,
     Periodic, Sum, TwoPoint, UniformSum,
@@ -8,7 +8,7 @@ use crate::{
 use serde_json::Value;
 
 /// A spec table of the given keys and values.
-pub(crate) fn spec_of<const N: usize>(pairs: [(&str, Value); N]) -> Spec {
+pub(crate) fn spec_of<const N: usize>(pairs: [(&str, Value); N]) -> SpecTable {
     pairs.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }
 
@@ -16,7 +16,7 @@ pub(crate) fn spec_of<const N: usize>(pairs: [(&str, Value); N]) -> Spec {
 /// standard deviation is `std_per_scale` times that parameter.
 fn one_scale<T: JitterModel + Clone + PartialEq + 'static>(
     name: &'static str,
-    summary: &str,
+    summary: &'static str,
     key: &'static str,
     meaning: &str,
     new: fn(f64) -> Result<T, JitterError>,
@@ -36,7 +36,7 @@ fn one_scale<T: JitterModel + Clone + PartialEq + 'static>(
     .with_std_dev(move |sigma, _, _| Ok(wrap(new(sigma / std_per_scale)?)))
 }
 
-fn uniform_sum_spec(u: &UniformSum) -> Spec {
+fn uniform_sum_spec(u: &UniformSum) -> SpecTable {
     spec_of([("n", u.n().into()), ("a", u.a().into())])
 }
 
@@ -70,7 +70,7 @@ fn uniform_sum() -> Family {
 }
 
 fn none() -> Family {
-    let wrap = || AnyJitter::new("none", NoJitter, |_: &NoJitter| Spec::new());
+    let wrap = || AnyJitter::new("none", NoJitter, |_: &NoJitter| SpecTable::new());
     Family::new("none", "no jitter: τ = 0", Vec::new(), move |_, _| {
         Ok(wrap())
     })
@@ -116,7 +116,7 @@ fn sum() -> Family {
     .with_terms()
 }
 
-fn mixture_spec(m: &Mixture<AnyJitter>) -> Spec {
+fn mixture_spec(m: &Mixture<AnyJitter>) -> SpecTable {
     let terms = m
         .components()
         .iter()

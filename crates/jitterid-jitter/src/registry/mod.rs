@@ -2,10 +2,16 @@
 //! fuzz tests) can choose at run time, with its parameter keys described, built from a spec
 //! table of key/value pairs.
 //!
-//! A spec table is a [`Spec`] (a JSON object): `"family"` names the family, the other keys are
-//! the family's (see [`Family::params`]); any family also takes `"offset"` (s), a constant
+//! A spec table is a [`SpecTable`] (a JSON object): `"family"` names the family, the other keys
+//! are the family's (see [`Family::params`]); any family also takes `"offset"` (s), a constant
 //! added to the jitter ([`Shifted`]). Composite families (`"sum"`,
 //! `"mixture"`) take `"terms"`, an array of spec tables.
+//!
+//! The registry is the workspace's one run-time registry shape ([`jitterid_registry::Registry`]
+//! of [`Family`] entries, each an [`Entry`]): the registry hands itself to a family's
+//! constructor as its build context (the terms of `sum` and `mixture` are built by it), and a
+//! family's second constructor builds its member of a given standard deviation
+//! ([`JitterRegistry::from_std_dev`]). Errors are [`JitterError`]s.
 //!
 //! ```
 //! use jitterid_jitter::registry::JitterRegistry;
@@ -32,13 +38,19 @@ mod reader;
 pub use family::Family;
 /// The description of one spec-table key, shared by every registry of the workspace.
 pub use jitterid_registry::ParamSpec;
-pub use reader::SpecReader;
+/// A spec table: key/value construction input, shared by every registry of the workspace.
+pub use jitterid_registry::SpecTable;
+/// The former name of [`SpecTable`] in this module, kept so that the path still resolves.
+pub use jitterid_registry::SpecTable as Spec;
+pub use reader::FamilyReader;
 
 use crate::{AnyJitter, JitterError, Shifted};
-use std::sync::{Arc, OnceLock};
+use jitterid_registry::{Entry, Registry};
+use std::sync::OnceLock;
 
-/// A spec table: key/value construction input of a family.
-pub type Spec = serde_json::Map<String, serde_json::Value>;
+/// The reader of a family's spec table ([`jitterid_registry::SpecReader`] with
+/// [`JitterError`]s); [`FamilyReader`] adds the reads of lists and terms.
+pub type SpecReader<'a> = jitterid_registry::SpecReader<'a, JitterError>;
 
 /// The key naming the family in a spec table.
 pub const FAMILY_KEY: &str = "family";
@@ -49,16 +61,28 @@ pub const OFFSET_KEY: &str = "offset";
 /// The key of the terms of a composite family.
 pub const TERMS_KEY: &str = "terms";
 
+/// The entries of a [`JitterRegistry`], by name.
+type Families = Registry<AnyJitter, JitterRegistry, JitterError, Family>;
+
 /// A set of jitter families by name.
-#[derive(Clone, Default)]
+#[derive(Clone)]
 pub struct JitterRegistry {
-    families: Vec<Arc<Family>>,
+    families: Families,
+}
+
+impl Default for JitterRegistry {
+    fn default() -> Self {
+        let offset = ParamSpec::new(OFFSET_KEY, "constant added to the jitter", "s", "finite");
+        let families =
+            Registry::empty(FAMILY_KEY, "jitter family", vec![offset], None).with_wrap(shift);
+        JitterRegistry { families }
+    }
 }
 
 impl std::fmt::Debug for JitterRegistry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_list()
-            .entries(self.families.iter().map(|fam| fam.name()))
+            .entries(self.families().map(Family::name))
             .finish()
     }
 }
@@ -78,85 +102,36 @@ impl JitterRegistry {
 
     /// Adds a family; its name must be new.
     pub fn register(&mut self, family: Family) -> Result<(), JitterError> {
-        if self.family(family.name()).is_some() {
-            return Err(JitterError::DuplicateFamily {
-                family: family.name().to_string(),
-            });
-        }
-        self.families.push(Arc::new(family));
-        Ok(())
+        self.families.register(family)
     }
 
     /// The family of this name, if registered.
     pub fn family(&self, name: &str) -> Option<&Family> {
-        self.families
-            .iter()
-            .find(|f| f.name() == name)
-            .map(|f| f.as_ref())
+        self.families.entry(name)
     }
 
     /// Every family, in registration order.
     pub fn families(&self) -> impl Iterator<Item = &Family> {
-        self.families.iter().map(|f| f.as_ref())
+        self.families.entries().iter()
     }
 
     /// The registered names, quoted and joined for a message.
     pub fn names(&self) -> String {
-        let names: Vec<String> = self
-            .families
-            .iter()
-            .map(|f| format!("\"{}\"", f.name()))
-            .collect();
-        names.join(", ")
+        quoted(&self.families.names())
     }
 
     /// The families and their keys as a Markdown table (one row per family with its summary,
     /// then one per key), as `docs/experiments.md` shows it.
     pub fn markdown_table(&self) -> String {
-        let mut out = String::from(
-            "| family | key | unit | accepts | default | meaning |\n|---|---|---|---|---|---|\n",
-        );
-        for f in self.families() {
-            let name = f.name();
-            out.push_str(&format!("| `{name}` | — | | | | {} |\n", f.summary()));
-            for p in f.params() {
-                let default = match p.default {
-                    Some(d) if p.boolean => (d != 0.0).to_string(),
-                    Some(d) if p.integer || d.fract() == 0.0 => format!("{d:.0}"),
-                    Some(d) => d.to_string(),
-                    None => "required".into(),
-                };
-                out.push_str(&format!(
-                    "| `{name}` | `{}` | {} | {} | {default} | {} |\n",
-                    p.key, p.unit, p.constraint, p.meaning
-                ));
-            }
-            if f.takes_terms() {
-                out.push_str(&format!(
-                    "| `{name}` | `{TERMS_KEY}` | | two or more tables, each with its own `{FAMILY_KEY}` and keys | required | the terms (`[[jitter.terms]]` in an experiment file) |\n"
-                ));
-            }
-        }
-        out
-    }
-
-    fn lookup(&self, name: &str) -> Result<&Family, JitterError> {
-        self.family(name).ok_or_else(|| JitterError::UnknownFamily {
-            family: name.to_string(),
-            known: self.names(),
-        })
+        self.families.markdown_table()
     }
 
     /// Builds the model a spec table describes: `"family"`, the family's keys, and optionally
     /// `"offset"`. Every key is checked, and a key the family does not take is an error, so a
     /// front end removes its own keys (such as an experiment file's `estimate`) first; an
     /// error names the key.
-    pub fn build(&self, spec: &Spec) -> Result<AnyJitter, JitterError> {
-        let name = family_name(spec)?;
-        let family = self.lookup(name)?;
-        let reader = SpecReader::new(family, spec)?;
-        let model = family.build_with(&reader, self)?;
-        shift(model, &reader)
+    pub fn build(&self, spec: &SpecTable) -> Result<AnyJitter, JitterError> {
+        self.families.build_with(spec, Some(self))
     }
 
     /// The member of family `name` with standard deviation `sigma` (s); `spec` holds the
@@ -167,37 +142,30 @@ impl JitterRegistry {
         &self,
         name: &str,
         sigma: f64,
-        spec: &Spec,
+        spec: &SpecTable,
     ) -> Result<AnyJitter, JitterError> {
-        let family = self.lookup(name)?;
+        let family = self
+            .family(name)
+            .ok_or_else(|| JitterError::UnknownFamily {
+                family: name.to_string(),
+                known: self.names(),
+            })?;
         // A family without keys (`none`) has no spread to set: any σ, even 0, gives it.
         if !family.params().is_empty() || family.takes_terms() {
             crate::kernels::validate::positive("sigma", sigma)?;
         }
-        let reader = SpecReader::new(family, spec)?;
-        let model = family.std_dev_member(sigma, &reader, self)?;
-        shift(model, &reader)
+        self.families.build_scaled(name, sigma, spec, Some(self))
     }
 }
 
-/// The `"family"` value of a spec table.
-fn family_name(spec: &Spec) -> Result<&str, JitterError> {
-    match spec.get(FAMILY_KEY) {
-        Some(serde_json::Value::String(s)) => Ok(s),
-        Some(other) => Err(JitterError::InvalidKey {
-            family: String::new(),
-            key: FAMILY_KEY.into(),
-            message: format!("expected a family name (a string), found {other}"),
-        }),
-        None => Err(JitterError::MissingKey {
-            family: String::new(),
-            key: FAMILY_KEY.into(),
-        }),
-    }
+/// Names quoted and joined for a message.
+fn quoted(names: &[&str]) -> String {
+    let names: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
+    names.join(", ")
 }
 
 /// `model` moved by the spec's `"offset"`, if it has one.
-fn shift(model: AnyJitter, reader: &SpecReader<'_>) -> Result<AnyJitter, JitterError> {
+fn shift(reader: &SpecReader<'_>, model: AnyJitter) -> Result<AnyJitter, JitterError> {
     let Some(offset) = reader.opt_f64(OFFSET_KEY)? else {
         return Ok(model);
     };
@@ -209,6 +177,81 @@ fn shift(model: AnyJitter, reader: &SpecReader<'_>) -> Result<AnyJitter, JitterE
         spec
     }))
 }
+
+impl jitterid_registry::SpecError for JitterError {
+    fn not_a_name(key: &str, found: &serde_json::Value) -> Self {
+        JitterError::InvalidKey {
+            family: String::new(),
+            key: key.into(),
+            message: format!("expected a family name (a string), found {found}"),
+        }
+    }
+
+    fn missing_name(key: &str) -> Self {
+        JitterError::MissingKey {
+            family: String::new(),
+            key: key.into(),
+        }
+    }
+
+    fn unknown_name(_: &str, _: &'static str, name: &str, known: &[&str]) -> Self {
+        JitterError::UnknownFamily {
+            family: name.to_string(),
+            known: quoted(known),
+        }
+    }
+
+    fn unknown_key(entry: &str, key: &str, _: &[ParamSpec], allowed: &[&str]) -> Self {
+        JitterError::UnexpectedKey {
+            family: entry.to_string(),
+            key: key.to_string(),
+            allowed: allowed
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        }
+    }
+
+    fn missing_key(entry: &str, key: &str) -> Self {
+        JitterError::MissingKey {
+            family: entry.to_string(),
+            key: key.to_string(),
+        }
+    }
+
+    fn bad_value(entry: &str, key: &str, message: String) -> Self {
+        JitterError::InvalidKey {
+            family: entry.to_string(),
+            key: key.to_string(),
+            message,
+        }
+    }
+
+    fn duplicate(name: &str) -> Self {
+        JitterError::DuplicateFamily {
+            family: name.to_string(),
+        }
+    }
+
+    fn missing_context(entry: &str) -> Self {
+        // Unreached: a JitterRegistry always hands itself to its families.
+        JitterError::InvalidKey {
+            family: entry.to_string(),
+            key: FAMILY_KEY.into(),
+            message: "built without the registry of its terms".into(),
+        }
+    }
+
+    fn no_scaled_form(entry: &str) -> Self {
+        JitterError::NoStdDevForm {
+            family: entry.to_string(),
+        }
+    }
+}
+
+/// The registry entry a [`Family`] wraps.
+pub type FamilyEntry = Entry<AnyJitter, JitterRegistry, JitterError>;
 
 #[cfg(test)]
 mod tests;

@@ -3,7 +3,7 @@ use crate::testing::check_contract;
 use crate::{Gaussian, JitterModel, UniformSum};
 use serde_json::json;
 
-fn table(v: serde_json::Value) -> Spec {
+fn table(v: serde_json::Value) -> SpecTable {
     v.as_object().cloned().unwrap_or_default()
 }
 
@@ -95,7 +95,7 @@ fn from_std_dev_gives_the_requested_spread() {
             let spec = if fam.params().iter().any(|p| p.key == "n") {
                 table(json!({ "n": n }))
             } else {
-                Spec::new()
+                SpecTable::new()
             };
             let j = r.from_std_dev(fam.name(), 0.125, &spec).unwrap();
             assert!(
@@ -107,11 +107,13 @@ fn from_std_dev_gives_the_requested_spread() {
         }
     }
     assert_eq!(
-        r.from_std_dev("none", 0.1, &Spec::new()).unwrap().std_dev(),
+        r.from_std_dev("none", 0.1, &SpecTable::new())
+            .unwrap()
+            .std_dev(),
         0.0
     );
     assert!(matches!(
-        r.from_std_dev("gaussian", -1.0, &Spec::new()),
+        r.from_std_dev("gaussian", -1.0, &SpecTable::new()),
         Err(JitterError::NotPositive { .. })
     ));
     let shifted = r
@@ -149,7 +151,7 @@ fn a_family_added_at_run_time_is_built_like_the_others() {
         .unwrap();
     assert!((j.std_dev() - 0.2).abs() < 1e-16);
     assert!(matches!(
-        r.from_std_dev("narrow", 0.1, &Spec::new()),
+        r.from_std_dev("narrow", 0.1, &SpecTable::new()),
         Err(JitterError::NoStdDevForm { .. })
     ));
     assert!(JitterRegistry::builtin().family("narrow").is_none());
@@ -183,7 +185,7 @@ fn composite_families_build_from_terms_and_round_trip() {
         three.param_names(),
         vec!["terms.0.sigma", "terms.1.d", "terms.2.a"]
     );
-    let p = r.from_std_dev("periodic", 0.1, &Spec::new()).unwrap();
+    let p = r.from_std_dev("periodic", 0.1, &SpecTable::new()).unwrap();
     assert!((p.std_dev() - 0.1).abs() < 1e-16);
 }
 
@@ -209,7 +211,7 @@ fn errors_inside_a_term_name_the_term() {
     );
     assert_eq!(e.key(), Some("terms.1.family"), "{e}");
     assert!(matches!(
-        r.from_std_dev("sum", 0.1, &Spec::new()),
+        r.from_std_dev("sum", 0.1, &SpecTable::new()),
         Err(JitterError::NoStdDevForm { .. })
     ));
 }

@@ -37,7 +37,7 @@
 //! The two BICs are never compared with each other.
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
-use jitterid_signal::registry::{SignalRegistry, Spec};
+use jitterid_signal::registry::{SignalRegistry, SpecTable};
 use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 use serde_json::json;
@@ -263,7 +263,7 @@ fn candidate_signal(
     record: &Record,
     options: &SelectionOptions,
 ) -> Result<AnySignal, String> {
-    let mut spec = Spec::new();
+    let mut spec = SpecTable::new();
     spec.insert("kind".into(), json!("tf"));
     spec.insert("num".into(), json!(model.num()));
     spec.insert("den".into(), json!(model.den()));

@@ -138,7 +138,7 @@ fn screened(poles: usize, family: &str, bic: f64, converged: bool) -> Candidate 
         .unwrap()
         .into();
     let model = LtiResponse::new(model, input);
-    let model = AnySignal::with_spectrum("tf", model, |_| Spec::new());
+    let model = AnySignal::with_spectrum("tf", model, |_| SpecTable::new());
     let none = JitterRegistry::builtin()
         .from_std_dev("none", 0.0, &serde_json::Map::new())
         .unwrap();
@@ -301,7 +301,7 @@ fn validation_fit_starts_from_the_validation_records_own_state() {
     let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
     let y = LtiResponse::new(truth, u).expected_values(&grid, &NoJitter);
     let record = Record::new(grid, y).unwrap();
-    let mut spec = Spec::new();
+    let mut spec = SpecTable::new();
     spec.insert("kind".into(), json!("tf"));
     spec.insert("num".into(), json!(num));
     spec.insert("den".into(), json!(den));

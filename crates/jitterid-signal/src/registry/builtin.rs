@@ -1,6 +1,6 @@
 //! The built-in signal kinds.
 
-use super::{ParamSpec, SignalKind, SignalRegistry, Spec, SpecReader};
+use super::{KindReader, ParamSpec, SignalKind, SignalRegistry, SpecReader, SpecTable};
 use crate::{
     AnySignal, Delayed, Input, LtiResponse, PulseResponse, RationalModel, Root, SignalError,
     Sinusoid, TransferFunction, WithInitialState, Zpk,
@@ -41,7 +41,7 @@ fn input_of(input: Option<&Input>) -> Result<Input, SignalError> {
 }
 
 /// Roots as a spec table writes them: a number for a real root, `[re, im]` for a pair
-/// (what [`SpecReader::roots`](super::SpecReader::roots) reads back).
+/// (what [`KindReader::roots`] reads back).
 pub fn roots_json(roots: &[Root]) -> Value {
     roots
         .iter()
@@ -179,7 +179,7 @@ fn unstable_key() -> ParamSpec {
 }
 
 /// `spec` with `unstable = true` when the model accepts unstable poles.
-fn with_unstable<M: RationalModel>(mut spec: Spec, g: &M) -> Spec {
+fn with_unstable<M: RationalModel>(mut spec: SpecTable, g: &M) -> SpecTable {
     if g.rational().allows_unstable() {
         spec.insert("unstable".into(), json!(true));
     }
@@ -219,7 +219,7 @@ fn lti_signal<M: RationalModel + Clone + 'static>(
     kind: &'static str,
     r: &SpecReader<'_>,
     response: LtiResponse<M>,
-    keys: fn(&M) -> Spec,
+    keys: fn(&M) -> SpecTable,
 ) -> Result<AnySignal, SignalError> {
     let delay = if r.has("delay") {
         let d = r.f64("delay")?;
@@ -235,7 +235,7 @@ fn lti_signal<M: RationalModel + Clone + 'static>(
         .then(|| r.f64_list("initial"))
         .transpose()?;
     let origin = r.f64("origin")?;
-    let with_origin = move |mut s: Spec, initial: &[f64], origin: f64| {
+    let with_origin = move |mut s: SpecTable, initial: &[f64], origin: f64| {
         s.insert("initial".into(), json!(initial));
         s.insert("origin".into(), json!(origin));
         s
@@ -346,6 +346,6 @@ fn pulse_response() -> SignalKind {
     )
 }
 
-fn spec<const N: usize>(pairs: [(&str, Value); N]) -> Spec {
+fn spec<const N: usize>(pairs: [(&str, Value); N]) -> SpecTable {
     pairs.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }

@@ -11,7 +11,7 @@ use super::range;
 use super::raw::RawTable;
 use super::spec::JitterSpec;
 use crate::error::{StudyError, StudyResult};
-use jitterid::jitter::registry::{Family, Spec, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
+use jitterid::jitter::registry::{Family, SpecTable, FAMILY_KEY, OFFSET_KEY, TERMS_KEY};
 use jitterid::jitter::{AnyJitter, JitterError, JitterModel, NoJitter, UniformSum};
 use jitterid::signal::SampleGrid;
 use serde_json::Value;
@@ -83,7 +83,7 @@ pub(super) fn parse_jitter(
 
 /// No jitter, and nothing of it estimated (the default without a `[jitter]` section).
 pub(super) fn no_jitter() -> JitterSpec {
-    let none = AnyJitter::new("none", NoJitter, |_| Spec::new());
+    let none = AnyJitter::new("none", NoJitter, |_| SpecTable::new());
     JitterSpec {
         truth: none.clone(),
         model: none,
@@ -125,7 +125,7 @@ fn check_keys(cx: &Source, r: &RawTable, entry: &Family) -> StudyResult<()> {
 }
 
 /// The section as the registry's spec table (the command line's own keys left out).
-fn spec_table(r: &RawTable) -> StudyResult<Spec> {
+fn spec_table(r: &RawTable) -> StudyResult<SpecTable> {
     r.iter()
         .filter(|(k, _)| !OWN_KEYS.contains(&k.as_str()))
         .map(|(k, v)| {
@@ -141,7 +141,7 @@ fn spec_table(r: &RawTable) -> StudyResult<Spec> {
 fn check_ranges(
     cx: &Source,
     r: &RawTable,
-    spec: &Spec,
+    spec: &SpecTable,
     path: &str,
     grid: &SampleGrid,
 ) -> StudyResult<()> {
@@ -208,7 +208,7 @@ fn fitted_family(
     cx: &Source,
     ff: &Spanned<toml::Value>,
     truth: &AnyJitter,
-    spec: &Spec,
+    spec: &SpecTable,
 ) -> StudyResult<AnyJitter> {
     let registry = &cx.registries.jitter;
     let name = cx.string_value(S, "fit_family", ff)?;
@@ -223,7 +223,7 @@ fn fitted_family(
     if name != "none" && !(sigma.is_finite() && sigma > 0.0) {
         return Err(fail(format!("a fitted family \"{name}\" needs a given jitter with a spread (standard deviation > 0) to start from")));
     }
-    let mut structural = Spec::new();
+    let mut structural = SpecTable::new();
     for p in entry.params().iter().filter(|p| p.integer) {
         if let Some(v) = spec.get(&p.key) {
             structural.insert(p.key.clone(), v.clone());

@@ -6,7 +6,6 @@ use jitterid::estimate::{
     AnyCriterion, AnyNoise, CriterionRegistry, Frequencies, NoiseModel, SpecTable,
 };
 use jitterid::jitter::AnyJitter;
-use jitterid::signal::registry::Spec;
 use jitterid::signal::{Input, RandomBinary, SampleGrid};
 use std::fmt;
 use std::path::PathBuf;
@@ -29,7 +28,7 @@ pub struct SystemSpec {
     /// The signal registry's spec table (`kind` and that kind's keys, checked at the door): the
     /// truth in `simulate`/`montecarlo`, the start in `fit`. Built with
     /// [`crate::fit::signal_of`].
-    pub kind: Spec,
+    pub kind: SpecTable,
     /// Whether its parameters are estimated.
     pub estimate: bool,
 }

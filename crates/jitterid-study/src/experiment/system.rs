@@ -6,7 +6,7 @@ use super::range;
 use super::raw::RawSystem;
 use super::spec::{quoted_list, SystemSpec};
 use crate::error::StudyResult;
-use jitterid::signal::registry::{roots_json, SignalKind, SignalRegistry, Spec, KIND_KEY};
+use jitterid::signal::registry::{roots_json, SignalKind, SignalRegistry, SpecTable, KIND_KEY};
 use jitterid::signal::{Root, SampleGrid, Sinusoid, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use toml::Spanned;
@@ -105,7 +105,7 @@ pub(super) fn parse_system(
     Ok(SystemSpec { kind, estimate })
 }
 
-fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
+fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
     let why = "kind = \"zpk\" needs gain, poles and optionally zeros";
     let g = cx.required(S, "gain", &r.gain, why)?;
     let gain = cx.checked(S, "gain", g, range::gain)?;
@@ -141,7 +141,7 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
     ))
 }
 
-fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
+fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
     let why = "kind = \"tf\" needs num and den (highest power first)";
     let n = cx.required(S, "num", &r.num, why)?;
     let d = cx.required(S, "den", &r.den, why)?;
@@ -169,7 +169,7 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
     ))
 }
 
-fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<Spec> {
+fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
     let why = "kind = \"sinusoid\" needs amplitude, frequency and optionally phase";
     let a = cx.required(S, "amplitude", &r.amplitude, why)?;
     let f = cx.required(S, "frequency", &r.frequency, why)?;
@@ -195,8 +195,8 @@ fn response_keys(
     cx: &Source,
     r: &RawSystem,
     grid: &SampleGrid,
-    mut kind: Spec,
-) -> StudyResult<Spec> {
+    mut kind: SpecTable,
+) -> StudyResult<SpecTable> {
     if let Some(d) = &r.delay {
         let d = cx.checked(S, "delay", d, |d| range::delay(d, grid))?;
         kind.insert("delay".into(), json!(d));
@@ -228,7 +228,7 @@ fn response_keys(
 }
 
 /// The number of poles of a zpk spec table (a pair `[re, im]` counts two).
-fn zpk_order(kind: &Spec) -> usize {
+fn zpk_order(kind: &SpecTable) -> usize {
     kind.get("poles").and_then(Value::as_array).map_or(0, |ps| {
         ps.iter().map(|p| if p.is_array() { 2 } else { 1 }).sum()
     })
@@ -236,15 +236,15 @@ fn zpk_order(kind: &Spec) -> usize {
 
 /// The signal registry's spec table of `kind` with `keys`, as the door checks built them.
 /// `spec` with `unstable = true` when asked for (`[system] unstable`).
-fn with_unstable(mut spec: Spec, unstable: bool) -> Spec {
+fn with_unstable(mut spec: SpecTable, unstable: bool) -> SpecTable {
     if unstable {
         spec.insert("unstable".into(), json!(true));
     }
     spec
 }
 
-fn spec<const N: usize>(kind: &str, keys: [(&str, Value); N]) -> Spec {
-    let mut spec = Spec::new();
+fn spec<const N: usize>(kind: &str, keys: [(&str, Value); N]) -> SpecTable {
+    let mut spec = SpecTable::new();
     spec.insert(KIND_KEY.into(), kind.into());
     spec.extend(keys.into_iter().map(|(k, v)| (k.to_string(), v)));
     spec
