@@ -7,7 +7,7 @@ use crate::data::Record;
 use crate::fit::estimate;
 use crate::noise::NoiseModel;
 use crate::options::FitOptions;
-use crate::profile::{refit_each, Profile};
+use crate::profile::{best_of, fitted_jitter, Profile};
 use crate::result::{CostKind, Fit};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
@@ -200,4 +200,55 @@ where
     let values: Vec<i64> = values.into_iter().collect();
     let build = |v| build(v).map_err(Into::into);
     criterion.profile(structure, record, options, &values, &build)
+}
+
+/// The default profile of a [`FitCriterion`]: every value fitted without the covariance, the
+/// best converged fit kept (the best of all if none converged), and the winner fitted once
+/// more from its estimate for the covariance when `options` asks for it.
+fn refit_each<S, J, N, C>(
+    criterion: &C,
+    structure: &ModelStructure<S, J, N>,
+    record: &Record,
+    options: &FitOptions,
+    values: &[i64],
+    build: &(dyn Fn(i64) -> Result<J, EstimateError> + Sync),
+) -> Result<Profile<J>, EstimateError>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: FitCriterion<S, J, N> + ?Sized,
+{
+    // The covariance is only wanted at the winner: fit every value without it.
+    let quick = FitOptions {
+        covariance: false,
+        ..options.clone()
+    };
+    let at = |v: i64| -> Result<ModelStructure<S, J, N>, EstimateError> {
+        let mut s = structure.clone();
+        s.jitter = build(v)?;
+        Ok(s)
+    };
+    let fits = values
+        .iter()
+        .map(|&v| (v, at(v).and_then(|s| criterion.fit(&s, record, &quick))))
+        .collect();
+    let (best, costs, first_error) = best_of(fits);
+    let Some((value, mut winner)) = best else {
+        return Err(first_error.unwrap_or(EstimateError::NothingToEstimate));
+    };
+    let start = at(value)?;
+    if options.covariance {
+        // Restart at the winner: the solver stops at once and the covariance is computed there.
+        let refit = criterion.fit(&start.with_params(&winner.params)?, record, options)?;
+        winner.covariance = refit.covariance;
+        winner.std_errors = refit.std_errors;
+        winner.noise_std = refit.noise_std;
+    }
+    Ok(Profile {
+        value,
+        jitter: fitted_jitter(structure, start.jitter, &winner)?,
+        estimate: winner,
+        costs,
+    })
 }
