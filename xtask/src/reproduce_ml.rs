@@ -350,7 +350,7 @@ pub fn table1_ml(o: &Options) -> Result<(), String> {
         "## Table 1 by maximum likelihood: known G(s) = 1/(s+2), jitter estimated from the second moment\n\n\
          Same realisations as `table1` (input, jitter, noise and start drawn in the same order). \
          Noise std 0.01 known to the likelihood estimators. Uniform-sum family: `n` profiled over 0..=9 \
-         (`ml_profile`), `a` by Brent's method in `ln a`. Exact ML: the per-sample likelihood \
+         (`fit_profile`), `a` by Brent's method in `ln a`. Exact ML: the per-sample likelihood \
          `∫ φ(y − s(t+τ)) p(τ) dτ`; quasi-ML: the Gaussian likelihood of `m_k` and `λ_k`. \
          CRB std: the exact model's Cramér–Rao bound of σ at the truth (the family's own parameter, `n` known; \
          σ = a/√(3(n+1)) for the uniform sum), root mean square over the first ",
