@@ -78,7 +78,8 @@ def montecarlo(
     """``runs`` realisations of ``experiment`` fitted with ``method`` under master ``seed``
     (or shard ``(i, n)`` of them), on ``threads`` worker threads (all cores by default).
     ``to_dict()`` equals ``jitterid montecarlo --json`` (``--shard i/n``) apart from
-    ``seconds``. The GIL is released while it runs."""
+    ``seconds``. The GIL is released while it runs; Ctrl-C stops the study before its next
+    realisations and raises ``KeyboardInterrupt``."""
     if not isinstance(experiment, _jitterid.Experiment):
         raise TypeError(f"experiment: expected an Experiment, found {type(experiment).__name__}")
     text = _jitterid.montecarlo(experiment, runs, seed, shard, method, threads)

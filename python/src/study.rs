@@ -4,12 +4,24 @@
 use crate::errors::{json_text, value_error};
 use crate::experiment::Experiment;
 use jitterid_study::merge::merge_values;
-use jitterid_study::montecarlo::{montecarlo_values, McJson, Shard, DEFAULT_SEED};
+use jitterid_study::montecarlo::{run_study, Keep, McJson, Shard, DEFAULT_SEED};
+use jitterid_study::Watch;
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// How often a running study looks for Ctrl-C (and any other Python signal).
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 /// Runs `runs` realisations of `experiment` with `method` (the file's if `None`) under master
 /// `seed`, or shard `(index, count)` of them, on `threads` worker threads; returns the result
 /// as JSON text (that of `jitterid montecarlo --json`).
+///
+/// The study runs on its own threads without the GIL while this thread looks for Python
+/// signals every [`SIGNAL_POLL`]: Ctrl-C stops the study before its next realisations and
+/// raises `KeyboardInterrupt` once the running ones end.
 #[pyfunction]
 #[pyo3(signature = (experiment, runs = 128, seed = DEFAULT_SEED, shard = None, method = None, threads = None))]
 pub fn montecarlo(
@@ -33,9 +45,28 @@ pub fn montecarlo(
             }
         })
         .transpose()?;
-    let j = py
-        .detach(|| montecarlo_values(&exp, runs, seed, shard, threads))
-        .map_err(value_error)?;
+    let cancel = Arc::new(AtomicBool::new(false));
+    let watch = Watch {
+        cancel: Some(Arc::clone(&cancel)),
+        ..Watch::none()
+    };
+    let j = std::thread::scope(|scope| -> PyResult<McJson> {
+        let study = scope.spawn(|| {
+            run_study(&exp, runs, seed, shard, threads, Keep::default(), &watch).map(|s| s.json)
+        });
+        while !study.is_finished() {
+            py.detach(|| std::thread::sleep(SIGNAL_POLL));
+            if let Err(signal) = py.check_signals() {
+                cancel.store(true, Ordering::Relaxed);
+                py.detach(|| study.join()).ok();
+                return Err(signal);
+            }
+        }
+        study
+            .join()
+            .map_err(|_| PyRuntimeError::new_err("the Monte Carlo study's thread panicked"))?
+            .map_err(value_error)
+    })?;
     json_text(&j)
 }
 

@@ -156,3 +156,22 @@ def test_covariance_matches_the_standard_errors(table2):
     np.testing.assert_allclose(np.sqrt(np.diag(fit.covariance)), fit.std_errors, rtol=1e-12)
     np.testing.assert_allclose(fit.covariance, fit.covariance.T, rtol=1e-12, atol=0)
     assert np.all(np.linalg.eigvalsh(fit.covariance) > 0)
+
+
+def test_ctrl_c_stops_a_long_study(table2):
+    """Ctrl-C during a study raises KeyboardInterrupt from inside the call instead of after
+    the whole study: a million realisations would take many minutes on one thread."""
+    import os
+    import signal
+    import threading
+    import time
+
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            jitterid.montecarlo(table2, runs=1_000_000, threads=1)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 60

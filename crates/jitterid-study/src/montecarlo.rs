@@ -286,7 +286,8 @@ pub struct StudyRun {
 /// Runs `runs` realisations (or shard `shard` of them) of the experiment with its method on
 /// `threads` worker threads (rayon's default if `None`), keeping the fitted models of the first
 /// runs when `keep.fitted`, and every fit's standard errors when `keep.stderr`; `watch.runs` is
-/// called as each realisation finishes.
+/// called as each realisation finishes, and a set `watch.cancel` stops the study before its
+/// next realisations (an error: an interrupted study has no result).
 pub fn run_study(
     exp: &Experiment,
     runs: u64,
@@ -327,8 +328,12 @@ pub fn run_study(
     };
     let t0 = Instant::now();
     let finished = AtomicU64::new(0);
-    let outs: Vec<RunOut> = pool.install(|| {
+    let outs: Vec<Option<RunOut>> = pool.install(|| {
         mc_run(seed, first..end, |r, rng| {
+            // Asked to stop: the realisations not yet started are skipped.
+            if watch.cancelled() {
+                return None;
+            }
             let out = one_run(
                 exp,
                 method,
@@ -346,9 +351,16 @@ pub fn run_study(
                 done,
                 total: end - first,
             });
-            out
+            Some(out)
         })
     });
+    let Some(outs) = outs.into_iter().collect::<Option<Vec<RunOut>>>() else {
+        return Err(study_err!(
+            "interrupted: the study was stopped after {} of {} realisations",
+            finished.load(Ordering::Relaxed),
+            end - first
+        ));
+    };
     let seconds = t0.elapsed().as_secs_f64();
     let realizations: Vec<Realization> = outs.iter().map(|o| o.realization.clone()).collect();
     let parameters = summarize(&names, &truth, &realizations);

@@ -1,9 +1,11 @@
-//! Hooks through which a front end follows long work: a fit's solver iterations and a study's
-//! finished realisations. The study layer calls them and draws nothing itself; the command line
-//! turns them into a progress bar, Python into its own callback.
+//! Hooks through which a front end follows long work (a fit's solver iterations and a study's
+//! finished realisations) and stops it (a study checks a cancel flag before each realisation).
+//! The study layer calls them and draws nothing itself; the command line turns them into a
+//! progress bar, Python into its own callback and its Ctrl-C.
 
 use jitterid::estimate::solver::ProgressHook;
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// What a front end watches. The default watches nothing.
@@ -14,6 +16,9 @@ pub struct Watch {
     /// Called once for each finished realisation of a Monte Carlo study, from the worker
     /// thread that ran it.
     pub runs: Option<Arc<dyn Fn(RunsDone) + Send + Sync>>,
+    /// Set by the front end to stop a Monte Carlo study: realisations not yet started are not
+    /// run, and the study ends with an error saying it was interrupted.
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 /// How far a Monte Carlo study is.
@@ -31,6 +36,13 @@ impl Watch {
         Self::default()
     }
 
+    /// Whether the front end asked to stop.
+    pub fn cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
     /// Tells the watcher that one realisation finished.
     pub(crate) fn run_done(&self, progress: RunsDone) {
         if let Some(f) = &self.runs {
@@ -44,6 +56,7 @@ impl fmt::Debug for Watch {
         f.debug_struct("Watch")
             .field("iterations", &self.iterations.is_some())
             .field("runs", &self.runs.is_some())
+            .field("cancelled", &self.cancelled())
             .finish()
     }
 }
