@@ -398,6 +398,8 @@ fn edited_shard_is_refused(dir: &Path, name: &str, edit: impl Fn(&mut Value), wa
     write_json(&bad, &v);
     let e = refused(&["merge", s(&s0), s(&bad)], want);
     assert!(e.contains(&format!("{name}.json")), "{name}: {e}");
+    // Values are printed as values, never as Rust's `Some(…)`/`None`.
+    assert!(!e.contains("Some(") && !e.contains("None"), "{name}: {e}");
 }
 
 #[test]
@@ -416,7 +418,7 @@ fn hand_edited_shards_do_not_merge() {
         &dir,
         "true-value",
         |v| v["parameters"][0]["true"] = Value::from(3.0),
-        &["true value", "gain"],
+        &["true value", "gain", "is 3, not 1 as in"],
     );
     edited_shard_is_refused(
         &dir,
@@ -442,6 +444,12 @@ fn hand_edited_shards_do_not_merge() {
         "null-values",
         |v| v["realizations"][0]["values"] = Value::Null,
         &["not a shard file"],
+    );
+    edited_shard_is_refused(
+        &dir,
+        "null-mean",
+        |v| v["parameters"][0]["mean"] = Value::Null,
+        &["summary of `gain`", "(mean none stored, 1", "computed)"],
     );
     edited_shard_is_refused(
         &dir,
