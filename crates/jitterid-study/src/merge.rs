@@ -260,6 +260,7 @@ fn merge_parts(parts: &[Part]) -> StudyResult<McJson> {
         runs: s0.runs_total,
         converged: all.iter().filter(|r| r.converged).count() as u64,
         terminations: terminations(&all),
+        // Summed where every shard has its time; absent if one has none.
         seconds: parts.iter().map(|p| p.json.seconds).sum(),
         seed: first.json.seed,
         experiment: first.json.experiment.clone(),
