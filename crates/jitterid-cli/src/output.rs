@@ -227,6 +227,10 @@ const READER_WAIT: Duration = Duration::from_secs(5);
 /// What every temporary of this module has in its name: `.<name>.jitterid-<kind>-<pid>-<hex>`.
 const MARK: &str = ".jitterid-";
 
+/// At most this many characters of a file's name go into its temporaries' names (which stay
+/// below the usual 255-byte limit); a shorter name in a temporary is its file's whole name.
+const NAME_KEPT: usize = 100;
+
 /// The kinds of temporaries, by what a later run does with a stale one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
@@ -235,7 +239,8 @@ enum Kind {
     /// A second link to a replaced file, kept for a roll-back (`old`): removed.
     Linked,
     /// A replaced file renamed aside where hard links are not available (`moved`): renamed back
-    /// if its file is missing (a kill between the two renames), removed otherwise.
+    /// if its file is missing (a kill between the two renames), removed otherwise (kept if its
+    /// name was shortened).
     Moved,
 }
 
@@ -267,9 +272,9 @@ fn fresh_name(target: &Path, kind: Kind) -> PathBuf {
     if let Ok(t) = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH) {
         h.write_u128(t.as_nanos());
     }
-    let name = target
+    let name: String = target
         .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
+        .map(|n| n.to_string_lossy().chars().take(NAME_KEPT).collect())
         .unwrap_or_else(|| "output".into());
     dir_of(target).join(format!(
         ".{name}{MARK}{}-{}-{:016x}",
@@ -341,13 +346,21 @@ fn clean_stale(dir: &Path, locked: bool) {
             Ok(m) if !m.is_dir() => {}
             _ => continue,
         }
-        let own = dir.join(&name);
-        let missing = matches!(
-            std::fs::symlink_metadata(&own),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound
-        );
-        if kind == Kind::Moved && missing && std::fs::rename(&path, &own).is_ok() {
-            continue;
+        if kind == Kind::Moved {
+            // A replaced file: put back where its file is missing; kept where its name was
+            // shortened (its file cannot be told), removed where its file is there.
+            if name.chars().count() >= NAME_KEPT {
+                continue;
+            }
+            let own = dir.join(&name);
+            let missing = matches!(
+                std::fs::symlink_metadata(&own),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound
+            );
+            if missing {
+                let _ = std::fs::rename(&path, &own);
+                continue;
+            }
         }
         let _ = std::fs::remove_file(&path);
     }
@@ -870,6 +883,16 @@ mod tests {
             std::fs::read_to_string(p.join("lost.csv")).unwrap(),
             "the previous lost.csv"
         );
+        // A file with a long name: its temporaries' names are shortened, and it is written.
+        let long = p.join("x".repeat(240));
+        let mut set = OutputSet::new();
+        set.file(&long, "long");
+        set.commit().unwrap();
+        let mut set = OutputSet::new();
+        set.file(&long, "longer");
+        set.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&long).unwrap(), "longer");
+        std::fs::remove_file(&long).unwrap();
         // Without the lock (a directory that cannot be locked), only a dead writer's go.
         let live = format!(
             ".r.json.jitterid-tmp-{}-00000000deadbeef",
