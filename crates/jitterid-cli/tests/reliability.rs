@@ -128,6 +128,29 @@ fn a_fifo_given_to_out_is_written_through_not_replaced() {
     assert!(is_fifo(&fifo));
 }
 
+/// A FIFO that no process reads does not block the command for ever: after a short wait it is
+/// an error (status 2, one line), and the FIFO stays.
+#[cfg(unix)]
+#[test]
+fn a_fifo_without_a_reader_is_refused_not_waited_for_ever() {
+    let dir = scratch("fifo-no-reader");
+    let exp = small(&dir);
+    let fifo = dir.join("pipe.csv");
+    mkfifo(&fifo);
+    let start = std::time::Instant::now();
+    refused(
+        &["simulate", s(&exp), "--out", s(&fifo)],
+        &["pipe.csv", "no process is reading"],
+    );
+    assert!(
+        start.elapsed() < std::time::Duration::from_secs(30),
+        "{:?}",
+        start.elapsed()
+    );
+    assert!(is_fifo(&fifo));
+    assert_eq!(names_in(&dir), ["pipe.csv", "small.toml"]);
+}
+
 /// A character device given to `--out` (a null device made for the test with `mknod`, which
 /// needs root, so the machine's `/dev/null` is never at stake) stays a device and has no side
 /// file written beside it. Where `mknod` is not allowed, the FIFO test above covers the path.
