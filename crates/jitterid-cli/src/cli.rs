@@ -173,6 +173,10 @@ pub struct MonteCarloArgs {
     /// output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Leave the study's wall time out (the JSON's `seconds` key and the table's time), so that
+    /// two runs of the same study give the same bytes.
+    #[arg(long)]
+    pub no_timing: bool,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub budget: BudgetArgs,
@@ -212,6 +216,9 @@ pub struct MergeArgs {
     /// Exit 0 even when no fit of the study converged; by default that exits 1.
     #[arg(long)]
     pub accept_unconverged: bool,
+    /// Leave the summed wall time out (the JSON's `seconds` key and the table's time).
+    #[arg(long)]
+    pub no_timing: bool,
 }
 
 fn dispatch(cli: Cli) -> StudyResult<Outcome> {
@@ -249,6 +256,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             accept_unconverged: a.budget.accept_unconverged,
             max_iterations: a.budget.max_iterations,
             time_limit: a.budget.time_limit,
+            timing: !a.no_timing,
         }),
         Command::Validate(a) => commands::validate(&commands::ValidateOptions {
             experiment: a.experiment,
@@ -266,9 +274,13 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             json: a.json,
             out: a.out,
         }),
-        Command::Merge(a) => {
-            commands::merge(&a.shards, a.json, a.out.as_deref(), a.accept_unconverged)
-        }
+        Command::Merge(a) => commands::merge(
+            &a.shards,
+            a.json,
+            a.out.as_deref(),
+            a.accept_unconverged,
+            !a.no_timing,
+        ),
     }
 }
 

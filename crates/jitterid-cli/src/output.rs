@@ -1,17 +1,39 @@
-//! Output files appear whole and together, or not at all.
+//! Output files appear whole and together, or not at all, and cannot be turned against the user.
 //!
 //! A command collects everything it writes (a data file and its side file; a JSON file and its
-//! figures) in one [`OutputSet`] and commits it once its results are computed. The commit first
-//! checks every destination, then writes each file as a temporary in its target's directory,
-//! then renames them all into place; if any step fails, the temporaries are removed and the files
-//! already renamed are restored to what they were, so previous outputs are left untouched.
+//! figures) in one [`OutputSet`] and commits it once its results are computed:
+//!
+//! 1. every destination is checked (see below) and missing figure directories are created;
+//! 2. the directories the files go to are locked (`flock`, exclusive, advisory; each once, in
+//!    one order), waiting up to 30 s for another writer, so that two commands writing the same
+//!    files never interleave (one's data file beside the other's side file);
+//! 3. stale temporaries there (`.<name>.jitterid-{tmp,old,moved}-<pid>-<hex>`, left by a
+//!    killed writer; with the lock held every such file is stale) are removed, and a replaced
+//!    file that a kill left moved aside is put back where its file is missing;
+//! 4. each file is written to a new temporary in its target's directory, created with `O_EXCL`
+//!    (never through a link, never over another file) and synced;
+//! 5. the temporaries are renamed into place one by one; before each rename, what was there is
+//!    kept under a fresh name by a second hard link (`link` fails on an existing name, another
+//!    name is drawn) or, where the file system has no hard links, by renaming it there (a
+//!    rename replaces a name, it never writes through it). Nothing is ever copied, so a link
+//!    planted at any of these names is never followed;
+//! 6. devices and FIFOs are written last (they cannot be rolled back);
+//! 7. only then are the kept predecessors removed and the locks released.
+//!
+//! If any step fails, the temporaries are removed and the files already renamed are restored
+//! from what was kept, so previous outputs are left untouched. A kill during step 5 can still
+//! leave some files new and the rest old (each file whole); the next commit to the same
+//! directory removes the temporaries. Where a directory cannot be locked (not readable, a file
+//! system without `flock`), the set is written unlocked and only temporaries of processes that
+//! are no longer running are cleaned.
 //!
 //! What a destination may be:
 //! - absent, or a regular file: replaced atomically (keeping the old file's permissions);
 //! - a symbolic link: followed; the file it points to is treated by these rules and the link
 //!   itself stays;
-//! - a character device or a FIFO (`/dev/null`, a named pipe): written through, never replaced
-//!   (these cannot be rolled back, so they are written after every rename has succeeded);
+//! - a character device or a FIFO (`/dev/null`, a named pipe): written through, never replaced,
+//!   opened without waiting (`O_NONBLOCK`): a FIFO with no reader is retried for 5 s, then
+//!   refused with an error instead of blocking for ever;
 //! - anything else (a directory, a block device, a socket, a link to nothing): refused.
 
 use jitterid_study::error::StudyResult;
@@ -19,7 +41,7 @@ use jitterid_study::study_err;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use tempfile::{NamedTempFile, TempPath};
+use std::time::{Duration, Instant};
 
 /// How one destination is written.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -82,12 +104,6 @@ fn dir_of(path: &Path) -> &Path {
     }
 }
 
-/// A file renamed into place, with what was there before (to restore on failure).
-struct Placed {
-    target: PathBuf,
-    previous: Option<TempPath>,
-}
-
 /// The files (and figure directories) one command writes, committed together.
 #[derive(Debug, Default)]
 pub struct OutputSet {
@@ -146,7 +162,7 @@ impl OutputSet {
             targets.push(target);
         }
         let created = create_dirs(&self.dirs)?;
-        let result = write_all(&self.files, &targets);
+        let result = lock_and_clean(&targets).and_then(|_locks| write_all(&self.files, &targets));
         if result.is_err() {
             for d in created.iter().rev() {
                 let _ = std::fs::remove_dir(d);
@@ -202,16 +218,269 @@ fn create_dirs(dirs: &[PathBuf]) -> StudyResult<Vec<PathBuf>> {
     Ok(created)
 }
 
+/// How long a commit waits for another writer's lock on a directory before it gives up.
+const LOCK_WAIT: Duration = Duration::from_secs(30);
+
+/// How long a FIFO given as a destination may have no reader before the commit gives up.
+const READER_WAIT: Duration = Duration::from_secs(5);
+
+/// What every temporary of this module has in its name: `.<name>.jitterid-<kind>-<pid>-<hex>`.
+const MARK: &str = ".jitterid-";
+
+/// At most this many characters of a file's name go into its temporaries' names (which stay
+/// below the usual 255-byte limit); a shorter name in a temporary is its file's whole name.
+const NAME_KEPT: usize = 100;
+
+/// The kinds of temporaries, by what a later run does with a stale one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    /// A new file being written (`tmp`): removed.
+    New,
+    /// A second link to a replaced file, kept for a roll-back (`old`): removed.
+    Linked,
+    /// A replaced file renamed aside where hard links are not available (`moved`): renamed back
+    /// if its file is missing (a kill between the two renames), removed otherwise (kept if its
+    /// name was shortened).
+    Moved,
+}
+
+impl Kind {
+    fn tag(self) -> &'static str {
+        match self {
+            Kind::New => "tmp",
+            Kind::Linked => "old",
+            Kind::Moved => "moved",
+        }
+    }
+
+    fn from_tag(tag: &str) -> Option<Self> {
+        [Kind::New, Kind::Linked, Kind::Moved]
+            .into_iter()
+            .find(|k| k.tag() == tag)
+    }
+}
+
+/// A fresh name for a temporary of `kind` beside `target`: `.<name>.jitterid-<kind>-<pid>-<hex>`
+/// with 64 random bits. The name is only a candidate: it is created with `O_EXCL` or linked
+/// (which fails on an existing name), never opened if it exists.
+fn fresh_name(target: &Path, kind: Kind) -> PathBuf {
+    use std::hash::{BuildHasher, Hasher};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u64(COUNTER.fetch_add(1, Ordering::Relaxed));
+    if let Ok(t) = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH) {
+        h.write_u128(t.as_nanos());
+    }
+    let name: String = target
+        .file_name()
+        .map(|n| n.to_string_lossy().chars().take(NAME_KEPT).collect())
+        .unwrap_or_else(|| "output".into());
+    dir_of(target).join(format!(
+        ".{name}{MARK}{}-{}-{:016x}",
+        kind.tag(),
+        std::process::id(),
+        h.finish()
+    ))
+}
+
+/// A temporary's kind, writer's pid and the file it belongs to, from its name; `None` for a
+/// name this module does not make.
+fn parse_temp(file_name: &str) -> Option<(Kind, u32, String)> {
+    let rest = file_name.strip_prefix('.')?;
+    let at = rest.rfind(MARK)?;
+    let (name, tail) = (&rest[..at], &rest[at + MARK.len()..]);
+    let mut parts = tail.split('-');
+    let kind = Kind::from_tag(parts.next()?)?;
+    let pid = parts.next()?;
+    let hex = parts.next()?;
+    let digits = |s: &str, hexa: bool| {
+        !s.is_empty()
+            && s.chars().all(|c| {
+                if hexa {
+                    c.is_ascii_hexdigit()
+                } else {
+                    c.is_ascii_digit()
+                }
+            })
+    };
+    if parts.next().is_some() || name.is_empty() || !digits(pid, false) || hex.len() != 16 {
+        return None;
+    }
+    if !digits(hex, true) {
+        return None;
+    }
+    Some((kind, pid.parse().ok()?, name.to_string()))
+}
+
+/// Whether the process `pid` may still be running (`true` where this cannot be told).
+fn may_be_alive(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    let proc = Path::new("/proc");
+    if proc.join("self").exists() {
+        proc.join(pid.to_string()).exists()
+    } else {
+        true
+    }
+}
+
+/// Removes the temporaries a killed writer left in `dir`. With the directory's lock held every
+/// temporary there is stale (a writer holds the lock for as long as its temporaries exist);
+/// without it, only those of a process that is no longer running.
+fn clean_stale(dir: &Path, locked: bool) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some((kind, pid, name)) = file_name.to_str().and_then(parse_temp) else {
+            continue;
+        };
+        if !locked && may_be_alive(pid) {
+            continue;
+        }
+        let path = entry.path();
+        match std::fs::symlink_metadata(&path) {
+            Ok(m) if !m.is_dir() => {}
+            _ => continue,
+        }
+        if kind == Kind::Moved {
+            // A replaced file: put back where its file is missing; kept where its name was
+            // shortened (its file cannot be told), removed where its file is there.
+            if name.chars().count() >= NAME_KEPT {
+                continue;
+            }
+            let own = dir.join(&name);
+            let missing = matches!(
+                std::fs::symlink_metadata(&own),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound
+            );
+            if missing {
+                let _ = std::fs::rename(&path, &own);
+                continue;
+            }
+        }
+        let _ = std::fs::remove_file(&path);
+    }
+}
+
+/// An exclusive advisory lock (`flock`) on a directory, released when dropped.
+struct DirLock {
+    #[allow(dead_code)] // held for its lock
+    file: File,
+}
+
+/// Locks `dir` for one writer, waiting up to `wait` for another to finish. Where a directory
+/// cannot be locked (not readable, a file system without `flock`), the set is written unlocked
+/// (`Ok(None)`).
+fn lock_dir(dir: &Path, wait: Duration) -> StudyResult<Option<DirLock>> {
+    #[cfg(unix)]
+    {
+        use rustix::fs::{flock, FlockOperation};
+        let Ok(file) = File::open(dir) else {
+            return Ok(None);
+        };
+        let start = Instant::now();
+        loop {
+            match flock(&file, FlockOperation::NonBlockingLockExclusive) {
+                Ok(()) => return Ok(Some(DirLock { file })),
+                Err(e) if e == rustix::io::Errno::WOULDBLOCK => {
+                    if start.elapsed() >= wait {
+                        return Err(study_err!(
+                            "{}: cannot write: another jitterid is writing its outputs in this directory (waited {} s); try again when it has finished",
+                            dir.display(),
+                            wait.as_secs()
+                        ));
+                    }
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+                Err(_) => return Ok(None),
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (dir, wait);
+        Ok(None)
+    }
+}
+
+/// Locks the directories the regular files of `targets` go to (each once, in one order, so
+/// that two writers never wait on each other) and cleans the stale temporaries there.
+fn lock_and_clean(targets: &[Target]) -> StudyResult<Vec<DirLock>> {
+    let dirs: std::collections::BTreeSet<PathBuf> = targets
+        .iter()
+        .filter_map(|t| match t {
+            Target::Replace(p) => {
+                let d = dir_of(p);
+                Some(std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf()))
+            }
+            Target::Stream(_) => None,
+        })
+        .collect();
+    let mut locks = Vec::with_capacity(dirs.len());
+    for d in &dirs {
+        let lock = lock_dir(d, LOCK_WAIT)?;
+        clean_stale(d, lock.is_some());
+        locks.extend(lock);
+    }
+    Ok(locks)
+}
+
+/// A temporary that is removed when dropped unless it was kept.
+struct Temp {
+    path: Option<PathBuf>,
+}
+
+impl Temp {
+    fn path(&self) -> &Path {
+        self.path.as_deref().expect("a temporary not yet kept")
+    }
+
+    /// Gives the file up to the caller: it is no longer removed on drop.
+    fn keep(mut self) -> PathBuf {
+        self.path.take().expect("a temporary not yet kept")
+    }
+}
+
+impl Drop for Temp {
+    fn drop(&mut self) {
+        if let Some(p) = self.path.take() {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+}
+
+/// A file renamed into place, with where its predecessor was kept (to restore on failure, or
+/// remove once the whole set is in place).
+struct Placed {
+    target: PathBuf,
+    previous: Option<Temp>,
+}
+
 fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> StudyResult<()> {
-    let mut staged: Vec<(NamedTempFile, &Path, &Path)> = Vec::new();
+    write_all_with(files, targets, &mut fresh_name, READER_WAIT)
+}
+
+/// [`write_all`] with the names of temporaries drawn from `names` (a test plants files there)
+/// and a FIFO's reader awaited for `reader_wait`.
+fn write_all_with(
+    files: &[(PathBuf, Vec<u8>)],
+    targets: &[Target],
+    names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
+    reader_wait: Duration,
+) -> StudyResult<()> {
+    let mut staged: Vec<(Temp, &Path, &Path)> = Vec::new();
     for ((path, contents), target) in files.iter().zip(targets) {
         if let Target::Replace(p) = target {
-            staged.push((stage(p, contents, path)?, p, path));
+            staged.push((stage(p, contents, path, names)?, p, path));
         }
     }
     let mut placed: Vec<Placed> = Vec::new();
     for (tmp, target, path) in staged {
-        match place(tmp, target) {
+        match place(tmp, target, names) {
             Ok(p) => placed.push(p),
             Err(e) => {
                 roll_back(placed);
@@ -221,63 +490,110 @@ fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> StudyResult<()
     }
     for ((path, contents), target) in files.iter().zip(targets) {
         if let Target::Stream(p) = target {
-            if let Err(e) = stream(p, contents) {
+            if let Err(e) = stream(p, contents, reader_wait) {
                 roll_back(placed);
                 return Err(study_err!("{}: cannot write: {e}", path.display()));
             }
         }
     }
+    // Every file is in place: the predecessors go (each `Temp` removes its file).
+    drop(placed);
     Ok(())
 }
 
-/// Writes `contents` to a temporary beside `target`.
-fn stage(target: &Path, contents: &[u8], path: &Path) -> StudyResult<NamedTempFile> {
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "output".into());
-    let result = (|| -> std::io::Result<NamedTempFile> {
-        let prefix = format!(".{name}.");
-        let mut builder = tempfile::Builder::new();
-        builder.prefix(&prefix).suffix(".tmp");
-        // A new file gets the permissions `File::create` would give (0666 less the umask), a
-        // replaced one keeps its own.
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::PermissionsExt;
-            builder.permissions(std::fs::Permissions::from_mode(0o666));
-        }
-        let mut tmp = builder.tempfile_in(dir_of(target))?;
+/// Writes `contents` to a new temporary beside `target`, created with `O_EXCL` (so never
+/// through a link or over another file).
+fn stage(
+    target: &Path,
+    contents: &[u8],
+    path: &Path,
+    names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
+) -> StudyResult<Temp> {
+    let result = (|| -> std::io::Result<Temp> {
+        let mut attempt = 0;
+        let (file, tmp) = loop {
+            let candidate = names(target, Kind::New);
+            // A new file gets the permissions `File::create` would give (0666 less the umask),
+            // a replaced one keeps its own.
+            match OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&candidate)
+            {
+                Ok(f) => {
+                    break (
+                        f,
+                        Temp {
+                            path: Some(candidate),
+                        },
+                    )
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < 100 => {
+                    attempt += 1
+                }
+                Err(e) => return Err(e),
+            }
+        };
+        let mut file = file;
         if let Ok(m) = std::fs::metadata(target) {
-            tmp.as_file().set_permissions(m.permissions())?;
+            file.set_permissions(m.permissions())?;
         }
-        tmp.write_all(contents)?;
-        tmp.as_file().sync_all()?;
+        file.write_all(contents)?;
+        file.sync_all()?;
         Ok(tmp)
     })();
     result.map_err(|e| study_err!("{}: cannot write: {e}", path.display()))
 }
 
-/// Renames the temporary over `target`, keeping what was there as a backup.
-fn place(tmp: NamedTempFile, target: &Path) -> std::io::Result<Placed> {
-    let previous = if target.is_file() {
-        let backup = tempfile::Builder::new()
-            .prefix(".backup.")
-            .suffix(".tmp")
-            .tempfile_in(dir_of(target))?
-            .into_temp_path();
-        std::fs::remove_file(&backup)?;
-        if std::fs::hard_link(target, &backup).is_err() {
-            std::fs::copy(target, &backup)?;
+/// Keeps what is at `target` under a fresh name beside it: a second hard link (`link` never
+/// follows or replaces what is at the new name: an existing name fails, and another is drawn),
+/// or, where the file system has no hard links, the file itself renamed there (a rename
+/// replaces a name, it never writes through one). Nothing is ever copied.
+/// (`hard_links: false` goes straight to the rename, for a test.)
+fn keep_aside(
+    target: &Path,
+    names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
+    hard_links: bool,
+) -> std::io::Result<(Temp, Kind)> {
+    for _ in 0..100 {
+        if hard_links {
+            let aside = names(target, Kind::Linked);
+            match std::fs::hard_link(target, &aside) {
+                Ok(()) => return Ok((Temp { path: Some(aside) }, Kind::Linked)),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(_) => {}
+            }
         }
-        Some(backup)
-    } else {
-        None
+        let aside = names(target, Kind::Moved);
+        std::fs::rename(target, &aside)?;
+        return Ok((Temp { path: Some(aside) }, Kind::Moved));
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::AlreadyExists,
+        "no free name for a temporary beside it",
+    ))
+}
+
+/// Renames the temporary over `target`, keeping what was there aside (see [`keep_aside`]).
+fn place(
+    tmp: Temp,
+    target: &Path,
+    names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
+) -> std::io::Result<Placed> {
+    let previous = match std::fs::symlink_metadata(target) {
+        Ok(m) if !m.is_dir() => Some(keep_aside(target, names, true)?),
+        _ => None,
     };
-    tmp.persist(target).map_err(|e| e.error)?;
+    if let Err(e) = std::fs::rename(tmp.path(), target) {
+        if let Some((aside, Kind::Moved)) = previous {
+            let _ = std::fs::rename(aside.keep(), target);
+        }
+        return Err(e);
+    }
+    let _ = tmp.keep();
     Ok(Placed {
         target: target.to_path_buf(),
-        previous,
+        previous: previous.map(|(aside, _)| aside),
     })
 }
 
@@ -285,9 +601,8 @@ fn place(tmp: NamedTempFile, target: &Path) -> std::io::Result<Placed> {
 fn roll_back(placed: Vec<Placed>) {
     for p in placed.into_iter().rev() {
         match p.previous {
-            Some(backup) => {
-                let _ = std::fs::rename(&backup, &p.target);
-                drop(backup);
+            Some(aside) => {
+                let _ = std::fs::rename(aside.keep(), &p.target);
             }
             None => {
                 let _ = std::fs::remove_file(&p.target);
@@ -296,11 +611,44 @@ fn roll_back(placed: Vec<Placed>) {
     }
 }
 
-/// Writes into a device or FIFO without replacing it.
-fn stream(path: &Path, contents: &[u8]) -> std::io::Result<()> {
-    let mut f: File = OpenOptions::new().write(true).open(path)?;
+/// Writes into a device or FIFO without replacing it. The open does not wait for a FIFO's
+/// reader (`O_NONBLOCK`): it tries again for up to `reader_wait`, then gives up.
+fn stream(path: &Path, contents: &[u8], reader_wait: Duration) -> std::io::Result<()> {
+    let mut f = open_stream(path, reader_wait)?;
     f.write_all(contents)?;
     f.flush()
+}
+
+#[cfg(unix)]
+fn open_stream(path: &Path, reader_wait: Duration) -> std::io::Result<File> {
+    use rustix::fs::{fcntl_getfl, fcntl_setfl, open, Mode, OFlags};
+    let start = Instant::now();
+    let flags = OFlags::WRONLY | OFlags::NONBLOCK | OFlags::NOCTTY | OFlags::CLOEXEC;
+    loop {
+        match open(path, flags, Mode::empty()) {
+            Ok(fd) => {
+                // Written blocking from here on: a slow reader is waited for, not an error.
+                fcntl_setfl(&fd, fcntl_getfl(&fd)?.difference(OFlags::NONBLOCK))?;
+                return Ok(File::from(fd));
+            }
+            // ENXIO: a FIFO that no process has open for reading.
+            Err(e) if e == rustix::io::Errno::NXIO => {
+                if start.elapsed() >= reader_wait {
+                    return Err(std::io::Error::other(format!(
+                        "a FIFO that no process is reading (waited {:.1} s)",
+                        reader_wait.as_secs_f64()
+                    )));
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
+#[cfg(not(unix))]
+fn open_stream(path: &Path, _reader_wait: Duration) -> std::io::Result<File> {
+    OpenOptions::new().write(true).open(path)
 }
 
 /// Whether `path` is (or links to) a character device or FIFO, which is written through rather
@@ -416,5 +764,192 @@ mod tests {
         let e = set.commit().unwrap_err();
         assert!(e.message().contains("does not exist"), "{e}");
         assert!(names(dir.path()).is_empty(), "{:?}", names(dir.path()));
+    }
+
+    /// The race of the old design, made deterministic: it created `.backup.XXXX.tmp`, unlinked
+    /// it, then linked or else *copied* the old output to that name; a symbolic link planted
+    /// there in between sent the old contents to the link's target. Here the name the set
+    /// would use is planted first, with a link to a victim file: the link is never written
+    /// through (`link` fails on an existing name and another name is drawn), the victim is
+    /// untouched, and the set is written.
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_where_the_old_file_is_kept_is_never_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let (out, victim) = (dir.path().join("out.csv"), dir.path().join("victim"));
+        std::fs::write(&out, "old output").unwrap();
+        std::fs::write(&victim, "precious").unwrap();
+        let planted = dir.path().join(".out.csv.jitterid-old-1-0000000000000000");
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        let mut first = true;
+        let mut names = |t: &Path, k: Kind| {
+            if k == Kind::Linked && std::mem::take(&mut first) {
+                planted.clone()
+            } else {
+                fresh_name(t, k)
+            }
+        };
+        let files = vec![(out.clone(), b"new output".to_vec())];
+        let targets = vec![Target::Replace(out.clone())];
+        write_all_with(&files, &targets, &mut names, READER_WAIT).unwrap();
+        assert!(!first, "the planted name was tried");
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "new output");
+        assert!(std::fs::symlink_metadata(&planted)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        // The fallback where there are no hard links renames the old file over the name: the
+        // link is replaced, not followed.
+        let mut names = |_: &Path, _: Kind| planted.clone();
+        let (aside, kind) = keep_aside(&out, &mut names, false).unwrap();
+        assert_eq!((aside.path(), kind), (planted.as_path(), Kind::Moved));
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+        assert_eq!(std::fs::read_to_string(&planted).unwrap(), "new output");
+        assert!(!out.exists());
+        drop(aside);
+        assert!(!planted.exists() && victim.exists());
+    }
+
+    /// Two sets committed to the same files from two threads at once: each ends whole (the data
+    /// file and its side file from the same writer), never one run's file beside the other's,
+    /// and no temporary stays behind.
+    #[test]
+    fn two_writers_of_the_same_files_never_leave_a_mixed_set() {
+        let dir = tempfile::tempdir().unwrap();
+        let (data, side) = (dir.path().join("d.csv"), dir.path().join("d.input.csv"));
+        for round in 0..40 {
+            let barrier = std::sync::Barrier::new(2);
+            std::thread::scope(|s| {
+                for who in ["A", "B"] {
+                    let (data, side, barrier) = (&data, &side, &barrier);
+                    s.spawn(move || {
+                        let mut set = OutputSet::new();
+                        // Large enough that the writes take a while.
+                        set.file(data, format!("{who}{round}").repeat(20_000));
+                        set.file(side, format!("{who}{round}"));
+                        barrier.wait();
+                        set.commit().unwrap();
+                    });
+                }
+            });
+            let (d, s) = (
+                std::fs::read_to_string(&data).unwrap(),
+                std::fs::read_to_string(&side).unwrap(),
+            );
+            assert_eq!(d, s.repeat(20_000), "round {round}: a mixed set");
+            assert_eq!(names(dir.path()), ["d.csv", "d.input.csv"]);
+        }
+    }
+
+    /// Temporaries a killed writer left (named after a process that is gone) are removed by
+    /// the next commit in their directory; a replaced file moved aside whose file is missing (a
+    /// kill between the two renames) is put back; files that only look alike stay.
+    #[test]
+    fn stale_temporaries_of_a_dead_writer_are_cleaned() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path();
+        // No process has this number (Linux's largest is 2^22).
+        let dead = 999_999_999u32;
+        let stale = [
+            format!(".r.json.jitterid-tmp-{dead}-00000000deadbeef"),
+            format!(".r.json.jitterid-old-{dead}-0123456789abcdef"),
+        ];
+        for n in &stale {
+            std::fs::write(p.join(n), "stale").unwrap();
+        }
+        let moved = format!(".lost.csv.jitterid-moved-{dead}-fedcba9876543210");
+        std::fs::write(p.join(&moved), "the previous lost.csv").unwrap();
+        let alike = [
+            ".r.json.jitterid-tmp-notapid-00000000deadbeef".to_string(),
+            format!(".r.json.jitterid-tmp-{dead}-short"),
+            "r.json.jitterid-tmp-1-0000000000000000".to_string(),
+        ];
+        for n in &alike {
+            std::fs::write(p.join(n), "mine").unwrap();
+        }
+        assert_eq!(
+            parse_temp(&stale[0]),
+            Some((Kind::New, dead, "r.json".to_string()))
+        );
+        let mut set = OutputSet::new();
+        set.file(&p.join("r.json"), "{}");
+        set.commit().unwrap();
+        let mut want: Vec<String> = alike.to_vec();
+        want.extend(["lost.csv".to_string(), "r.json".to_string()]);
+        want.sort();
+        assert_eq!(names(p), want);
+        assert_eq!(
+            std::fs::read_to_string(p.join("lost.csv")).unwrap(),
+            "the previous lost.csv"
+        );
+        // A file with a long name: its temporaries' names are shortened, and it is written.
+        let long = p.join("x".repeat(240));
+        let mut set = OutputSet::new();
+        set.file(&long, "long");
+        set.commit().unwrap();
+        let mut set = OutputSet::new();
+        set.file(&long, "longer");
+        set.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&long).unwrap(), "longer");
+        std::fs::remove_file(&long).unwrap();
+        // Without the lock (a directory that cannot be locked), only a dead writer's go.
+        let live = format!(
+            ".r.json.jitterid-tmp-{}-00000000deadbeef",
+            std::process::id()
+        );
+        std::fs::write(p.join(&live), "in use").unwrap();
+        std::fs::write(p.join(&stale[0]), "stale").unwrap();
+        clean_stale(p, false);
+        assert!(p.join(&live).exists() && !p.join(&stale[0]).exists());
+    }
+
+    /// A FIFO that no process reads: the write gives up after the wait, with an error, instead
+    /// of blocking for ever; what was renamed before it is rolled back.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_without_a_reader_is_an_error_not_a_hang() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let data = dir.path().join("d.csv");
+        std::fs::write(&data, "previous").unwrap();
+        let files = vec![
+            (data.clone(), b"new".to_vec()),
+            (fifo.clone(), b"never read".to_vec()),
+        ];
+        let targets = vec![
+            target_of(&data, "d").unwrap(),
+            target_of(&fifo, "p").unwrap(),
+        ];
+        assert_eq!(targets[1], Target::Stream(fifo.clone()));
+        let start = Instant::now();
+        let e = write_all_with(
+            &files,
+            &targets,
+            &mut fresh_name,
+            Duration::from_millis(200),
+        )
+        .unwrap_err();
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "{:?}",
+            start.elapsed()
+        );
+        assert!(e.message().contains("no process is reading"), "{e}");
+        assert_eq!(std::fs::read_to_string(&data).unwrap(), "previous");
+        assert_eq!(names(dir.path()), ["d.csv", "pipe"]);
+        // With a reader, the same FIFO is written.
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+        };
+        write_all_with(&files, &targets, &mut fresh_name, Duration::from_secs(30)).unwrap();
+        assert_eq!(reader.join().unwrap(), "never read");
+        assert_eq!(std::fs::read_to_string(&data).unwrap(), "new");
     }
 }

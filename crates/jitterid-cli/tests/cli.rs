@@ -380,6 +380,63 @@ fn shards_merge_to_the_unsharded_study() {
     assert!(ok(&["merge", s(&s0), s(&s1)]).contains("pole0.im"));
 }
 
+/// The wall time is the one thing that differs between two runs of the same study: by
+/// default it is there (`seconds`, the keys unchanged), and `--no-timing` leaves it out, so that
+/// the two runs' JSON (and a merge of their shards) are equal byte for byte.
+#[test]
+fn no_timing_makes_identical_studies_identical_bytes() {
+    let exp = example("table2.toml");
+    let args = ["montecarlo", &exp, "--runs", "3", "--seed", "5", "--json"];
+    let timed = json(&args);
+    assert!(
+        timed["seconds"].as_f64().is_some_and(|s| s >= 0.0),
+        "{timed}"
+    );
+    let with = |extra: &[&str]| {
+        let mut v = args.to_vec();
+        v.extend_from_slice(extra);
+        ok(&v)
+    };
+    let (a, b) = (with(&["--no-timing"]), with(&["--no-timing"]));
+    assert_eq!(a, b);
+    let untimed: Value = serde_json::from_str(&a).unwrap();
+    let mut keys: Vec<&String> = timed.as_object().unwrap().keys().collect();
+    keys.retain(|k| *k != "seconds");
+    assert_eq!(
+        untimed.as_object().unwrap().keys().collect::<Vec<_>>(),
+        keys
+    );
+    assert_eq!(untimed["parameters"], timed["parameters"]);
+    // The table leaves the time out too.
+    let table = |extra: &[&str]| {
+        let mut v = vec!["montecarlo", &exp, "--runs", "3", "--seed", "5"];
+        v.extend_from_slice(extra);
+        ok(&v)
+    };
+    assert_eq!(table(&["--no-timing"]), table(&["--no-timing"]));
+    // Shards: a merge of timed shards sums their times unless told not to; a merge of
+    // untimed shards has none.
+    let dir = scratch("no-timing");
+    let shard = |i: &str, name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut v = vec!["montecarlo", &exp, "--runs", "3", "--seed", "5", "--json"];
+        v.extend_from_slice(&["--shard", i, "--out", s(&out)]);
+        v.extend_from_slice(extra);
+        ok(&v);
+        out
+    };
+    let (t0, t1) = (shard("0/2", "t0.json", &[]), shard("1/2", "t1.json", &[]));
+    let (u0, u1) = (
+        shard("0/2", "u0.json", &["--no-timing"]),
+        shard("1/2", "u1.json", &["--no-timing"]),
+    );
+    assert!(json(&["merge", s(&t0), s(&t1), "--json"])["seconds"].is_f64());
+    let m1 = ok(&["merge", s(&t0), s(&t1), "--json", "--no-timing"]);
+    let m2 = ok(&["merge", s(&u0), s(&u1), "--json"]);
+    assert_eq!(m1, m2);
+    assert_eq!(m1, a);
+}
+
 #[test]
 fn montecarlo_plots() {
     let dir = scratch("mc-plots");

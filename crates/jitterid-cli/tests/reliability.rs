@@ -128,6 +128,29 @@ fn a_fifo_given_to_out_is_written_through_not_replaced() {
     assert!(is_fifo(&fifo));
 }
 
+/// A FIFO that no process reads does not block the command for ever: after a short wait it is
+/// an error (status 2, one line), and the FIFO stays.
+#[cfg(unix)]
+#[test]
+fn a_fifo_without_a_reader_is_refused_not_waited_for_ever() {
+    let dir = scratch("fifo-no-reader");
+    let exp = small(&dir);
+    let fifo = dir.join("pipe.csv");
+    mkfifo(&fifo);
+    let start = std::time::Instant::now();
+    refused(
+        &["simulate", s(&exp), "--out", s(&fifo)],
+        &["pipe.csv", "no process is reading"],
+    );
+    assert!(
+        start.elapsed() < std::time::Duration::from_secs(30),
+        "{:?}",
+        start.elapsed()
+    );
+    assert!(is_fifo(&fifo));
+    assert_eq!(names_in(&dir), ["pipe.csv", "small.toml"]);
+}
+
 /// A character device given to `--out` (a null device made for the test with `mknod`, which
 /// needs root, so the machine's `/dev/null` is never at stake) stays a device and has no side
 /// file written beside it. Where `mknod` is not allowed, the FIFO test above covers the path.
@@ -398,6 +421,8 @@ fn edited_shard_is_refused(dir: &Path, name: &str, edit: impl Fn(&mut Value), wa
     write_json(&bad, &v);
     let e = refused(&["merge", s(&s0), s(&bad)], want);
     assert!(e.contains(&format!("{name}.json")), "{name}: {e}");
+    // Values are printed as values, never as Rust's `Some(…)`/`None`.
+    assert!(!e.contains("Some(") && !e.contains("None"), "{name}: {e}");
 }
 
 #[test]
@@ -416,7 +441,7 @@ fn hand_edited_shards_do_not_merge() {
         &dir,
         "true-value",
         |v| v["parameters"][0]["true"] = Value::from(3.0),
-        &["true value", "gain"],
+        &["true value", "gain", "is 3, not 1 as in"],
     );
     edited_shard_is_refused(
         &dir,
@@ -442,6 +467,12 @@ fn hand_edited_shards_do_not_merge() {
         "null-values",
         |v| v["realizations"][0]["values"] = Value::Null,
         &["not a shard file"],
+    );
+    edited_shard_is_refused(
+        &dir,
+        "null-mean",
+        |v| v["parameters"][0]["mean"] = Value::Null,
+        &["summary of `gain`", "(mean none stored, 1", "computed)"],
     );
     edited_shard_is_refused(
         &dir,

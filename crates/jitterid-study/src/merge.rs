@@ -88,6 +88,11 @@ fn identity_mismatch(p: &Part, first: &Part) -> Option<(&'static str, String, St
     fields.into_iter().find(|(_, a, b)| a != b)
 }
 
+/// An optional value as a message shows it: the number, or `none` (`null` in the file).
+fn shown(v: Option<f64>) -> String {
+    v.map_or_else(|| "none".to_string(), |x| x.to_string())
+}
+
 /// Checks that `p` is whole: its runs, value counts, and stored summaries agree.
 fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> StudyResult<()> {
     let name = &p.name;
@@ -150,10 +155,10 @@ fn check_whole(p: &Part, names: &[String], truth: &[Option<f64>]) -> StudyResult
         .find(|(a, b)| a != b)
     {
         return Err(study_err!(
-            "{name}: the summary of `{}` is not that of its realisations (mean {:?} stored, {:?} computed): was the file edited?",
+            "{name}: the summary of `{}` is not that of its realisations (mean {} stored, {} computed): was the file edited?",
             stored.name,
-            stored.mean,
-            again.mean
+            shown(stored.mean),
+            shown(again.mean)
         ));
     }
     Ok(())
@@ -223,11 +228,11 @@ fn merge_parts(parts: &[Part]) -> StudyResult<McJson> {
             .find(|(q, t)| q.truth.map(f64::to_bits) != t.map(f64::to_bits))
         {
             return Err(study_err!(
-                "{}: the true value of `{}` is {:?}, not {:?} as in {}",
+                "{}: the true value of `{}` is {}, not {} as in {}",
                 p.name,
                 q.0.name,
-                q.0.truth,
-                q.1,
+                shown(q.0.truth),
+                shown(*q.1),
                 first.name
             ));
         }
@@ -255,6 +260,7 @@ fn merge_parts(parts: &[Part]) -> StudyResult<McJson> {
         runs: s0.runs_total,
         converged: all.iter().filter(|r| r.converged).count() as u64,
         terminations: terminations(&all),
+        // Summed where every shard has its time; absent if one has none.
         seconds: parts.iter().map(|p| p.json.seconds).sum(),
         seed: first.json.seed,
         experiment: first.json.experiment.clone(),

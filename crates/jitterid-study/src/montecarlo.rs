@@ -116,8 +116,12 @@ pub struct McJson {
     /// How many runs ended for each reason (the solver's termination, or `failed: …`).
     #[serde(default)]
     pub terminations: BTreeMap<String, u64>,
-    /// Wall time in seconds (summed over shards after a merge).
-    pub seconds: f64,
+    /// Wall time in seconds (summed over shards after a merge); the one field that differs
+    /// between two runs of the same study. `None` (the key left out) where the command line was
+    /// given `--no-timing`, so that identical studies' files are equal byte for byte, or after
+    /// merging a shard without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seconds: Option<f64>,
     /// Master seed.
     pub seed: u64,
     /// Experiment file, as given (for people; the fingerprint identifies it).
@@ -371,7 +375,7 @@ pub fn run_study(
         runs: end - first,
         converged,
         terminations: terminations(&realizations),
-        seconds,
+        seconds: Some(seconds),
         seed,
         experiment: exp.file.clone(),
         fingerprint: experiment_fingerprint(exp),

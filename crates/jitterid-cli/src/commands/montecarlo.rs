@@ -44,14 +44,22 @@ pub struct MonteCarloOptions {
     pub max_iterations: Option<u64>,
     /// Wall-clock budget of every fit in seconds.
     pub time_limit: Option<f64>,
+    /// Report the study's wall time (`seconds`); without it two runs of the same study print
+    /// and write the same bytes.
+    pub timing: bool,
 }
 
 fn mc_table(j: &McJson) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "Monte Carlo of {} with {}: {} runs (seed {}), {} converged, {:.2} s",
-        j.experiment, j.method, j.runs, j.seed, j.converged, j.seconds
+        "Monte Carlo of {} with {}: {} runs (seed {}), {} converged{}",
+        j.experiment,
+        j.method,
+        j.runs,
+        j.seed,
+        j.converged,
+        j.seconds.map_or(String::new(), |s| format!(", {s:.2} s"))
     );
     let reasons: Vec<String> = j
         .terminations
@@ -114,7 +122,10 @@ pub fn montecarlo(o: &MonteCarloOptions) -> StudyResult<Outcome> {
     if let Some(bar) = bar.get() {
         bar.finish();
     }
-    let study = study?;
+    let mut study = study?;
+    if !o.timing {
+        study.json.seconds = None;
+    }
     let j = &study.json;
     let mut outputs = OutputSet::new();
     if let Some(dir) = &o.plot {
