@@ -64,7 +64,7 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let watch = Watch {
         iterations: crate::progress::active_fit_hook(),
-        runs: None,
+        ..Watch::none()
     };
     let f = fit_values(&exp, signal.clone(), y.clone(), &table.name, &watch)?;
     drop(ticker);

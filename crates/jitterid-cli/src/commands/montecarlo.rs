@@ -113,10 +113,10 @@ pub fn montecarlo(o: &MonteCarloOptions) -> StudyResult<Outcome> {
     let bar: Arc<OnceLock<Progress>> = Arc::new(OnceLock::new());
     let ticks = Arc::clone(&bar);
     let watch = Watch {
-        iterations: None,
         runs: Some(Arc::new(move |p: RunsDone| {
             ticks.get_or_init(|| Progress::new(p.total)).tick();
         })),
+        ..Watch::none()
     };
     let study = run_study(&exp, o.runs, o.seed, o.shard, o.threads, keep, &watch);
     if let Some(bar) = bar.get() {
