@@ -55,6 +55,12 @@ class Experiment(_jitterid.Experiment):
 
     ``Experiment.from_toml(path)`` reads a file; ``Experiment(text)`` takes the TOML text.
     Experiments pickle by their text.
+
+    A file the experiment names (``[input] path``) is resolved against the experiment file's
+    directory (for ``Experiment(text)``: ``dir``, the current directory by default) and must be
+    inside it: an absolute path, a ``..`` component or a symbolic link leading out raises
+    ``ValueError`` before the file is read, unless ``allow_paths_outside=True`` (keyword only,
+    in both constructors; kept when pickled).
     """
 
     def fit(self, record: Mapping[str, Any], method: Optional[str] = None) -> FitResult:

@@ -7,11 +7,11 @@ use crate::toml_text;
 use jitterid::signal::Input;
 use jitterid::signal::{PiecewiseConstant, SampleGrid};
 use jitterid_study::csvio;
-use jitterid_study::experiment::{self, InputSpec, Method, Purpose};
+use jitterid_study::experiment::{self, InputSpec, Method, Paths, Purpose};
 use jitterid_study::fingerprint::experiment_fingerprint;
 use jitterid_study::inputs;
 use jitterid_study::montecarlo::DEFAULT_SEED;
-use jitterid_study::{fit as fitting, records, simulate};
+use jitterid_study::{fit as fitting, records, simulate, Registries};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
@@ -26,6 +26,8 @@ use std::path::PathBuf;
 pub struct Experiment {
     text: String,
     dir: PathBuf,
+    /// Where the files the text names may be (`allow_paths_outside`).
+    paths: Paths,
     pub(crate) exp: experiment::Experiment,
     /// The experiment read for estimation with its own method, once (re-reading it per fit
     /// cost about half a Table 2 fit); the message when the file cannot be fitted as it is.
@@ -53,11 +55,13 @@ impl Experiment {
                 })
             })
             .transpose()?;
-        experiment::parse(
+        experiment::parse_with(
+            &Registries::builtin(),
             &self.exp.file,
             &self.text,
             &self.dir,
             Purpose::Estimate(chosen),
+            self.paths,
         )
         .map(Cow::Owned)
         .map_err(value_error)
@@ -67,34 +71,51 @@ impl Experiment {
 #[pymethods]
 impl Experiment {
     /// The experiment in TOML `text`; `file` names it in messages and results, `dir` resolves
-    /// its relative paths.
+    /// its relative paths (the current directory by default). The files the text names must
+    /// be inside `dir` (no absolute path, no `..`, no symbolic link leading out) unless
+    /// `allow_paths_outside`.
     #[new]
-    #[pyo3(signature = (text, file = "<string>".to_string(), dir = ".".to_string()))]
-    fn new(text: String, file: String, dir: String) -> PyResult<Self> {
+    #[pyo3(signature = (text, file = "<string>".to_string(), dir = ".".to_string(), *, allow_paths_outside = false))]
+    fn new(text: String, file: String, dir: String, allow_paths_outside: bool) -> PyResult<Self> {
         let dir = PathBuf::from(dir);
-        let exp = experiment::parse(&file, &text, &dir, Purpose::Simulate).map_err(value_error)?;
-        let for_own_method = experiment::parse(&file, &text, &dir, Purpose::Estimate(None))
-            .map_err(|e| e.to_string());
+        let paths = if allow_paths_outside {
+            Paths::Anywhere
+        } else {
+            Paths::Inside
+        };
+        let registries = Registries::builtin();
+        let parse =
+            |purpose| experiment::parse_with(&registries, &file, &text, &dir, purpose, paths);
+        let exp = parse(Purpose::Simulate).map_err(value_error)?;
+        let for_own_method = parse(Purpose::Estimate(None)).map_err(|e| e.to_string());
         Ok(Experiment {
             text,
             dir,
+            paths,
             exp,
             for_own_method,
         })
     }
 
-    /// The experiment file at `path` (the command line's TOML format).
+    /// The experiment file at `path` (the command line's TOML format), read as the command
+    /// line reads it (a regular file of at most `csvio::MAX_FILE_BYTES`, UTF-8); the files it
+    /// names must be inside its directory unless `allow_paths_outside`.
     #[classmethod]
-    fn from_toml<'py>(cls: &Bound<'py, PyType>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    #[pyo3(signature = (path, *, allow_paths_outside = false))]
+    fn from_toml<'py>(
+        cls: &Bound<'py, PyType>,
+        path: PathBuf,
+        allow_paths_outside: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            PyOSError::new_err(format!("{file}: cannot read: {}", csvio::io_reason(&e)))
-        })?;
+        let text = experiment::read_text(&path).map_err(|e| PyOSError::new_err(e.to_string()))?;
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d.display().to_string(),
             _ => ".".to_string(),
         };
-        cls.call1((text, file, dir))
+        let kwargs = PyDict::new(cls.py());
+        kwargs.set_item("allow_paths_outside", allow_paths_outside)?;
+        cls.call((text, file, dir), Some(&kwargs))
     }
 
     /// The experiment whose sections are the tables of `sections` (JSON text: `{"sampling":
@@ -242,12 +263,23 @@ impl Experiment {
         fit.map(|fit| Fit { fit }).map_err(value_error)
     }
 
-    fn __getnewargs__(&self) -> (String, String, String) {
-        (
-            self.text.clone(),
-            self.exp.file.clone(),
-            self.dir.display().to_string(),
-        )
+    /// Pickling: the text, the file name, the directory and whether paths outside it are
+    /// allowed.
+    #[allow(clippy::type_complexity)]
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<((String, String, String), Bound<'py, PyDict>)> {
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("allow_paths_outside", self.paths == Paths::Anywhere)?;
+        Ok((
+            (
+                self.text.clone(),
+                self.exp.file.clone(),
+                self.dir.display().to_string(),
+            ),
+            kwargs,
+        ))
     }
 
     fn __repr__(&self) -> String {

@@ -8,7 +8,7 @@ use crate::commands::{self, FitRequest, MonteCarloOptions, SimulateOptions};
 use crate::exit::{Outcome, BAD_INPUT};
 use clap::{Args, Parser, Subcommand};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::Method;
+use jitterid_study::experiment::{Method, Paths};
 use jitterid_study::montecarlo::{Shard, DEFAULT_SEED};
 use jitterid_study::select::InitChoice;
 use std::ffi::OsString;
@@ -70,6 +70,9 @@ pub struct ValidateArgs {
     /// Write SVG figures into this directory: time.svg, correlations.svg, bode.svg, step.svg.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub paths: PathArgs,
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -95,6 +98,29 @@ pub struct SimulateArgs {
     /// Also write the drawn jitter `tau` and measurement noise `v`.
     #[arg(long)]
     pub truth: bool,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub paths: PathArgs,
+}
+
+/// Where the files an experiment file names may be: shared by every subcommand that reads an
+/// experiment file.
+#[derive(Debug, Args)]
+pub struct PathArgs {
+    /// Let the experiment file name files outside its own directory (absolute paths, `..`,
+    /// symbolic links leading out); by default such a path is refused before it is read.
+    #[arg(long)]
+    pub allow_paths_outside: bool,
+}
+
+impl PathArgs {
+    fn paths(&self) -> Paths {
+        if self.allow_paths_outside {
+            Paths::Anywhere
+        } else {
+            Paths::Inside
+        }
+    }
 }
 
 /// Exit-status and budget options shared by `fit` and `montecarlo`.
@@ -141,6 +167,9 @@ pub struct FitArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub budget: BudgetArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub paths: PathArgs,
 }
 
 /// Arguments of `montecarlo`.
@@ -180,6 +209,9 @@ pub struct MonteCarloArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub budget: BudgetArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub paths: PathArgs,
 }
 
 /// Arguments of `select`.
@@ -199,6 +231,9 @@ pub struct SelectArgs {
     /// Write the JSON to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub paths: PathArgs,
 }
 
 /// Arguments of `merge`.
@@ -225,6 +260,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
     match cli.command {
         Command::Simulate(a) => commands::simulate(&SimulateOptions {
             experiment: a.experiment,
+            paths: a.paths.paths(),
             seed: a.seed,
             run: a.run,
             out: a.out,
@@ -233,6 +269,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
         .map(|s| Outcome::success(s + "\n")),
         Command::Fit(a) => commands::fit(&FitRequest {
             experiment: a.experiment,
+            paths: a.paths.paths(),
             data: a.data,
             input: a.input,
             method: a.method,
@@ -245,6 +282,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
         }),
         Command::Montecarlo(a) => commands::montecarlo(&MonteCarloOptions {
             experiment: a.experiment,
+            paths: a.paths.paths(),
             runs: a.runs,
             seed: a.seed,
             threads: a.threads,
@@ -260,6 +298,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
         }),
         Command::Validate(a) => commands::validate(&commands::ValidateOptions {
             experiment: a.experiment,
+            paths: a.paths.paths(),
             data: a.data,
             validation: a.validation,
             model: a.model,
@@ -269,6 +308,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
         }),
         Command::Select(a) => commands::select(&commands::SelectOptions {
             experiment: a.experiment,
+            paths: a.paths.paths(),
             data: a.data,
             validation: a.validation,
             json: a.json,

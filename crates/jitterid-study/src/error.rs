@@ -25,10 +25,24 @@ fn capped(message: String) -> String {
     format!("{start} … [{left_out} characters left out] … {end}")
 }
 
+/// What kind of error a [`StudyError`] is, for a caller that treats some differently (the
+/// message says the rest).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum StudyErrorKind {
+    /// Anything else: a value, a file or an option that is not as expected.
+    #[default]
+    Invalid,
+    /// A path written in an experiment file leads outside the experiment's directory and the
+    /// caller did not allow that ([`crate::experiment::Paths`]).
+    PathOutside,
+}
+
 /// An error reported to the user as one line (`error: …` on the command line's stderr).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct StudyError {
     message: String,
+    kind: StudyErrorKind,
 }
 
 impl StudyError {
@@ -44,7 +58,20 @@ impl StudyError {
             .join(" ");
         Self {
             message: capped(message),
+            kind: StudyErrorKind::Invalid,
         }
+    }
+
+    /// The same error, of `kind`.
+    #[must_use]
+    pub fn with_kind(mut self, kind: StudyErrorKind) -> Self {
+        self.kind = kind;
+        self
+    }
+
+    /// What kind of error it is.
+    pub fn kind(&self) -> StudyErrorKind {
+        self.kind
     }
 
     /// The message.
@@ -54,7 +81,7 @@ impl StudyError {
 
     /// The same error with `prefix: ` in front.
     pub fn context(self, prefix: impl fmt::Display) -> Self {
-        Self::new(format!("{prefix}: {}", self.message))
+        Self::new(format!("{prefix}: {}", self.message)).with_kind(self.kind)
     }
 }
 

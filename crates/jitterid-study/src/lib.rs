@@ -39,6 +39,6 @@ pub mod validate;
 mod watch;
 pub mod whiten;
 
-pub use error::{StudyError, StudyResult};
+pub use error::{StudyError, StudyErrorKind, StudyResult};
 pub use registries::Registries;
 pub use watch::{RunsDone, Watch};

@@ -3,7 +3,7 @@
 
 use crate::csvio;
 use crate::error::StudyResult;
-use crate::experiment::{self, Experiment, InputSpec, Purpose};
+use crate::experiment::{self, Experiment, InputSpec, Paths, Purpose};
 use crate::inputs;
 use crate::study_err;
 use jitterid::signal::Input;
@@ -54,14 +54,15 @@ pub fn read_data(exp: &Experiment, path: &Path) -> StudyResult<csvio::Table> {
 }
 
 /// The experiment of `path` with the command line's iteration and wall-clock budgets, where
-/// given.
+/// given; `paths` says where the files it names may be.
 pub fn read_experiment(
     path: &Path,
     purpose: Purpose,
+    paths: Paths,
     max_iterations: Option<u64>,
     time_limit: Option<f64>,
 ) -> StudyResult<Experiment> {
-    let mut exp = experiment::read(path, purpose)?;
+    let mut exp = experiment::read_with(path, purpose, paths)?;
     if let Some(t) = time_limit {
         if !(t.is_finite() && t >= 0.0) {
             return Err(study_err!(

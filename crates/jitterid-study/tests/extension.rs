@@ -195,6 +195,7 @@ fn an_out_of_tree_family_is_fitted_and_studied_through_the_study_layer() {
         EXPERIMENT,
         Path::new("."),
         Purpose::Estimate(None),
+        experiment::Paths::Inside,
     )
     .unwrap();
     assert_eq!(exp.jitter.model.name(), "triangle");
@@ -326,6 +327,7 @@ fn an_out_of_tree_likelihood_is_fitted_and_studied_through_the_study_layer() {
         LIKELIHOOD_EXPERIMENT,
         Path::new("."),
         Purpose::Estimate(None),
+        experiment::Paths::Inside,
     )
     .unwrap();
     assert!(exp.estimate.method.is_likelihood_in(&registries.criteria));

@@ -9,7 +9,7 @@ use crate::progress::Ticker;
 use jitterid::signal::{AnySignal, Input};
 use jitterid_study::csvio;
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{Experiment, Method, Purpose};
+use jitterid_study::experiment::{Experiment, Method, Paths, Purpose};
 use jitterid_study::export;
 use jitterid_study::fit::{self, fit_json, fit_values, Fit};
 use jitterid_study::records::{read_data, read_experiment, read_input};
@@ -24,6 +24,8 @@ use std::path::{Path, PathBuf};
 pub struct FitRequest {
     /// The experiment file.
     pub experiment: PathBuf,
+    /// Where the files the experiment file names may be (`--allow-paths-outside`).
+    pub paths: Paths,
     /// The data file.
     pub data: PathBuf,
     /// The input file (for a random-binary experiment), default `<data>.input.csv`.
@@ -50,6 +52,7 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let exp = read_experiment(
         &o.experiment,
         Purpose::Estimate(o.method),
+        o.paths,
         o.max_iterations,
         o.time_limit,
     )?;

@@ -9,7 +9,7 @@
 use crate::exit::{Outcome, Status};
 use crate::output::OutputSet;
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::Purpose;
+use jitterid_study::experiment::{Paths, Purpose};
 use jitterid_study::records::read_experiment;
 use jitterid_study::select::{ranked_by, select as run_selection};
 use jitterid_study::study_err;
@@ -21,6 +21,8 @@ use std::path::PathBuf;
 pub struct SelectOptions {
     /// The experiment file (its `[sampling]`, `[input]` and `[select]` are used).
     pub experiment: PathBuf,
+    /// Where the files the experiment file names may be (`--allow-paths-outside`).
+    pub paths: Paths,
     /// The estimation record.
     pub data: PathBuf,
     /// An optional validation record (same experiment grid; input from its side file).
@@ -33,7 +35,7 @@ pub struct SelectOptions {
 
 /// `jitterid select`.
 pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
-    let exp = read_experiment(&o.experiment, Purpose::Simulate, None, None)?;
+    let exp = read_experiment(&o.experiment, Purpose::Simulate, o.paths, None, None)?;
     let selection = run_selection(&exp, &o.data, o.validation.as_deref())?;
     let (ranked, fits) = (&selection.ranked, &selection.validation_fits);
     let status = Status::of_convergence(ranked.first().is_some_and(|c| c.converged), false);

@@ -5,7 +5,7 @@ use crate::exit::Outcome;
 use crate::output::OutputSet;
 use crate::plots::{self, RecordPlot, ValidatePlots};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{self, Experiment, Purpose};
+use jitterid_study::experiment::{self, Experiment, Paths, Purpose};
 use jitterid_study::fit::Structure;
 use jitterid_study::study_err;
 use jitterid_study::validate::{
@@ -19,6 +19,8 @@ use std::path::{Path, PathBuf};
 pub struct ValidateOptions {
     /// The experiment file.
     pub experiment: PathBuf,
+    /// Where the files the experiment file names may be (`--allow-paths-outside`).
+    pub paths: Paths,
     /// The estimation record.
     pub data: PathBuf,
     /// A validation record (same `T`, its own input side file).
@@ -74,7 +76,7 @@ fn stage_figures(
 /// `jitterid validate`: the JSON, printed or written to `--out` with the CSV and the figures,
 /// all at once.
 pub fn validate(o: &ValidateOptions) -> StudyResult<Outcome> {
-    let exp = experiment::read(&o.experiment, Purpose::Estimate(None))?;
+    let exp = experiment::read_with(&o.experiment, Purpose::Estimate(None), o.paths)?;
     let v = run_validation(
         &exp,
         &o.data,

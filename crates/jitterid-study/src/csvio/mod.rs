@@ -12,7 +12,10 @@ pub use record_io::{
     input_from_table, input_side_file, input_to_csv, load_record, piecewise, record_from_table,
     record_to_csv, save_record,
 };
-pub use table::{check_regular_file, format, parse, read, Column, Table, MAX_FILE_BYTES};
+pub use table::{
+    check_regular_file, excerpt, format, parse, read, read_as, Column, Table, MAX_EXCERPT_CHARS,
+    MAX_FILE_BYTES,
+};
 
 impl From<CsvError> for crate::error::StudyError {
     fn from(e: CsvError) -> Self {

@@ -208,12 +208,23 @@ fn some_names(columns: &[String]) -> String {
     s
 }
 
-fn shorten(s: &str) -> String {
-    let mut out: String = s.chars().take(40).collect();
-    if s.chars().count() > 40 {
+/// Most characters of a file's content that a message quotes (a cell, a column name): a file
+/// can be one the user did not mean to show (named by someone else's experiment file), so a
+/// message shows a short excerpt, never a line.
+pub const MAX_EXCERPT_CHARS: usize = 20;
+
+/// A short, printable excerpt of `s` for a message: at most [`MAX_EXCERPT_CHARS`] characters
+/// (`…` marks a cut), control and other unprintable characters escaped (`\u{1b}`, `\t`).
+pub fn excerpt(s: &str) -> String {
+    let mut out: String = s.chars().take(MAX_EXCERPT_CHARS).collect();
+    if s.chars().count() > MAX_EXCERPT_CHARS {
         out.push('…');
     }
     out.escape_debug().to_string()
+}
+
+fn shorten(s: &str) -> String {
+    excerpt(s)
 }
 
 /// The column names of a header line, checked: named, not numbers, each once.
@@ -368,7 +379,17 @@ pub fn check_regular_file(path: &Path, name: &str) -> Result<(), CsvError> {
 ///
 /// [`CsvError::Io`] if the file cannot be read or is not UTF-8 text; those of [`parse`].
 pub fn read(path: &Path) -> Result<Table, CsvError> {
-    let name = path.display().to_string();
+    read_as(path, &path.display().to_string())
+}
+
+/// Reads and parses the CSV file at `path`, named `name` in messages (for a file opened by
+/// its canonical path but known to the user by another).
+///
+/// # Errors
+///
+/// As [`read`].
+pub fn read_as(path: &Path, name: &str) -> Result<Table, CsvError> {
+    let name = name.to_string();
     check_regular_file(path, &name)?;
     let bytes = std::fs::read(path).map_err(|e| CsvError::Io {
         name: name.clone(),

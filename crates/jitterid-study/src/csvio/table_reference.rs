@@ -45,8 +45,8 @@ fn some_names(columns: &[String]) -> String {
 }
 
 fn shorten(s: &str) -> String {
-    let mut out: String = s.chars().take(40).collect();
-    if s.chars().count() > 40 {
+    let mut out: String = s.chars().take(20).collect();
+    if s.chars().count() > 20 {
         out.push('…');
     }
     out.escape_debug().to_string()

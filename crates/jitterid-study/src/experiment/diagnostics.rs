@@ -1,6 +1,7 @@
 //! Where an error is in the file and what the user probably meant: every message is one line
 //! `file:line: [section] key: what was expected`.
 
+use super::paths::Paths;
 use super::raw::keys_of;
 use crate::error::StudyError;
 use crate::study_err;
@@ -14,6 +15,8 @@ pub(super) struct Source<'a> {
     pub(super) text: &'a str,
     /// The directory relative paths are resolved from.
     pub(super) dir: PathBuf,
+    /// Where the files the experiment names may be.
+    pub(super) paths: Paths,
     /// Line of every section header given.
     section_lines: Vec<(&'static str, usize)>,
     /// The registries every name in the file is looked up in.
@@ -26,6 +29,7 @@ impl<'a> Source<'a> {
         file: &'a str,
         text: &'a str,
         dir: PathBuf,
+        paths: Paths,
         registries: &'a Registries,
     ) -> Self {
         let mut section_lines = Vec::new();
@@ -42,6 +46,7 @@ impl<'a> Source<'a> {
             file,
             text,
             dir,
+            paths,
             section_lines,
             registries,
         }

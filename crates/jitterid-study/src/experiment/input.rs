@@ -2,6 +2,7 @@
 
 use super::checks::finite_value;
 use super::diagnostics::Source;
+use super::paths;
 use super::range;
 use super::raw::RawInput;
 use super::spec::{InputSpec, SystemSpec};
@@ -236,7 +237,8 @@ fn csv_file(cx: &Source, r: &RawInput, grid: &SampleGrid) -> StudyResult<InputSp
         .value_column
         .as_ref()
         .map_or("u", |s| s.get_ref().as_str());
-    let table = csvio::read(&cx.dir.join(p.get_ref()))?;
+    let file = paths::resolve(cx, S, "path", p)?;
+    let table = csvio::read_as(&file.open, &file.name)?;
     let p = piecewise_from_table(&table, tc, vc, grid)?;
     Ok(InputSpec::Known(Input::Piecewise(p)))
 }

@@ -14,6 +14,7 @@ mod input;
 mod jitter;
 mod method;
 mod noise;
+mod paths;
 pub mod range;
 mod raw;
 mod sampling;
@@ -22,6 +23,7 @@ mod spec;
 mod system;
 
 pub use input::MAX_SWITCHES;
+pub use paths::Paths;
 pub use sampling::MAX_SAMPLES;
 pub use spec::{
     name_table, EstimateSpec, Experiment, InputSpec, JitterSpec, Method, NoiseSpec, SolverName,
@@ -48,40 +50,80 @@ pub enum Purpose {
     Estimate(Option<Method>),
 }
 
-/// Reads and validates an experiment file for `purpose`.
+/// Reads and validates an experiment file for `purpose`; the files it names must be inside its
+/// directory ([`Paths::Inside`]).
 pub fn read(path: &Path, purpose: Purpose) -> StudyResult<Experiment> {
+    read_with(path, purpose, Paths::Inside)
+}
+
+/// Reads and validates an experiment file for `purpose`; `paths` says where the files it names
+/// may be (see [`Paths`]).
+pub fn read_with(path: &Path, purpose: Purpose, paths: Paths) -> StudyResult<Experiment> {
+    let file = path.display().to_string();
+    let text = read_text(path)?;
+    parse_with(
+        &Registries::builtin(),
+        &file,
+        &text,
+        &directory_of(path),
+        purpose,
+        paths,
+    )
+}
+
+/// The text of the experiment file at `path`, read as every front end reads it: only a regular
+/// file of at most [`csvio::MAX_FILE_BYTES`] (a device such as `/dev/zero` or a pipe is refused
+/// before it is read), and only UTF-8 text.
+///
+/// # Errors
+///
+/// One line naming the file: it does not exist, cannot be read, is not a regular file, is too
+/// large or is not UTF-8.
+pub fn read_text(path: &Path) -> StudyResult<String> {
     let file = path.display().to_string();
     csvio::check_regular_file(path, &file)?;
     let bytes = std::fs::read(path)
         .map_err(|e| study_err!("{file}: cannot read: {}", csvio::io_reason(&e)))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
+    String::from_utf8(bytes).map_err(|e| {
         study_err!(
             "{file}: not UTF-8 text (invalid byte at offset {}); expected a TOML experiment file",
             e.utf8_error().valid_up_to()
         )
-    })?;
-    let dir = path
-        .parent()
+    })
+}
+
+/// The directory the paths in the experiment file at `path` are resolved against: the file's
+/// own (the empty path, that is the current directory, for a bare file name).
+pub fn directory_of(path: &Path) -> PathBuf {
+    path.parent()
         .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."));
-    parse(&file, &text, &dir, purpose)
+        .unwrap_or_else(|| PathBuf::from("."))
 }
 
 /// Parses and validates experiment text for `purpose` with the built-in registries; `file`
-/// names it in messages, `dir` resolves relative paths.
+/// names it in messages, `dir` resolves relative paths, and the files it names must be inside
+/// `dir` ([`Paths::Inside`]).
 pub fn parse(file: &str, text: &str, dir: &Path, purpose: Purpose) -> StudyResult<Experiment> {
-    parse_with(&Registries::builtin(), file, text, dir, purpose)
+    parse_with(
+        &Registries::builtin(),
+        file,
+        text,
+        dir,
+        purpose,
+        Paths::Inside,
+    )
 }
 
 /// Parses and validates experiment text for `purpose`, looking every name up in `registries`
 /// (which the experiment keeps to build its models); `file` names it in messages, `dir`
-/// resolves relative paths.
+/// resolves relative paths, `paths` says where the files it names may be (see [`Paths`]).
 pub fn parse_with(
     registries: &Arc<Registries>,
     file: &str,
     text: &str,
     dir: &Path,
     purpose: Purpose,
+    paths: Paths,
 ) -> StudyResult<Experiment> {
     // TOML knows LF and CRLF only; a lone CR would be reported as a stray character on line 1.
     let bytes = text.as_bytes();
@@ -94,7 +136,7 @@ pub fn parse_with(
         return Err(e);
     }
     let raw: RawExperiment = toml::from_str(text).map_err(|e| toml_error(file, text, &e))?;
-    let cx = Source::new(file, text, dir.to_path_buf(), registries);
+    let cx = Source::new(file, text, dir.to_path_buf(), paths, registries);
     let r_sampling = raw.sampling.as_ref().ok_or_else(|| {
         study_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
     })?;
