@@ -75,6 +75,18 @@ fn validate_reports_verdicts_and_refuses_bad_input() {
         assert!(stderr(&o).contains(needle), "{}", stderr(&o));
     };
     refused(validate(&wrong, None), "do not match");
+    // A ragged covariance: refused by name, not read as a model without one.
+    let mut m: Value =
+        serde_json::from_str(&stdout(&run(&["fit", &exp, "--data", s(&data), "--json"]))).unwrap();
+    m["covariance"][2].as_array_mut().unwrap().pop();
+    std::fs::write(&wrong, m.to_string()).unwrap();
+    refused(
+        validate(&wrong, None),
+        "covariance: row 3 has 3 entries, expected 4",
+    );
+    m["covariance"].as_array_mut().unwrap().pop();
+    std::fs::write(&wrong, m.to_string()).unwrap();
+    refused(validate(&wrong, None), "covariance: expected 4 rows");
     // Malformed JSON.
     std::fs::write(&wrong, "{").unwrap();
     refused(validate(&wrong, None), "fit --json");

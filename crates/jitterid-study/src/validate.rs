@@ -115,6 +115,24 @@ fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> StudyResult<M
             exp.estimate.method.as_str()
         ));
     }
+    // A covariance that is there must be whole: a ragged one is a damaged file, not a model
+    // without bands.
+    if let Some(c) = &f.covariance {
+        let n = f.parameters.len();
+        if c.len() != n {
+            return Err(study_err!(
+                "{name}: covariance: expected {n} rows (one per parameter), found {}",
+                c.len()
+            ));
+        }
+        if let Some((i, row)) = c.iter().enumerate().find(|(_, row)| row.len() != n) {
+            return Err(study_err!(
+                "{name}: covariance: row {} has {} entries, expected {n} (one per parameter)",
+                i + 1,
+                row.len()
+            ));
+        }
+    }
     if let Some(p) = f.parameters.iter().find(|p| !p.estimate.is_finite()) {
         return Err(study_err!(
             "{name}: parameter {}: not a finite estimate",
