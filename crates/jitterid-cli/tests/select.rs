@@ -73,6 +73,8 @@ fn bad_grids_exit_2_naming_the_key() {
         ("zeros = [2]", "zeros"),
         ("families = []", "families"),
         ("families = [\"cauchy\"]", "families"),
+        ("families = [\"gaussian\", \"sum\"]", "families"),
+        ("families = [\"mixture\"]", "families"),
         ("poles = [1, 150]", "poles"),
     ] {
         let exp = experiment(dir.path(), select);

@@ -202,10 +202,21 @@ impl SelectionGrid {
         }
         let known: Vec<&str> = registry.families().map(|f| f.name()).collect();
         for name in &self.families {
-            if !known.contains(&name.as_str()) {
+            let Some(family) = registry.family(name) else {
                 return Err(invalid(
                     "families",
                     format!("unknown family {name:?}; known: {}", known.join(", ")),
+                ));
+            };
+            // Every candidate is started from standard deviations alone: a composite needs its
+            // terms, which a grid of names cannot give.
+            if family.takes_terms() || !family.has_std_dev_form() {
+                return Err(invalid(
+                    "families",
+                    format!(
+                        "family {name:?} cannot be started from a standard deviation alone \
+                         (a composite needs its terms); list the families of its terms instead"
+                    ),
                 ));
             }
         }
