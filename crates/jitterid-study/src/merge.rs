@@ -26,9 +26,7 @@ struct Part {
 
 fn read_part(path: &Path) -> StudyResult<Part> {
     let name = path.display().to_string();
-    csvio::check_regular_file(path, &name)?;
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| study_err!("{name}: cannot read: {}", csvio::io_reason(&e)))?;
+    let text = csvio::read_text(path, &name, "a shard file")?;
     let json: McJson = serde_json::from_str(&text).map_err(|e| {
         study_err!(
             "{name}:{}:{}: not a shard file of `jitterid montecarlo --shard i/n --json`: {e}",

@@ -95,8 +95,7 @@ type Model = (Structure, f64, Option<Vec<Vec<f64>>>);
 
 fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> StudyResult<Model> {
     let name = path.display();
-    csvio::check_regular_file(path, &name.to_string())?;
-    let text = std::fs::read_to_string(path).map_err(|e| study_err!("{name}: cannot read: {e}"))?;
+    let text = csvio::read_text(path, &name.to_string(), "the JSON of `jitterid fit --json`")?;
     let f: FitFile = serde_json::from_str(&text)
         .map_err(|e| study_err!("{name}: not the JSON of `jitterid fit --json`: {e}"))?;
     if exp.jitter.estimate && exp.jitter.n_range.is_some() {

@@ -389,20 +389,31 @@ pub fn read(path: &Path) -> Result<Table, CsvError> {
 ///
 /// As [`read`].
 pub fn read_as(path: &Path, name: &str) -> Result<Table, CsvError> {
-    let name = name.to_string();
-    check_regular_file(path, &name)?;
+    let text = read_text(path, name, "a CSV file")?;
+    parse(name, &text)
+}
+
+/// The text of the file at `path`, named `name` in messages, read only if it is a regular
+/// file of at most [`MAX_FILE_BYTES`]: the one checked reader of every file the study layer
+/// reads (CSV files, experiment files, shard files, fit files). `expected` says what the file
+/// should have been (`"a CSV file"`) when it is not UTF-8 text.
+///
+/// # Errors
+///
+/// [`CsvError::Io`]: not a regular file, too large, unreadable, or not UTF-8.
+pub fn read_text(path: &Path, name: &str, expected: &str) -> Result<String, CsvError> {
+    check_regular_file(path, name)?;
     let bytes = std::fs::read(path).map_err(|e| CsvError::Io {
-        name: name.clone(),
+        name: name.to_string(),
         reason: format!("cannot read: {}", io_reason(&e)),
     })?;
-    let text = String::from_utf8(bytes).map_err(|e| CsvError::Io {
-        name: name.clone(),
+    String::from_utf8(bytes).map_err(|e| CsvError::Io {
+        name: name.to_string(),
         reason: format!(
-            "not UTF-8 text (invalid byte at offset {}); expected a CSV file",
+            "not UTF-8 text (invalid byte at offset {}); expected {expected}",
             e.utf8_error().valid_up_to()
         ),
-    })?;
-    parse(&name, &text)
+    })
 }
 
 /// A column to write: a name and its values; integer columns are printed without a fraction.

@@ -81,15 +81,7 @@ pub fn read_with(path: &Path, purpose: Purpose, paths: Paths) -> StudyResult<Exp
 /// large or is not UTF-8.
 pub fn read_text(path: &Path) -> StudyResult<String> {
     let file = path.display().to_string();
-    csvio::check_regular_file(path, &file)?;
-    let bytes = std::fs::read(path)
-        .map_err(|e| study_err!("{file}: cannot read: {}", csvio::io_reason(&e)))?;
-    String::from_utf8(bytes).map_err(|e| {
-        study_err!(
-            "{file}: not UTF-8 text (invalid byte at offset {}); expected a TOML experiment file",
-            e.utf8_error().valid_up_to()
-        )
-    })
+    Ok(csvio::read_text(path, &file, "a TOML experiment file")?)
 }
 
 /// The directory the paths in the experiment file at `path` are resolved against: the file's
