@@ -21,7 +21,7 @@ const SIGNAL_POLL: Duration = Duration::from_millis(50);
 ///
 /// The study runs on its own threads without the GIL while this thread looks for Python
 /// signals every [`SIGNAL_POLL`]: Ctrl-C stops the study before its next realisations and
-/// raises `KeyboardInterrupt` once the running ones end.
+/// raises `KeyboardInterrupt` once the running ones end, its `__cause__` saying how many ran.
 #[pyfunction]
 #[pyo3(signature = (experiment, runs = 128, seed = DEFAULT_SEED, shard = None, method = None, threads = None))]
 pub fn montecarlo(
@@ -58,7 +58,10 @@ pub fn montecarlo(
             py.detach(|| std::thread::sleep(SIGNAL_POLL));
             if let Err(signal) = py.check_signals() {
                 cancel.store(true, Ordering::Relaxed);
-                py.detach(|| study.join()).ok();
+                // The stopped study's report (how many realisations ran) is the signal's cause.
+                if let Ok(Err(stopped)) = py.detach(|| study.join()) {
+                    signal.set_cause(py, Some(PyRuntimeError::new_err(stopped.to_string())));
+                }
                 return Err(signal);
             }
         }
