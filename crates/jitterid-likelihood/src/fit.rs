@@ -11,7 +11,9 @@ use super::objective::LikelihoodObjective;
 use super::param::{default_transforms, likelihood_param_names, likelihood_params, Layout};
 use super::MlError;
 use faer::Mat;
-use jitterid_estimate::solver::{Brent, BrentOrBfgs, ObjectiveSolver, ProgressHook, Transform};
+use jitterid_estimate::solver::{
+    AnySolver, Brent, BrentOrBfgs, ObjectiveSolver, ProgressHook, Transform,
+};
 use jitterid_estimate::support::{best_of, fitted_jitter};
 use jitterid_estimate::EstimateError;
 use jitterid_estimate::ModelStructure;
@@ -270,8 +272,7 @@ const WARM_BRACKET_STEP: f64 = 0.03;
 /// to that tolerance (the profile's coarse-then-refine schedule replaces it for
 /// one-parameter fits, and refines to that tolerance).
 fn staged_tolerance<V: Any>(solver: &V) -> Option<f64> {
-    (solver as &dyn Any)
-        .downcast_ref::<BrentOrBfgs>()
+    as_default(solver)
         .filter(|s| {
             // A progress hook only observes: it does not make the solver another one.
             let mut plain = (*s).clone();
@@ -286,15 +287,23 @@ fn staged_tolerance<V: Any>(solver: &V) -> Option<f64> {
 /// The progress hook of the default solver's Brent stage, handed on to the staged profile's
 /// own Brent solvers.
 fn brent_hook<V: Any>(solver: &V) -> Option<ProgressHook> {
-    (solver as &dyn Any)
-        .downcast_ref::<BrentOrBfgs>()
-        .and_then(|s| s.brent.progress.clone())
+    as_default(solver).and_then(|s| s.brent.progress.clone())
+}
+
+/// `solver` as the default likelihood solver, if it is one: by its type, or behind the
+/// run-time [`AnySolver`] that [`fit`](jitterid_estimate::fit) hands on.
+fn as_default<V: Any>(solver: &V) -> Option<&BrentOrBfgs> {
+    let any = solver as &dyn Any;
+    any.downcast_ref::<BrentOrBfgs>().or_else(|| {
+        any.downcast_ref::<AnySolver>()?
+            .downcast_ref::<BrentOrBfgs>()
+    })
 }
 
 /// Fits `structure` with its jitter replaced by `build(v)` for every `v` in `values` and
 /// returns the converged fit with the largest likelihood (the largest of all if
 /// none converged). `build` makes the start jitter of a value (see
-/// [`profile`](jitterid_estimate::profile)). The covariance, if asked for, is computed for the winner only.
+/// [`fit_profile`](jitterid_estimate::fit_profile)). The covariance, if asked for, is computed for the winner only.
 ///
 /// With the default solver (whatever the tolerance of its Brent stage) and a single free
 /// parameter (the jitter's), every value is first fitted loosely, on the criterion's

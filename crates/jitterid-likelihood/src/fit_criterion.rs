@@ -22,31 +22,18 @@ use jitterid_signal::Signal;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Likelihood<C>(pub C);
 
-/// The options of the likelihood estimator that `options` describe, with the default solver.
-fn ml_options(options: &FitOptions) -> MlOptions {
+/// The options of the likelihood estimator that `options` describe: its solver, or the
+/// default likelihood solver ([`BrentOrBfgs`]), which the estimator recognises behind the
+/// [`AnySolver`] (the integer profile's staged schedule is for it; see [`ml_profile`]).
+fn ml_options(options: &FitOptions) -> MlOptions<AnySolver> {
     MlOptions {
-        solver: BrentOrBfgs::default(),
+        solver: options
+            .solver
+            .clone()
+            .unwrap_or_else(|| AnySolver::new(BrentOrBfgs::default())),
         covariance: options.covariance,
         transforms: options.transforms.clone(),
         noise_std_start: options.noise_std_start,
-    }
-}
-
-/// The solver of `options` as the likelihood estimator runs it: the default likelihood solver
-/// by its type (so that the profile's staged schedule applies to it, see
-/// [`ml_profile`]), any other behind the trait object.
-enum MlSolver {
-    Default(BrentOrBfgs),
-    Any(AnySolver),
-}
-
-fn ml_solver(options: &FitOptions) -> MlSolver {
-    match &options.solver {
-        None => MlSolver::Default(BrentOrBfgs::default()),
-        Some(s) => match s.downcast_ref::<BrentOrBfgs>() {
-            Some(b) => MlSolver::Default(b.clone()),
-            None => MlSolver::Any(s.clone()),
-        },
     }
 }
 
@@ -63,11 +50,12 @@ where
     N: NoiseModel,
     C: LikelihoodCriterion,
 {
-    let base = ml_options(options);
-    Ok(match ml_solver(options) {
-        MlSolver::Default(s) => ml_estimate(structure, record, criterion, &base.with_solver(s))?,
-        MlSolver::Any(s) => ml_estimate(structure, record, criterion, &base.with_solver(s))?,
-    })
+    Ok(ml_estimate(
+        structure,
+        record,
+        criterion,
+        &ml_options(options),
+    )?)
 }
 
 /// [`ml_profile`] with the estimator's options from `options`.
@@ -85,26 +73,11 @@ where
     N: NoiseModel,
     C: LikelihoodCriterion,
 {
-    let base = ml_options(options);
     let values = values.iter().copied();
-    Ok(match ml_solver(options) {
-        MlSolver::Default(s) => ml_profile(
-            structure,
-            record,
-            criterion,
-            &base.with_solver(s),
-            values,
-            build,
-        )?,
-        MlSolver::Any(s) => ml_profile(
-            structure,
-            record,
-            criterion,
-            &base.with_solver(s),
-            values,
-            build,
-        )?,
-    })
+    let options = ml_options(options);
+    Ok(ml_profile(
+        structure, record, criterion, &options, values, build,
+    )?)
 }
 
 /// `FitCriterion` for a likelihood type: `−log L` minimised by the likelihood estimator, the
