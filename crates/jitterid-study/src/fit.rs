@@ -97,10 +97,7 @@ pub fn solver(exp: &Experiment, seed: u64, watch: &Watch) -> StudyResult<AnySolv
             e.solver.as_str()
         )
     })?;
-    Ok(match &watch.iterations {
-        Some(hook) => solver.with_progress(hook.clone()),
-        None => solver,
-    })
+    Ok(watch.watched(solver))
 }
 
 /// One reported parameter of a fit.
@@ -244,11 +241,7 @@ fn options(
         if let Some(max_seconds) = exp.estimate.max_seconds {
             s.bfgs.max_seconds = max_seconds;
         }
-        let s = AnySolver::new(s);
-        match &watch.iterations {
-            Some(hook) => s.with_progress(hook.clone()),
-            None => s,
-        }
+        watch.watched(AnySolver::new(s))
     } else {
         solver(exp, seed, watch)?
     };

@@ -3,7 +3,7 @@
 //! The study layer calls them and draws nothing itself; the command line turns them into a
 //! progress bar, Python into its own callback and its Ctrl-C.
 
-use jitterid::estimate::solver::ProgressHook;
+use jitterid::estimate::solver::{AnySolver, ProgressHook};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -34,6 +34,14 @@ impl Watch {
     /// Nothing is watched.
     pub fn none() -> Self {
         Self::default()
+    }
+
+    /// `solver` reporting its iterations to [`iterations`](Self::iterations), if watched.
+    pub(crate) fn watched(&self, solver: AnySolver) -> AnySolver {
+        match &self.iterations {
+            Some(hook) => solver.with_progress(hook.clone()),
+            None => solver,
+        }
     }
 
     /// Whether the front end asked to stop.
