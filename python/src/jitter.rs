@@ -124,9 +124,16 @@ impl Jitter {
     }
 
     /// `size` independent draws of `τ` from a generator seeded with `seed`.
-    fn sample<'py>(&self, py: Python<'py>, size: usize, seed: u64) -> Bound<'py, PyArray1<f64>> {
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        size: usize,
+        seed: u64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let mut rng = StdRng::seed_from_u64(seed);
-        jitterid::jitter::sample_n(self.model.model(), size, &mut rng).into_pyarray(py)
+        let draws = jitterid::jitter::sample_n(self.model.model(), size, &mut rng)
+            .map_err(value_error)?;
+        Ok(draws.into_pyarray(py))
     }
 
     fn __repr__(&self) -> String {

@@ -129,8 +129,9 @@ pub struct BudgetArgs {
     /// Iteration limit of every fit (overrides [estimate] max_iterations).
     #[arg(long, value_name = "N")]
     pub max_iterations: Option<u64>,
-    /// Wall-clock budget of every fit in seconds [default: 600]; a fit that spends it stops,
-    /// not converged, with the reason (Levenberg–Marquardt and maximum likelihood).
+    /// Wall-clock budget of every fit in seconds [default: 600], covering its search,
+    /// covariance and (in montecarlo) simulation; a fit that spends it stops, not converged,
+    /// with the reason.
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
     /// Exit 0 even when the fit did not converge (montecarlo, merge: when no fit converged);
@@ -231,6 +232,10 @@ pub struct SelectArgs {
     /// Write the JSON to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Wall-clock budget of the whole selection in seconds [default: 600]; a selection that
+    /// spends it stops with the reason (status 1).
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub paths: PathArgs,
@@ -313,6 +318,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             validation: a.validation,
             json: a.json,
             out: a.out,
+            time_limit: a.time_limit,
         }),
         Command::Merge(a) => commands::merge(
             &a.shards,

@@ -380,6 +380,12 @@ fn project_to_time(
         return g;
     }
     for (fi, &f) in freqs.frequencies().iter().enumerate() {
+        // `O(N)` per frequency: a spent budget leaves the projection (and so the covariance,
+        // which the fit then drops) unfinished.
+        if jitterid_numeric::budget::spent() {
+            g.iter_mut().for_each(|v| *v = f64::NAN);
+            break;
+        }
         let sw = w[fi].sqrt();
         let step = Complex64::from_polar(1.0, TAU * f * t);
         let mut rot = Complex64::new(1.0, 0.0);

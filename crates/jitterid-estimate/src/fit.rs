@@ -14,6 +14,7 @@ use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
 use jitterid_jitter::JitterModel;
+use jitterid_numeric::budget;
 use jitterid_signal::{SampleGrid, Signal};
 use jitterid_window::{FrequencySet, Window};
 
@@ -277,12 +278,18 @@ where
     let report = settle_at_bounds(&problem, report, &held)?;
     let fitted = structure.with_params(&report.params)?;
     let residuals = problem.residuals(&report.params)?;
-    let (covariance, noise_std) = if options.covariance {
+    let (mut covariance, noise_std) = if options.covariance && !budget::spent() {
         let known = problem.memoised_sensitivities(&report.params);
         sandwich(&data, &fitted, criterion, &held, known)
     } else {
         (None, fitted.noise_std.unwrap_or(f64::NAN))
     };
+    // A budget spent in the search or in the covariance leaves the fit unfinished: its point
+    // is reported, not converged, with the reason and without a covariance.
+    let stopped = jitterid_optim::budget_termination();
+    if stopped.is_some() {
+        covariance = None;
+    }
     let std_errors = covariance
         .as_ref()
         .map(|c: &Vec<Vec<f64>>| (0..p).map(|i| c[i][i].max(0.0).sqrt()).collect());
@@ -296,8 +303,9 @@ where
         None
     };
     // A converged fit that leaves a band of frequencies unexplained is not a solution.
-    let (converged, termination) = match residual_flatness {
-        Some(f) if report.converged && f > crate::FLATNESS_LIMIT => {
+    let (converged, termination) = match (stopped, residual_flatness) {
+        (Some(stop), _) => (false, stop.into()),
+        (None, Some(f)) if report.converged && f > crate::FLATNESS_LIMIT => {
             (false, crate::FitTermination::ResidualNotFlat)
         }
         _ => (report.converged, report.termination.into()),

@@ -111,6 +111,19 @@ pub enum JitterError {
         /// The buffer's length.
         got: usize,
     },
+    /// A member whose spread is beyond double precision (a scale of `1e308` s has an infinite
+    /// variance and no characteristic function).
+    #[error("jitter family `{family}` at these parameters has variance {variance:e}: its scale is beyond double precision")]
+    Unrepresentable {
+        /// The family.
+        family: String,
+        /// The variance it has.
+        variance: f64,
+    },
+    /// A size beyond one of the library's documented limits (draws, terms of a sum,
+    /// components of a mixture).
+    #[error(transparent)]
+    Limit(#[from] jitterid_numeric::limits::LimitExceeded),
 }
 
 impl JitterError {

@@ -164,8 +164,21 @@ pub trait JitterModel: fmt::Debug + Send + Sync + CfAtParams {
 }
 
 /// Draws `n` jitter values.
-pub fn sample_n<J: JitterModel + ?Sized>(jitter: &J, n: usize, rng: &mut dyn RngCore) -> Vec<f64> {
-    (0..n).map(|_| jitter.sample(rng)).collect()
+///
+/// # Errors
+///
+/// [`JitterError::Limit`] when `n` is beyond the library's limit on samples
+/// ([`MAX_SAMPLES`](jitterid_numeric::limits::MAX_SAMPLES)) or the memory cannot be had: a
+/// size that comes from a user is refused, not an abort.
+pub fn sample_n<J: JitterModel + ?Sized>(
+    jitter: &J,
+    n: usize,
+    rng: &mut dyn RngCore,
+) -> Result<Vec<f64>, JitterError> {
+    use jitterid_numeric::limits::{vec_with_capacity, Limit};
+    let mut draws = vec_with_capacity(Limit::Samples, n)?;
+    draws.extend((0..n).map(|_| jitter.sample(rng)));
+    Ok(draws)
 }
 
 /// Relative step of the default [`cf_gradient`](JitterModel::cf_gradient): `ε^{1/3}`, which

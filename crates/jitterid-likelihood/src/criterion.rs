@@ -236,7 +236,13 @@ impl ExactMl {
         };
         let want = signal_grad || sigma_grad;
         let glen = channels + 1;
+        // Taken along to the worker threads: a spent budget leaves the remaining samples' log
+        // densities NaN (unfinished), which the fit's budget then reports.
+        let budget = jitterid_numeric::budget::current();
         let one = |scratch: &mut Scratch, k: usize| {
+            if budget.as_ref().is_some_and(|b| b.is_spent()) {
+                return Ok((f64::NAN, want.then(|| vec![f64::NAN; glen])));
+            }
             let y = record.y()[k];
             let too_large = |_: RuleTooLarge| MlError::QuadratureTooLarge {
                 limit: MAX_SAMPLE_NODES,

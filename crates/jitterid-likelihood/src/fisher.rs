@@ -327,8 +327,11 @@ where
         }
         Ok((info, (mass - 1.0).abs()))
     };
-    let parts: Vec<Result<(Vec<f64>, f64), MlError>> =
-        (0..grid.len()).into_par_iter().map(per_sample).collect();
+    let budget = jitterid_numeric::budget::current();
+    let parts: Vec<Result<(Vec<f64>, f64), MlError>> = (0..grid.len())
+        .into_par_iter()
+        .map(|k| jitterid_numeric::budget::run_with(budget.clone(), || per_sample(k)))
+        .collect();
     let mut matrix = vec![vec![0.0; p]; p];
     let mut max_err: f64 = 0.0;
     for part in parts {

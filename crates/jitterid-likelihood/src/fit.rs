@@ -217,11 +217,15 @@ where
     let report = options.solver.minimize(&problem as &dyn Objective, &phi0)?;
     let params = constrained.to_external(&report.params);
     let (_, sigma) = super::param::split(structure, &params)?;
-    let covariance = if options.covariance {
+    let covariance = if options.covariance && !jitterid_numeric::budget::spent() {
         hessian(&objective, &params).and_then(|h| spd_inverse(&h))
     } else {
         None
     };
+    // A budget spent in the search or the Hessian leaves the fit unfinished: its point is
+    // reported, not converged, with the reason and without a covariance.
+    let stopped = jitterid_optim::budget_termination();
+    let covariance = covariance.filter(|_| stopped.is_none());
     let std_errors = covariance
         .as_ref()
         .map(|c| (0..p).map(|i| c[i][i].sqrt()).collect());
@@ -234,8 +238,8 @@ where
         cost: report.cost,
         cost_kind: CostKind::NegLogLikelihood,
         iterations: report.iterations,
-        termination: report.termination.into(),
-        converged: report.converged,
+        converged: report.converged && stopped.is_none(),
+        termination: stopped.unwrap_or(report.termination).into(),
         noise_std: sigma,
         residuals: Vec::new(),
         residual_flatness: None,
@@ -420,9 +424,14 @@ where
         }
         out
     } else {
+        let budget = jitterid_numeric::budget::current();
         values
             .par_iter()
-            .map(|&v| (v, at(v).and_then(|s| fit_with(&s, None, None, criterion))))
+            .map(|&v| {
+                jitterid_numeric::budget::run_with(budget.clone(), || {
+                    (v, at(v).and_then(|s| fit_with(&s, None, None, criterion)))
+                })
+            })
             .collect()
     };
     if let Some(tolerance) = staged {
@@ -442,26 +451,29 @@ where
             covariance: false,
             ..fine
         };
+        let budget = jitterid_numeric::budget::current();
         fits.par_iter_mut().for_each(|(v, fit)| {
-            let refine = match fit {
-                Ok(e) => !(e.cost > best + PROFILE_MARGIN),
-                Err(_) => false,
-            };
-            if refine {
-                if let Ok(e) = fit {
-                    // Restart from the coarse minimum, whose value is known if the first
-                    // pass was on the criterion itself.
-                    let known = (screening.is_none() && e.cost.is_finite())
-                        .then_some((e.params.as_slice(), e.cost));
-                    let refined = at(*v).and_then(|s| {
-                        let s = s.with_params(&e.params).map_err(MlError::from)?;
-                        fit_with(&s, Some(&fine), known, criterion)
-                    });
-                    if let Ok(better) = refined {
-                        *fit = Ok(better);
+            jitterid_numeric::budget::run_with(budget.clone(), || {
+                let refine = match fit {
+                    Ok(e) => !(e.cost > best + PROFILE_MARGIN),
+                    Err(_) => false,
+                };
+                if refine {
+                    if let Ok(e) = fit {
+                        // Restart from the coarse minimum, whose value is known if the first
+                        // pass was on the criterion itself.
+                        let known = (screening.is_none() && e.cost.is_finite())
+                            .then_some((e.params.as_slice(), e.cost));
+                        let refined = at(*v).and_then(|s| {
+                            let s = s.with_params(&e.params).map_err(MlError::from)?;
+                            fit_with(&s, Some(&fine), known, criterion)
+                        });
+                        if let Ok(better) = refined {
+                            *fit = Ok(better);
+                        }
                     }
                 }
-            }
+            })
         });
     }
     let (best, costs, first_error) = best_of(fits);
@@ -474,6 +486,11 @@ where
         let theta = estimate.params.clone();
         let objective = LikelihoodObjective::new(&start, criterion, record);
         estimate.covariance = hessian(&objective, &theta).and_then(|h| spd_inverse(&h));
+        if let Some(stop) = jitterid_optim::budget_termination() {
+            estimate.covariance = None;
+            estimate.converged = false;
+            estimate.termination = stop.into();
+        }
         estimate.std_errors = estimate
             .covariance
             .as_ref()

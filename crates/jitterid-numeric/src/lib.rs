@@ -18,6 +18,10 @@
 //!   Dirichlet kernels of the window crate;
 //! * [`pieces`]: merging the smooth pieces of several laws into one sorted, disjoint list, as
 //!   a sum or a mixture of jitter families needs;
+//! * [`limits`]: the documented limits on the sizes a caller can ask for (samples, switches,
+//!   tones, poles, sum terms, quadrature nodes, file sizes, realisations), checked where each
+//!   size enters the library;
+//! * [`budget`]: the wall-clock budget and cancel flag that every long loop checks;
 //! * [`validate`]: the validators of a constructor's real parameters (`finite`, `positive`,
 //!   `non_negative`), whose error names the parameter.
 //!
@@ -37,11 +41,13 @@
 #![warn(missing_docs)]
 
 pub mod bessel;
+pub mod budget;
 pub mod chebyshev;
 pub mod clenshaw_curtis;
 pub mod complex;
 pub mod filon;
 pub mod gauss;
+pub mod limits;
 pub mod phase;
 pub mod pieces;
 pub mod validate;

@@ -157,6 +157,9 @@ impl Bfgs {
             if started.elapsed().as_secs_f64() >= self.max_seconds {
                 break Termination::TimeLimit;
             }
+            if let Some(stop) = crate::budget_termination() {
+                break stop;
+            }
             let hg = mat_vec(&h, &g);
             if 0.5 * dot(&g, &hg) <= self.decrement_tol && updated {
                 break Termination::SmallGradient;

@@ -142,9 +142,11 @@ impl Brent {
         }
         let (lo, hi) = if a < c { (a, c) } else { (c, a) };
         let solver = BrentOpt::new(lo, hi).set_tolerance(f64::EPSILON.sqrt(), self.tolerance);
-        let mut executor = Executor::new(Scalar(objective), solver)
-            .configure(|s: IterState<f64, (), (), (), (), f64>| s.max_iters(self.max_iters))
-            .ctrlc(false);
+        let mut executor = crate::with_budget_timeout(
+            Executor::new(Scalar(objective), solver)
+                .configure(|s: IterState<f64, (), (), (), (), f64>| s.max_iters(self.max_iters))
+                .ctrlc(false),
+        );
         if let Some(hook) = &self.progress {
             executor = executor.add_observer(
                 ProgressObserver {
@@ -170,7 +172,14 @@ impl Brent {
             argmin::core::TerminationStatus::Terminated(
                 argmin::core::TerminationReason::MaxItersReached,
             ) => Termination::MaxIterations,
+            argmin::core::TerminationStatus::Terminated(
+                argmin::core::TerminationReason::Timeout,
+            ) => Termination::TimeLimit,
             ref other => Termination::Other(format!("{other:?}")),
+        };
+        let termination = match crate::budget_termination() {
+            Some(stop) if !termination.is_convergence() => stop,
+            _ => termination,
         };
         Ok(SolverReport {
             converged: termination.is_convergence() && fx.is_finite(),

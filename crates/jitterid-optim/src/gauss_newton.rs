@@ -163,11 +163,15 @@ impl<P: LeastSquares + ?Sized> Solver<P> for GaussNewtonLineSearch {
             .with_tolerance(self.tol)
             .map_err(SolverError::from_argmin)?;
         let last = LastIterate::default();
-        let run = Executor::new(ArgminFaerProblem::new(&scaled), solver)
-            .configure(|state: GnState| state.param(vec_to_col(start)).max_iters(self.max_iters))
-            .add_observer(last.clone(), ObserverMode::Always)
-            .ctrlc(false)
-            .run();
+        let run = crate::with_budget_timeout(
+            Executor::new(ArgminFaerProblem::new(&scaled), solver)
+                .configure(|state: GnState| {
+                    state.param(vec_to_col(start)).max_iters(self.max_iters)
+                })
+                .add_observer(last.clone(), ObserverMode::Always)
+                .ctrlc(false),
+        )
+        .run();
 
         let (params, iterations, mut termination) = match run {
             Ok(result) => {
@@ -201,6 +205,9 @@ impl<P: LeastSquares + ?Sized> Solver<P> for GaussNewtonLineSearch {
         let cost = half_sum_sq(&checked_residuals(problem, &params)?);
         if !cost.is_finite() {
             termination = Termination::NonFinite;
+        }
+        if let Some(stop) = crate::budget_termination().filter(|_| !termination.is_convergence()) {
+            termination = stop;
         }
         Ok(SolverReport {
             converged: termination.is_convergence(),

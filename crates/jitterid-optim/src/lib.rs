@@ -238,8 +238,35 @@ fn from_argmin_reason(
         TerminationStatus::Terminated(TerminationReason::MaxItersReached) => {
             Termination::MaxIterations
         }
+        TerminationStatus::Terminated(TerminationReason::Timeout) => Termination::TimeLimit,
         TerminationStatus::Terminated(reason) => Termination::Other(reason.text().to_string()),
         TerminationStatus::NotTerminated => Termination::Other("not terminated".to_string()),
+    }
+}
+
+/// The reason to report when the budget the solver ran under (see
+/// [`jitterid_numeric::budget`]) is spent: its time limit, or the caller's stop. Every solver
+/// asks it between iterations (the argmin-based ones after their run, with the time left as
+/// the executor's timeout), so that a spent budget ends a search as it ends with its own
+/// `max_seconds`.
+pub fn budget_termination() -> Option<Termination> {
+    jitterid_numeric::budget::stop().map(|stop| match stop {
+        jitterid_numeric::budget::Stop::TimeLimit { .. } => Termination::TimeLimit,
+        _ => Termination::Other(format!("stopped: {stop}")),
+    })
+}
+
+/// An argmin executor with the time left in the calling thread's budget as its timeout.
+pub(crate) fn with_budget_timeout<O, S, I>(
+    executor: argmin::core::Executor<O, S, I>,
+) -> argmin::core::Executor<O, S, I>
+where
+    I: argmin::core::State,
+    S: argmin::core::Solver<O, I>,
+{
+    match jitterid_numeric::budget::current().and_then(|b| b.seconds_left()) {
+        Some(left) => executor.timeout(std::time::Duration::from_secs_f64(left)),
+        None => executor,
     }
 }
 

@@ -327,6 +327,7 @@ impl LevenbergMarquardt {
     fn out_of_time(&self) -> bool {
         self.started
             .is_some_and(|t| t.elapsed().as_secs_f64() >= self.options.max_seconds)
+            || jitterid_numeric::budget::spent()
     }
 
     /// The options.
@@ -515,7 +516,7 @@ where
 
         for _ in 0..MAX_REJECTIONS {
             if self.out_of_time() {
-                self.stop = Some(Termination::TimeLimit);
+                self.stop = Some(crate::budget_termination().unwrap_or(Termination::TimeLimit));
                 return Ok((state, self.kv()));
             }
             if !self.mu.is_finite() {
@@ -608,7 +609,7 @@ where
             self.stop = Some(Termination::MaxIterations);
         }
         if self.stop.is_none() && self.out_of_time() {
-            self.stop = Some(Termination::TimeLimit);
+            self.stop = Some(crate::budget_termination().unwrap_or(Termination::TimeLimit));
         }
         match &self.stop {
             None => TerminationStatus::NotTerminated,

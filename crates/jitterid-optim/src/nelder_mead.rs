@@ -125,16 +125,21 @@ impl<P: Objective + ?Sized> Solver<P> for NelderMead {
             problem,
             scale: if v0 == 0.0 { 1.0 } else { 1.0 / v0.abs() },
         };
-        let result = Executor::new(cost, solver)
-            .configure(|state: IterState<Vec<f64>, (), (), (), (), f64>| {
-                state.max_iters(self.max_iters)
-            })
-            .ctrlc(false)
-            .run()
-            .map_err(SolverError::from_argmin)?;
+        let result = crate::with_budget_timeout(
+            Executor::new(cost, solver)
+                .configure(|state: IterState<Vec<f64>, (), (), (), (), f64>| {
+                    state.max_iters(self.max_iters)
+                })
+                .ctrlc(false),
+        )
+        .run()
+        .map_err(SolverError::from_argmin)?;
         let mut state = result.state;
-        let termination =
+        let mut termination =
             from_argmin_reason(&state.termination_status, Termination::SmallCostChange);
+        if let Some(stop) = crate::budget_termination().filter(|_| !termination.is_convergence()) {
+            termination = stop;
+        }
         let params = state
             .take_best_param()
             .or_else(|| state.take_param())

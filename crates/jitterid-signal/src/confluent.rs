@@ -35,6 +35,7 @@ use crate::signal::Jacobian;
 use crate::SampleGrid;
 use jitterid_jitter::rule::QuadratureRule;
 use jitterid_jitter::JitterModel;
+use jitterid_numeric::budget;
 
 /// A rational model and its parameter derivatives as readouts of one linear system.
 #[derive(Debug, Clone, PartialEq)]
@@ -440,6 +441,14 @@ impl Confluent {
             reach_end = reach_end.max(next_past);
             while reach_end < steps.len() && steps[reach_end].0 <= t + hi {
                 reach_end += 1;
+            }
+            if budget::spent() {
+                // The rest of the record is left unfinished (see `LtiResponse::walk`).
+                z.iter_mut().for_each(|v| *v = f64::NAN);
+                for k in k..grid.len() {
+                    visit(k, grid.time(k), &z, &[]);
+                }
+                return;
             }
             visit(k, t, &z, &steps[next_past..reach_end]);
         }

@@ -1,3 +1,4 @@
+use jitterid_numeric::limits::{self, Limit};
 use thiserror::Error;
 
 /// Why a signal model, input or sampling grid could not be built.
@@ -171,6 +172,22 @@ pub enum SignalError {
         /// The feature.
         what: &'static str,
     },
+    /// A value outside the range where the model keeps its meaning.
+    #[error("`{name}` must be {expected}, got {value}")]
+    OutOfRange {
+        /// The parameter's name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The range, in words.
+        expected: &'static str,
+    },
+    /// The work was stopped by the budget it ran under (its time limit, or the caller).
+    #[error("the simulation was stopped: {0}")]
+    Stopped(jitterid_numeric::budget::Stop),
+    /// A size beyond one of the library's documented limits (poles, tones, switches, samples).
+    #[error(transparent)]
+    Limit(#[from] jitterid_numeric::limits::LimitExceeded),
     /// The roots of a polynomial could not be found to the required accuracy.
     #[error("could not find the roots of `{name}`")]
     Roots {
@@ -239,6 +256,7 @@ pub(crate) fn tf_coefficients(num: &[f64], den: &[f64]) -> Result<(), SignalErro
             value: den.len(),
         });
     }
+    limits::check(Limit::Poles, den.len() - 1)?;
     Ok(())
 }
 

@@ -24,6 +24,7 @@ impl SampleGrid {
                 value: len,
             });
         }
+        jitterid_numeric::limits::check(jitterid_numeric::limits::Limit::Samples, len)?;
         Ok(Self {
             start,
             interval,

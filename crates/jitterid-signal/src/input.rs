@@ -1,6 +1,7 @@
 //! Known inputs `u(t)` that drive a system.
 
 use crate::error::{all_finite, increasing, positive, SignalError};
+use jitterid_numeric::limits::{self, Limit};
 use num_complex::Complex64;
 use rand::{Rng, RngCore};
 use rand_distr::{Distribution, Exp};
@@ -86,6 +87,7 @@ impl PiecewiseConstant {
                 got: edges.len(),
             });
         }
+        limits::check(Limit::Switches, edges.len())?;
         increasing("edges", &edges)?;
         all_finite("levels", &levels)?;
         Ok(Self { edges, levels })
@@ -95,6 +97,7 @@ impl PiecewiseConstant {
     /// `[start + k·interval, start + (k+1)·interval)`.
     pub fn zero_order_hold(start: f64, interval: f64, values: &[f64]) -> Result<Self, SignalError> {
         positive("interval", interval)?;
+        limits::check(Limit::Switches, values.len() + 1)?;
         let edges = (0..=values.len())
             .map(|k| start + k as f64 * interval)
             .collect();
@@ -180,7 +183,8 @@ pub struct Multisine {
 }
 
 impl Multisine {
-    /// At least one tone, all values finite, frequencies ≥ 0.
+    /// At least one tone and at most [`MAX_TONES`](limits::MAX_TONES), all values finite,
+    /// frequencies ≥ 0, phases within ±[`MAX_PHASE`](limits::MAX_PHASE) rad.
     pub fn new(tones: Vec<Tone>) -> Result<Self, SignalError> {
         if tones.is_empty() {
             return Err(SignalError::TooFew {
@@ -189,6 +193,7 @@ impl Multisine {
                 value: 0,
             });
         }
+        limits::check(Limit::Tones, tones.len())?;
         for t in &tones {
             crate::error::finite("frequency", t.frequency)?;
             if t.frequency < 0.0 {
@@ -199,6 +204,13 @@ impl Multisine {
             }
             crate::error::finite("amplitude", t.amplitude)?;
             crate::error::finite("phase", t.phase)?;
+            if !(t.phase.abs() <= limits::MAX_PHASE) {
+                return Err(SignalError::OutOfRange {
+                    name: "phase",
+                    value: t.phase,
+                    expected: "within ±1e6 rad (beyond it the tone has lost its digits)",
+                });
+            }
         }
         Ok(Self { tones })
     }
@@ -226,8 +238,9 @@ impl Multisine {
     }
 }
 
-/// The largest expected number of switches of one [`RandomBinary::generate`] call.
-pub const MAX_SWITCHES: f64 = 1e8;
+/// The largest expected number of switches of one [`RandomBinary::generate`] call: the
+/// library's limit on the switches of an input.
+pub const MAX_SWITCHES: f64 = limits::MAX_SWITCHES as f64;
 
 /// The random binary input of the paper's section 4: it switches between `low` and `high` after
 /// exponentially distributed dwell times of mean `mean_dwell`, at any time (not on the sample

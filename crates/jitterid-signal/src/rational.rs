@@ -672,6 +672,8 @@ impl Zpk {
                 poles: np,
             });
         }
+        // Before the expansion, whose sensitivities take `np²` numbers.
+        jitterid_numeric::limits::check(jitterid_numeric::limits::Limit::Poles, np)?;
         let (zn, dzn) = expand(&zeros);
         let (den, dden_p) = expand(&poles);
         let num: Vec<f64> = zn.iter().map(|c| gain * c).collect();

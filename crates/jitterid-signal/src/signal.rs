@@ -67,6 +67,10 @@ pub trait Signal: fmt::Debug + Send + Sync {
         let (lo, hi) = jitter.reach();
         grid.times()
             .map(|t| {
+                // Unfinished once the budget is spent: the caller's budget reports it.
+                if jitterid_numeric::budget::spent() {
+                    return f64::NAN;
+                }
                 let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), self.rate());
                 rule.expect(|tau| self.value(t + tau))
             })
@@ -81,6 +85,10 @@ pub trait Signal: fmt::Debug + Send + Sync {
         let (lo, hi) = jitter.reach();
         let mut g = vec![0.0; p];
         for (k, t) in grid.times().enumerate() {
+            if jitterid_numeric::budget::spent() {
+                cols.iter_mut().for_each(|c| c[k] = f64::NAN);
+                continue;
+            }
             let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), self.rate());
             for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
                 self.value_gradient(t + tau, &mut g);
@@ -114,6 +122,9 @@ pub trait Signal: fmt::Debug + Send + Sync {
         let (lo, hi) = jitter.reach();
         grid.times()
             .map(|t| {
+                if jitterid_numeric::budget::spent() {
+                    return f64::NAN;
+                }
                 let rule = jitter.rule(&local_breaks(&breaks, t, lo, hi), 2.0 * self.rate());
                 rule.expect(|tau| self.value(t + tau).powi(2))
             })

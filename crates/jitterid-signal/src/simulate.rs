@@ -51,12 +51,13 @@ pub fn simulate<S: Signal + ?Sized>(
     let n = grid.len();
     let tau: Vec<f64> = (0..n).map(|_| jitter.sample(rng)).collect();
     let noise: Vec<f64> = (0..n).map(|_| normal.sample(rng)).collect();
-    let y = grid
-        .times()
-        .zip(&tau)
-        .zip(&noise)
-        .map(|((t, &tau), &v)| signal.value(t + tau) + v)
-        .collect();
+    let mut y = Vec::with_capacity(n);
+    for ((t, &tau), &v) in grid.times().zip(&tau).zip(&noise) {
+        if let Some(stop) = jitterid_numeric::budget::stop() {
+            return Err(SignalError::Stopped(stop));
+        }
+        y.push(signal.value(t + tau) + v);
+    }
     Ok(Simulation {
         grid: *grid,
         y,

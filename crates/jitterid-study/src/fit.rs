@@ -381,8 +381,16 @@ pub fn fit(
         return Err("maximum likelihood is not available in this build of jitterid".into());
     }
     let opts = options(exp, &criterion, seed, covariance, watch).map_err(|e| e.to_string())?;
-    let (e, fitted, n) =
-        run_criterion(exp, s, record, &criterion, &opts).map_err(|e| e.to_string())?;
+    // The fit's whole work (search, covariance, flatness) under its time limit and the front
+    // end's cancel flag: a spent budget ends the search as not converged with the reason, or,
+    // when it ran out before the search began, as this error rather than the NaN it left.
+    let budget = crate::budget_of(exp, watch.cancel.clone());
+    let (e, fitted, n) = budget
+        .run(|| run_criterion(exp, s, record, &criterion, &opts))
+        .map_err(|e| match budget.stop() {
+            Some(stop) => format!("stopped before the search could begin: {stop}"),
+            None => e.to_string(),
+        })?;
     let e = Raw::of(e, fitted, n);
     let names = report_names(exp, s);
     let se = |i: usize| {

@@ -42,3 +42,19 @@ pub mod whiten;
 pub use error::{StudyError, StudyErrorKind, StudyResult};
 pub use registries::Registries;
 pub use watch::{RunsDone, Watch};
+
+/// The time limit in seconds of a fit (its search, covariance and, in a study, simulation) and
+/// of a selection when the experiment and the front end give none: no command runs unbounded.
+pub const DEFAULT_TIME_LIMIT: f64 = 600.0;
+
+/// The budget of one fit or selection of `exp`: its time limit (or [`DEFAULT_TIME_LIMIT`])
+/// and `cancel`, under the calling thread's budget.
+pub(crate) fn budget_of(
+    exp: &experiment::Experiment,
+    cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+) -> std::sync::Arc<jitterid::budget::Budget> {
+    jitterid::budget::Budget::new(
+        Some(exp.estimate.max_seconds.unwrap_or(DEFAULT_TIME_LIMIT)),
+        cancel,
+    )
+}

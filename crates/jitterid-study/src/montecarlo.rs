@@ -17,8 +17,9 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-/// Largest number of Monte Carlo realisations.
-pub const MAX_RUNS: u64 = 10_000_000;
+/// Largest number of Monte Carlo realisations: the library's limit
+/// ([`jitterid::limits::MAX_RUNS`]).
+pub const MAX_RUNS: u64 = jitterid::limits::MAX_RUNS;
 
 /// The default master seed (that of `cargo xtask reproduce`).
 pub const DEFAULT_SEED: u64 = 20_051_205;
@@ -338,18 +339,23 @@ pub fn run_study(
             if watch.cancelled() {
                 return None;
             }
-            let out = one_run(
-                exp,
-                method,
-                seed,
-                n,
-                r,
-                rng,
-                Keep {
-                    fitted: keep.fitted && r < first + KEEP_FITTED,
-                    stderr: keep.stderr,
-                },
-            );
+            // The realisation's simulation and fit under the time limit of a fit and the
+            // front end's cancel flag, which a fit inside also stops on.
+            let budget = crate::budget_of(exp, watch.cancel.clone());
+            let out = budget.run(|| {
+                one_run(
+                    exp,
+                    method,
+                    seed,
+                    n,
+                    r,
+                    rng,
+                    Keep {
+                        fitted: keep.fitted && r < first + KEEP_FITTED,
+                        stderr: keep.stderr,
+                    },
+                )
+            });
             let done = finished.fetch_add(1, Ordering::Relaxed) + 1;
             watch.run_done(RunsDone {
                 done,
@@ -358,7 +364,13 @@ pub fn run_study(
             Some(out)
         })
     });
-    let Some(outs) = outs.into_iter().collect::<Option<Vec<RunOut>>>() else {
+    // A cancel during the last realisations stops their fits (reported as stopped) without
+    // skipping any: the study is interrupted all the same.
+    let outs = outs
+        .into_iter()
+        .collect::<Option<Vec<RunOut>>>()
+        .filter(|_| !watch.cancelled());
+    let Some(outs) = outs else {
         return Err(study_err!(
             "interrupted: the study was stopped after {} of {} realisations",
             finished.load(Ordering::Relaxed),

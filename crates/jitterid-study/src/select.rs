@@ -126,8 +126,19 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
         }
         None => None,
     };
-    let ranked = run_select(&record, &input, &grid, &exp.registries.jitter, &options)
+    // The whole selection under the command's time limit: candidates still fitting when it is
+    // spent stop, and a ranking of unfinished fits is no ranking.
+    let budget = crate::budget_of(exp, None);
+    let ranked = budget
+        .run(|| run_select(&record, &input, &grid, &exp.registries.jitter, &options))
         .map_err(|e| study_err!("{}: {e}", exp.file))?;
+    if let Some(stop) = budget.stop() {
+        return Err(study_err!(
+            "{}: the selection of {} candidates was stopped: {stop} (give a longer --time-limit, or fewer candidates)",
+            exp.file,
+            ranked.len()
+        ));
+    }
     let fits: Vec<Option<f64>> = ranked
         .iter()
         .map(|c| {

@@ -60,6 +60,10 @@ pub mod estimate {
     pub use jitterid_optim as solver;
 }
 pub use jitterid_jitter as jitter;
+/// The wall-clock budget and cancel flag that every long loop checks.
+pub use jitterid_numeric::budget;
+/// The documented limits on the sizes a caller can ask for, checked where each enters.
+pub use jitterid_numeric::limits;
 pub use jitterid_signal as signal;
 pub use jitterid_window as window;
 pub use num_complex;

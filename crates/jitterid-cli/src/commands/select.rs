@@ -31,11 +31,20 @@ pub struct SelectOptions {
     pub json: bool,
     /// Write the JSON to this file instead of standard output.
     pub out: Option<PathBuf>,
+    /// Wall-clock budget of the whole selection in seconds (default
+    /// [`DEFAULT_TIME_LIMIT`](jitterid_study::DEFAULT_TIME_LIMIT)).
+    pub time_limit: Option<f64>,
 }
 
 /// `jitterid select`.
 pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
-    let exp = read_experiment(&o.experiment, Purpose::Simulate, o.paths, None, None)?;
+    let exp = read_experiment(
+        &o.experiment,
+        Purpose::Simulate,
+        o.paths,
+        None,
+        o.time_limit,
+    )?;
     let selection = run_selection(&exp, &o.data, o.validation.as_deref())?;
     let (ranked, fits) = (&selection.ranked, &selection.validation_fits);
     let status = Status::of_convergence(ranked.first().is_some_and(|c| c.converged), false);

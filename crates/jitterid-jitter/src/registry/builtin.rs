@@ -3,8 +3,9 @@
 use super::{Family, FamilyReader, JitterRegistry, ParamSpec, SpecReader, SpecTable};
 use crate::{
     AnyJitter, ExponentialDelay, Gaussian, JitterError, JitterModel, Laplace, Mixture, NoJitter,
-    Periodic, Sum, TwoPoint, UniformSum,
+    Periodic, Shifted, Sum, TwoPoint, UniformSum,
 };
+use jitterid_numeric::limits::{self, Limit};
 use serde_json::Value;
 
 /// A spec table of the given keys and values.
@@ -90,6 +91,26 @@ fn sum_terms(s: &Sum<AnyJitter, AnyJitter>) -> Vec<Value> {
     terms
 }
 
+/// The leaf terms of `j` and how many of them have a density, counted through sums (whose
+/// terms add), mixtures (the largest component counts: a component's density is evaluated
+/// on its own) and offsets: what the limits on a sum bound, since each further term with a
+/// density nests one more quadrature inside every density value.
+fn term_counts(j: &AnyJitter) -> (usize, usize) {
+    if let Some(s) = j.downcast_ref::<Sum<AnyJitter, AnyJitter>>() {
+        let ((ta, da), (tb, db)) = (term_counts(s.first()), term_counts(s.second()));
+        (ta + tb, da + db)
+    } else if let Some(m) = j.downcast_ref::<Mixture<AnyJitter>>() {
+        m.components()
+            .iter()
+            .map(term_counts)
+            .fold((1, 0), |(t, d), (tc, dc)| (t.max(tc), d.max(dc)))
+    } else if let Some(s) = j.downcast_ref::<Shifted<AnyJitter>>() {
+        term_counts(s.inner())
+    } else {
+        (1, usize::from(!j.pieces().is_empty()))
+    }
+}
+
 fn wrap_sum(s: Sum<AnyJitter, AnyJitter>) -> AnyJitter {
     AnyJitter::new("sum", s, |s: &Sum<AnyJitter, AnyJitter>| {
         spec_of([(super::TERMS_KEY, Value::Array(sum_terms(s)))])
@@ -102,7 +123,13 @@ fn sum() -> Family {
         "independent sum of two or more terms, each a spec table of its own (γ = Π γ_k)",
         Vec::new(),
         |r, registry| {
-            let mut terms = r.terms(registry, 2)?;
+            let mut terms = r.terms(registry, 2, Limit::SumTerms)?;
+            let (count, densities) = terms
+                .iter()
+                .map(term_counts)
+                .fold((0, 0), |(t, d), (tc, dc)| (t + tc, d + dc));
+            limits::check(Limit::SumTerms, count)?;
+            limits::check(Limit::DensityTerms, densities)?;
             // Nest to the right: t0 + (t1 + (… + tn)).
             let mut acc = terms
                 .pop()
@@ -155,7 +182,7 @@ fn mixture() -> Family {
             .boolean(false),
         ],
         |r, registry| {
-            let terms = r.terms(registry, 2)?;
+            let terms = r.terms(registry, 2, Limit::MixtureComponents)?;
             let weights = r.f64_list("weights")?;
             let m = Mixture::new(terms, weights).map_err(|e| r.invalid("weights", e))?;
             let m = if r.bool_or("fixed_weights", false)? {

@@ -131,7 +131,7 @@ impl JitterRegistry {
     /// front end removes its own keys (such as an experiment file's `estimate`) first; an
     /// error names the key.
     pub fn build(&self, spec: &SpecTable) -> Result<AnyJitter, JitterError> {
-        self.families.build_with(spec, Some(self))
+        representable(self.families.build_with(spec, Some(self))?)
     }
 
     /// The member of family `name` with standard deviation `sigma` (s); `spec` holds the
@@ -154,7 +154,21 @@ impl JitterRegistry {
         if !family.params().is_empty() || family.takes_terms() {
             crate::kernels::validate::positive("sigma", sigma)?;
         }
-        self.families.build_scaled(name, sigma, spec, Some(self))
+        representable(self.families.build_scaled(name, sigma, spec, Some(self))?)
+    }
+}
+
+/// `j` if its variance is finite: a member built from finite keys can still have a spread
+/// that squares to infinity (`sigma = 1e308`), whose `γ(0)` is then NaN, not 1.
+fn representable(j: AnyJitter) -> Result<AnyJitter, JitterError> {
+    let variance = crate::JitterModel::variance(&j);
+    if variance.is_finite() {
+        Ok(j)
+    } else {
+        Err(JitterError::Unrepresentable {
+            family: j.family().to_string(),
+            variance,
+        })
     }
 }
 

@@ -3,6 +3,7 @@
 
 use super::{JitterRegistry, SpecReader, FAMILY_KEY, TERMS_KEY};
 use crate::{AnyJitter, JitterError};
+use jitterid_numeric::limits::{self, Limit};
 use serde_json::Value;
 
 /// Reads of a family's [`SpecReader`] that only jitter families need.
@@ -11,8 +12,13 @@ pub trait FamilyReader {
     fn f64_list(&self, key: &str) -> Result<Vec<f64>, JitterError>;
 
     /// The terms of a composite family: every entry of `"terms"` built by `registry`, at
-    /// least `min` of them. An error inside term `i` names its key as `terms.<i>.<key>`.
-    fn terms(&self, registry: &JitterRegistry, min: usize) -> Result<Vec<AnyJitter>, JitterError>;
+    /// least `min` of them and at most `limit`'s bound (checked before any is built). An error inside term `i` names its key as `terms.<i>.<key>`.
+    fn terms(
+        &self,
+        registry: &JitterRegistry,
+        min: usize,
+        limit: Limit,
+    ) -> Result<Vec<AnyJitter>, JitterError>;
 
     /// `error` from inside term `i`, its key prefixed with `terms.<i>.`.
     fn in_term(&self, i: usize, error: JitterError) -> JitterError;
@@ -35,7 +41,12 @@ impl FamilyReader for SpecReader<'_> {
         }
     }
 
-    fn terms(&self, registry: &JitterRegistry, min: usize) -> Result<Vec<AnyJitter>, JitterError> {
+    fn terms(
+        &self,
+        registry: &JitterRegistry,
+        min: usize,
+        limit: Limit,
+    ) -> Result<Vec<AnyJitter>, JitterError> {
         let list = match self.get(TERMS_KEY) {
             Some(Value::Array(list)) => list,
             Some(other) => {
@@ -52,6 +63,7 @@ impl FamilyReader for SpecReader<'_> {
                 format!("expected at least {min} terms, found {}", list.len()),
             ));
         }
+        limits::check(limit, list.len())?;
         list.iter()
             .enumerate()
             .map(|(i, term)| {

@@ -163,7 +163,7 @@ impl ExactMl {
 /// This bound (`2¹⁸`, four times the most that one refined interval can hold; a fully refined
 /// sample of the `select` study at its estimate needs about 10³) caps the time and memory of one
 /// evaluation instead of letting such a trial point run for minutes.
-pub const MAX_SAMPLE_NODES: usize = 1 << 18;
+pub const MAX_SAMPLE_NODES: usize = jitterid_numeric::limits::MAX_QUADRATURE_NODES;
 
 /// A sample's rule would exceed [`MAX_SAMPLE_NODES`].
 #[derive(Debug, Clone, Copy, PartialEq)]

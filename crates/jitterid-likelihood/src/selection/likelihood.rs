@@ -154,9 +154,14 @@ pub(super) fn refine_finalists(
     candidates: &mut [Candidate],
 ) {
     let jobs = starts(candidates, registry);
+    let budget = jitterid_numeric::budget::current();
     let fits: Vec<_> = jobs
         .par_iter()
-        .map(|(i, start)| exact_fit(record, &candidates[*i].family, start.clone()))
+        .map(|(i, start)| {
+            jitterid_numeric::budget::run_with(budget.clone(), || {
+                exact_fit(record, &candidates[*i].family, start.clone())
+            })
+        })
         .collect();
     // Converged before not converged before failed, then the lower BIC.
     let key = |r: &ExactFit| match r {

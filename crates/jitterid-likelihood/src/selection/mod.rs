@@ -431,9 +431,14 @@ pub fn select(
         ));
     }
     let list = grid.candidates(registry, record.y().len())?;
+    let budget = jitterid_numeric::budget::current();
     let mut out: Vec<Candidate> = list
         .into_par_iter()
-        .map(|c| fit_candidate(record, input, registry, options, c))
+        .map(|c| {
+            jitterid_numeric::budget::run_with(budget.clone(), || {
+                fit_candidate(record, input, registry, options, c)
+            })
+        })
         .collect();
     if options.refine_by_likelihood {
         likelihood::refine_finalists(record, registry, &mut out);

@@ -41,6 +41,7 @@ impl ZpkForm {
                 poles: poles.len(),
             });
         }
+        jitterid_numeric::limits::check(jitterid_numeric::limits::Limit::Poles, poles.len())?;
         conjugate_closed("zero", &zeros)?;
         conjugate_closed("pole", &poles)?;
         Ok(Self { gain, zeros, poles })

@@ -14,6 +14,7 @@ use crate::signal::{Jacobian, Signal};
 use crate::spectrum::{SpectralLine, Spectrum};
 use crate::{SampleGrid, SignalError};
 use jitterid_jitter::JitterModel;
+use jitterid_numeric::budget;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
@@ -423,6 +424,17 @@ impl<M: RationalModel> LtiResponse<M> {
             reach_end = reach_end.max(next_past);
             while reach_end < steps.len() && steps[reach_end].0 <= t + hi {
                 reach_end += 1;
+            }
+            if budget::spent() {
+                // The rest of the record is left unfinished: NaN states and no steps in reach
+                // (whose rules are the expensive part), which the caller's budget reports.
+                x.iter_mut()
+                    .chain(y.iter_mut())
+                    .for_each(|v| *v = Complex64::new(f64::NAN, 0.0));
+                for k in k..grid.len() {
+                    visit(k, grid.time(k), f64::NAN, &x, &y, &[]);
+                }
+                return;
             }
             visit(k, t, u_past, &x, &y, &steps[next_past..reach_end]);
         }

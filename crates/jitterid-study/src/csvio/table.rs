@@ -348,8 +348,9 @@ pub fn parse(name: &str, text: &str) -> Result<Table, CsvError> {
     })
 }
 
-/// Largest input file accepted (1 GiB).
-pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Largest input file accepted (1 GiB): the library's limit
+/// ([`jitterid::limits::MAX_FILE_BYTES`]).
+pub const MAX_FILE_BYTES: u64 = jitterid::limits::MAX_FILE_BYTES;
 
 /// Fails unless `path` is a regular file of at most [`MAX_FILE_BYTES`] (so that a device or a
 /// pipe given by mistake cannot block or exhaust memory).

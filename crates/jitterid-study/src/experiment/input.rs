@@ -14,8 +14,9 @@ use jitterid::signal::registry::KIND_KEY;
 use jitterid::signal::{Input, Multisine, RandomBinary, SampleGrid, Tone};
 use toml::Spanned;
 
-/// Largest expected number of switches of a random binary input over its span.
-pub const MAX_SWITCHES: f64 = 1e6;
+/// Largest expected number of switches of a random binary input over its span: the
+/// library's limit on an input's switches ([`jitterid::limits::MAX_SWITCHES`]).
+pub const MAX_SWITCHES: f64 = jitterid::limits::MAX_SWITCHES as f64;
 
 const S: &str = "input";
 const KINDS: &str = "\"random-binary\", \"sine\", \"multisine\", \"piecewise\" or \"csv\"";

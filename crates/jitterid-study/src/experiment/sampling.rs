@@ -6,8 +6,9 @@ use super::raw::RawSampling;
 use crate::error::StudyResult;
 use jitterid::signal::SampleGrid;
 
-/// Largest number of samples accepted.
-pub const MAX_SAMPLES: i64 = 10_000_000;
+/// Largest number of samples accepted: the library's limit
+/// ([`jitterid::limits::MAX_SAMPLES`]).
+pub const MAX_SAMPLES: i64 = jitterid::limits::MAX_SAMPLES as i64;
 
 const S: &str = "sampling";
 
