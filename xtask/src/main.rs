@@ -2,6 +2,7 @@
 #![allow(clippy::type_complexity)]
 
 mod demo;
+mod memory;
 mod outputs;
 mod paper;
 mod reproduce;
@@ -20,6 +21,8 @@ const USAGE: &str = "usage:
       BCLS evaluation and fit time against the record length (default 200 … 10^6)
   cargo xtask speedup
       the Table 2 study on 1 and 2 threads: wall time and identical results
+  cargo xtask memory [N] [--out DIR]
+      peak memory of the release binary's simulate, fit and montecarlo at N samples (default 10^7)
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
       cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, all";
 
@@ -84,6 +87,24 @@ fn parse(args: &[String]) -> Result<(String, Options), String> {
     Ok((case.ok_or("which case?")?, o))
 }
 
+/// `memory [N] [--out DIR]`: the record length (default 10⁷) and where its files go.
+fn memory_args(args: &[String]) -> Result<(u64, std::path::PathBuf), String> {
+    let mut n = 10_000_000;
+    let mut dir = std::path::PathBuf::from("target/memory");
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--out" => dir = it.next().ok_or("--out needs a directory")?.into(),
+            s => {
+                n = s
+                    .parse()
+                    .map_err(|_| format!("memory takes a record length, found `{s}`"))?
+            }
+        }
+    }
+    Ok((n, dir))
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
@@ -100,6 +121,7 @@ fn main() -> ExitCode {
             }
         }
         Some("speedup") => scale::speedup(),
+        Some("memory") => memory_args(&args[1..]).and_then(|(n, dir)| memory::run(n, &dir)),
         Some("reproduce") => parse(&args[1..]).and_then(|(case, o)| reproduce::run(&case, &o)),
         _ => Err(USAGE.to_string()),
     };

@@ -7,25 +7,30 @@
 //! 2. the directories the files go to are locked (`flock`, exclusive, advisory; each once, in
 //!    one order), waiting up to 30 s for another writer, so that two commands writing the same
 //!    files never interleave (one's data file beside the other's side file);
-//! 3. stale temporaries there (`.<name>.jitterid-{tmp,old,moved}-<pid>-<hex>`, left by a
-//!    killed writer; with the lock held every such file is stale) are removed, and a replaced
-//!    file that a kill left moved aside is put back where its file is missing;
+//! 3. a set that a killed writer left half renamed there is finished or undone from its
+//!    journal (step 6; [`journal`]), then stale temporaries
+//!    (`.<name>.jitterid-{tmp,old,moved}-<pid>-<hex>`; with the lock held every such file is
+//!    stale) are removed, and a replaced file that a kill left moved aside is put back where
+//!    its file is missing;
 //! 4. each file is written to a new temporary in its target's directory, created with `O_EXCL`
 //!    (never through a link, never over another file) and synced;
-//! 5. the temporaries are renamed into place one by one; before each rename, what was there is
-//!    kept under a fresh name by a second hard link (`link` fails on an existing name, another
-//!    name is drawn) or, where the file system has no hard links, by renaming it there (a
-//!    rename replaces a name, it never writes through it). Nothing is ever copied, so a link
-//!    planted at any of these names is never followed;
-//! 6. devices and FIFOs are written last (they cannot be rolled back);
-//! 7. only then are the kept predecessors removed and the locks released.
+//! 5. what each file replaces is kept under a fresh name by a second hard link (`link` fails on
+//!    an existing name, another name is drawn) or, where the file system has no hard links, by
+//!    renaming it there (a rename replaces a name, it never writes through it). Nothing is ever
+//!    copied, so a link planted at any of these names is never followed;
+//! 6. a journal naming every file of the set, its temporary and its kept predecessor is written
+//!    (synced) in each directory of the set;
+//! 7. the temporaries are renamed into place one by one, then devices and FIFOs are written
+//!    (they cannot be rolled back);
+//! 8. only then is the journal removed, then the kept predecessors, and the locks released.
 //!
 //! If any step fails, the temporaries are removed and the files already renamed are restored
-//! from what was kept, so previous outputs are left untouched. A kill during step 5 can still
-//! leave some files new and the rest old (each file whole); the next commit to the same
-//! directory removes the temporaries. Where a directory cannot be locked (not readable, a file
-//! system without `flock`), the set is written unlocked and only temporaries of processes that
-//! are no longer running are cleaned.
+//! from what was kept (the journal marked for undoing first), so previous outputs are left
+//! untouched. A kill at any point leaves a set that the next commit to any of its directories
+//! makes all old (killed before the journal was whole, or while undoing) or all new (killed
+//! during the renames or after them), and whose temporaries it removes. Where a directory
+//! cannot be locked (not readable, a file system without `flock`), the set is written unlocked
+//! and only journals and temporaries of processes that are no longer running are taken.
 //!
 //! What a destination may be:
 //! - absent, or a regular file: replaced atomically (keeping the old file's permissions);
@@ -36,8 +41,11 @@
 //!   refused with an error instead of blocking for ever;
 //! - anything else (a directory, a block device, a socket, a link to nothing): refused.
 
+mod journal;
+
 use jitterid_study::error::StudyResult;
 use jitterid_study::study_err;
+use std::collections::BTreeSet;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -242,6 +250,11 @@ enum Kind {
     /// if its file is missing (a kill between the two renames), removed otherwise (kept if its
     /// name was shortened).
     Moved,
+    /// A copy of a set's journal (`journal`, [`journal`]): the set is finished by the next
+    /// writer.
+    Journal,
+    /// A copy of a set's journal marked for undoing (`undo`): the set is rolled back.
+    Undo,
 }
 
 impl Kind {
@@ -250,13 +263,21 @@ impl Kind {
             Kind::New => "tmp",
             Kind::Linked => "old",
             Kind::Moved => "moved",
+            Kind::Journal => "journal",
+            Kind::Undo => "undo",
         }
     }
 
     fn from_tag(tag: &str) -> Option<Self> {
-        [Kind::New, Kind::Linked, Kind::Moved]
-            .into_iter()
-            .find(|k| k.tag() == tag)
+        [
+            Kind::New,
+            Kind::Linked,
+            Kind::Moved,
+            Kind::Journal,
+            Kind::Undo,
+        ]
+        .into_iter()
+        .find(|k| k.tag() == tag)
     }
 }
 
@@ -264,6 +285,15 @@ impl Kind {
 /// with 64 random bits. The name is only a candidate: it is created with `O_EXCL` or linked
 /// (which fails on an existing name), never opened if it exists.
 fn fresh_name(target: &Path, kind: Kind) -> PathBuf {
+    let name: String = target
+        .file_name()
+        .map(|n| n.to_string_lossy().chars().take(NAME_KEPT).collect())
+        .unwrap_or_else(|| "output".into());
+    temp_name(dir_of(target), &name, kind, &fresh_stamp())
+}
+
+/// `<pid>-<hex>`: this process and 64 random bits, drawn afresh at each call.
+fn fresh_stamp() -> String {
     use std::hash::{BuildHasher, Hasher};
     use std::sync::atomic::{AtomicU64, Ordering};
     static COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -272,16 +302,12 @@ fn fresh_name(target: &Path, kind: Kind) -> PathBuf {
     if let Ok(t) = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH) {
         h.write_u128(t.as_nanos());
     }
-    let name: String = target
-        .file_name()
-        .map(|n| n.to_string_lossy().chars().take(NAME_KEPT).collect())
-        .unwrap_or_else(|| "output".into());
-    dir_of(target).join(format!(
-        ".{name}{MARK}{}-{}-{:016x}",
-        kind.tag(),
-        std::process::id(),
-        h.finish()
-    ))
+    format!("{}-{:016x}", std::process::id(), h.finish())
+}
+
+/// `dir/.<name>.jitterid-<kind>-<stamp>`.
+fn temp_name(dir: &Path, name: &str, kind: Kind, stamp: &str) -> PathBuf {
+    dir.join(format!(".{name}{MARK}{}-{stamp}", kind.tag()))
 }
 
 /// A temporary's kind, writer's pid and the file it belongs to, from its name; `None` for a
@@ -339,6 +365,10 @@ fn clean_stale(dir: &Path, locked: bool) {
             continue;
         };
         if !locked && may_be_alive(pid) {
+            continue;
+        }
+        if matches!(kind, Kind::Journal | Kind::Undo) {
+            // Taken by the recovery of its set, never removed on its own.
             continue;
         }
         let path = entry.path();
@@ -408,110 +438,208 @@ fn lock_dir(dir: &Path, wait: Duration) -> StudyResult<Option<DirLock>> {
 }
 
 /// Locks the directories the regular files of `targets` go to (each once, in one order, so
-/// that two writers never wait on each other) and cleans the stale temporaries there.
+/// that two writers never wait on each other), finishes or undoes the sets a killed writer left
+/// there ([`journal`]) and cleans the stale temporaries.
 fn lock_and_clean(targets: &[Target]) -> StudyResult<Vec<DirLock>> {
-    let dirs: std::collections::BTreeSet<PathBuf> = targets
+    let dirs: BTreeSet<PathBuf> = targets
         .iter()
         .filter_map(|t| match t {
-            Target::Replace(p) => {
-                let d = dir_of(p);
-                Some(std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf()))
-            }
+            Target::Replace(p) => Some(absolute_dir(p)),
             Target::Stream(_) => None,
         })
         .collect();
     let mut locks = Vec::with_capacity(dirs.len());
+    let mut locked = Vec::with_capacity(dirs.len());
     for d in &dirs {
         let lock = lock_dir(d, LOCK_WAIT)?;
-        clean_stale(d, lock.is_some());
+        locked.push(lock.is_some());
         locks.extend(lock);
+    }
+    // A killed writer's set may reach into directories this one does not write: the recovery
+    // locks those too, and holds them with the others.
+    let mut held_dirs = dirs.clone();
+    for (d, &is_locked) in dirs.iter().zip(&locked) {
+        journal::recover(d, is_locked, &mut locks, &mut held_dirs)?;
+        clean_stale(d, is_locked);
     }
     Ok(locks)
 }
 
-/// A temporary that is removed when dropped unless it was kept.
-struct Temp {
-    path: Option<PathBuf>,
+/// The directory of `path`, absolute and with its links resolved where it exists (so that a
+/// journal names files that a writer started elsewhere finds).
+fn absolute_dir(path: &Path) -> PathBuf {
+    let d = dir_of(path);
+    std::fs::canonicalize(d).unwrap_or_else(|_| {
+        std::env::current_dir()
+            .map(|cwd| cwd.join(d))
+            .unwrap_or_else(|_| d.to_path_buf())
+    })
 }
 
-impl Temp {
-    fn path(&self) -> &Path {
-        self.path.as_deref().expect("a temporary not yet kept")
-    }
-
-    /// Gives the file up to the caller: it is no longer removed on drop.
-    fn keep(mut self) -> PathBuf {
-        self.path.take().expect("a temporary not yet kept")
-    }
+/// Where a commit can be stopped as a kill would stop it, for the tests of the recovery.
+#[cfg_attr(not(test), allow(dead_code))]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum KillPoint {
+    /// The new files staged, the old ones kept aside, no journal yet.
+    BeforeJournal,
+    /// After this many renames (the journal written).
+    AfterRenames(usize),
+    /// Every rename done, the journal removed, the old files still kept aside.
+    AfterJournal,
+    /// A rename failed and this many of the files renamed before it were put back.
+    WhileUndoing(usize),
 }
 
-impl Drop for Temp {
-    fn drop(&mut self) {
-        if let Some(p) = self.path.take() {
-            let _ = std::fs::remove_file(p);
-        }
-    }
-}
-
-/// A file renamed into place, with where its predecessor was kept (to restore on failure, or
-/// remove once the whole set is in place).
-struct Placed {
-    target: PathBuf,
-    previous: Option<Temp>,
+/// The error of a commit stopped at a [`KillPoint`]: everything is left as a killed process
+/// would leave it.
+fn killed() -> jitterid_study::error::StudyError {
+    study_err!("stopped as by a kill (a test)")
 }
 
 fn write_all(files: &[(PathBuf, Vec<u8>)], targets: &[Target]) -> StudyResult<()> {
-    write_all_with(files, targets, &mut fresh_name, READER_WAIT)
+    write_all_with(files, targets, &mut fresh_name, READER_WAIT, None)
 }
 
-/// [`write_all`] with the names of temporaries drawn from `names` (a test plants files there)
-/// and a FIFO's reader awaited for `reader_wait`.
+/// [`write_all`] with the names of temporaries drawn from `names` (a test plants files there),
+/// a FIFO's reader awaited for `reader_wait`, and the commit stopped at `kill` (a test).
+///
+/// The regular files are staged, what they replace is kept aside, the journal is written,
+/// the staged files are renamed into place, devices and FIFOs are written, and only then is
+/// the journal removed and what was kept aside deleted. On an error every step is undone.
 fn write_all_with(
     files: &[(PathBuf, Vec<u8>)],
     targets: &[Target],
     names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
     reader_wait: Duration,
+    kill: Option<KillPoint>,
 ) -> StudyResult<()> {
-    let mut staged: Vec<(Temp, &Path, &Path)> = Vec::new();
-    for ((path, contents), target) in files.iter().zip(targets) {
-        if let Target::Replace(p) = target {
-            staged.push((stage(p, contents, path, names)?, p, path));
-        }
-    }
-    let mut placed: Vec<Placed> = Vec::new();
-    for (tmp, target, path) in staged {
-        match place(tmp, target, names) {
-            Ok(p) => placed.push(p),
-            Err(e) => {
-                roll_back(placed);
-                return Err(study_err!("{}: cannot write: {e}", path.display()));
+    let mut entries: Vec<journal::Entry> = Vec::new();
+    // How each file's predecessor was kept, and the file's name as the user gave it.
+    let mut kinds: Vec<Option<Kind>> = Vec::new();
+    let mut shown: Vec<&Path> = Vec::new();
+    let undo_staged = |entries: &[journal::Entry], kinds: &[Option<Kind>]| {
+        for (e, k) in entries.iter().zip(kinds) {
+            let _ = std::fs::remove_file(&e.new);
+            match (k, &e.aside) {
+                (Some(Kind::Moved), Some(a)) => {
+                    let _ = std::fs::rename(a, &e.target);
+                }
+                (_, Some(a)) => {
+                    let _ = std::fs::remove_file(a);
+                }
+                _ => {}
             }
         }
+    };
+    for ((path, contents), target) in files.iter().zip(targets) {
+        let Target::Replace(p) = target else {
+            continue;
+        };
+        // Absolute names: a later writer that finishes the set may run elsewhere.
+        let dir = absolute_dir(p);
+        let target = p.file_name().map_or_else(|| p.clone(), |f| dir.join(f));
+        let (new, id) = match stage(&target, contents, path, names) {
+            Ok(staged) => staged,
+            Err(e) => {
+                undo_staged(&entries, &kinds);
+                return Err(e);
+            }
+        };
+        let previous = match std::fs::symlink_metadata(&target) {
+            Ok(m) if !m.is_dir() => match keep_aside(&target, names, true) {
+                Ok((aside, kind)) => Some((aside, kind)),
+                Err(e) => {
+                    let _ = std::fs::remove_file(&new);
+                    undo_staged(&entries, &kinds);
+                    return Err(study_err!("{}: cannot write: {e}", path.display()));
+                }
+            },
+            _ => None,
+        };
+        kinds.push(previous.as_ref().map(|(_, k)| *k));
+        shown.push(path);
+        entries.push(journal::Entry {
+            target,
+            new,
+            aside: previous.map(|(a, _)| a),
+            id,
+        });
+    }
+    if kill == Some(KillPoint::BeforeJournal) {
+        return Err(killed());
+    }
+    let journal = journal::Journal::new(entries);
+    if let Err(e) = journal.write() {
+        journal.remove();
+        undo_staged(&journal.entries, &kinds);
+        return Err(study_err!("cannot write the outputs' journal: {e}"));
+    }
+    // Puts back what the first `placed` renames replaced, the journal marked for undoing
+    // first so that a kill meanwhile is undone by the next writer, not finished.
+    let undo = |placed: usize, kill: Option<KillPoint>| -> StudyResult<()> {
+        journal.mark_undo();
+        for (i, e) in journal.entries[..placed].iter().enumerate().rev() {
+            if kill == Some(KillPoint::WhileUndoing(placed - 1 - i)) {
+                return Err(killed());
+            }
+            match &e.aside {
+                Some(a) => {
+                    let _ = std::fs::rename(a, &e.target);
+                }
+                None => {
+                    let _ = std::fs::remove_file(&e.target);
+                }
+            }
+        }
+        undo_staged(&journal.entries[placed..], &kinds[placed..]);
+        journal.remove();
+        Ok(())
+    };
+    for (i, e) in journal.entries.iter().enumerate() {
+        if kill == Some(KillPoint::AfterRenames(i)) {
+            return Err(killed());
+        }
+        if let Err(err) = std::fs::rename(&e.new, &e.target) {
+            undo(i, kill)?;
+            return Err(study_err!("{}: cannot write: {err}", shown[i].display()));
+        }
+    }
+    if kill == Some(KillPoint::AfterRenames(journal.entries.len())) {
+        return Err(killed());
     }
     for ((path, contents), target) in files.iter().zip(targets) {
         if let Target::Stream(p) = target {
             if let Err(e) = stream(p, contents, reader_wait) {
-                roll_back(placed);
+                undo(journal.entries.len(), kill)?;
                 return Err(study_err!("{}: cannot write: {e}", path.display()));
             }
         }
     }
-    // Every file is in place: the predecessors go (each `Temp` removes its file).
-    drop(placed);
+    // Every file is in place: the set is new, and what it replaced goes.
+    journal.remove();
+    if kill == Some(KillPoint::AfterJournal) {
+        return Err(killed());
+    }
+    for e in &journal.entries {
+        if let Some(a) = &e.aside {
+            let _ = std::fs::remove_file(a);
+        }
+    }
     Ok(())
 }
 
 /// Writes `contents` to a new temporary beside `target`, created with `O_EXCL` (so never
-/// through a link or over another file).
+/// through a link or over another file) and synced; returns its name and identity.
 fn stage(
     target: &Path,
     contents: &[u8],
     path: &Path,
     names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
-) -> StudyResult<Temp> {
-    let result = (|| -> std::io::Result<Temp> {
+) -> StudyResult<(PathBuf, journal::FileId)> {
+    let mut created: Option<PathBuf> = None;
+    let result = (|| -> std::io::Result<()> {
         let mut attempt = 0;
-        let (file, tmp) = loop {
+        let mut file = loop {
             let candidate = names(target, Kind::New);
             // A new file gets the permissions `File::create` would give (0666 less the umask),
             // a replaced one keeps its own.
@@ -521,12 +649,8 @@ fn stage(
                 .open(&candidate)
             {
                 Ok(f) => {
-                    break (
-                        f,
-                        Temp {
-                            path: Some(candidate),
-                        },
-                    )
+                    created = Some(candidate);
+                    break f;
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < 100 => {
                     attempt += 1
@@ -534,15 +658,28 @@ fn stage(
                 Err(e) => return Err(e),
             }
         };
-        let mut file = file;
         if let Ok(m) = std::fs::metadata(target) {
             file.set_permissions(m.permissions())?;
         }
         file.write_all(contents)?;
         file.sync_all()?;
-        Ok(tmp)
+        Ok(())
     })();
-    result.map_err(|e| study_err!("{}: cannot write: {e}", path.display()))
+    match (result, created) {
+        (Ok(()), Some(tmp)) => {
+            let id = journal::file_id(&tmp);
+            Ok((tmp, id))
+        }
+        (result, created) => {
+            if let Some(tmp) = created {
+                let _ = std::fs::remove_file(tmp);
+            }
+            let e = result
+                .err()
+                .unwrap_or_else(|| std::io::Error::other("no temporary created"));
+            Err(study_err!("{}: cannot write: {e}", path.display()))
+        }
+    }
 }
 
 /// Keeps what is at `target` under a fresh name beside it: a second hard link (`link` never
@@ -554,61 +691,24 @@ fn keep_aside(
     target: &Path,
     names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
     hard_links: bool,
-) -> std::io::Result<(Temp, Kind)> {
+) -> std::io::Result<(PathBuf, Kind)> {
     for _ in 0..100 {
         if hard_links {
             let aside = names(target, Kind::Linked);
             match std::fs::hard_link(target, &aside) {
-                Ok(()) => return Ok((Temp { path: Some(aside) }, Kind::Linked)),
+                Ok(()) => return Ok((aside, Kind::Linked)),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
                 Err(_) => {}
             }
         }
         let aside = names(target, Kind::Moved);
         std::fs::rename(target, &aside)?;
-        return Ok((Temp { path: Some(aside) }, Kind::Moved));
+        return Ok((aside, Kind::Moved));
     }
     Err(std::io::Error::new(
         std::io::ErrorKind::AlreadyExists,
         "no free name for a temporary beside it",
     ))
-}
-
-/// Renames the temporary over `target`, keeping what was there aside (see [`keep_aside`]).
-fn place(
-    tmp: Temp,
-    target: &Path,
-    names: &mut dyn FnMut(&Path, Kind) -> PathBuf,
-) -> std::io::Result<Placed> {
-    let previous = match std::fs::symlink_metadata(target) {
-        Ok(m) if !m.is_dir() => Some(keep_aside(target, names, true)?),
-        _ => None,
-    };
-    if let Err(e) = std::fs::rename(tmp.path(), target) {
-        if let Some((aside, Kind::Moved)) = previous {
-            let _ = std::fs::rename(aside.keep(), target);
-        }
-        return Err(e);
-    }
-    let _ = tmp.keep();
-    Ok(Placed {
-        target: target.to_path_buf(),
-        previous: previous.map(|(aside, _)| aside),
-    })
-}
-
-/// Restores what the renamed files replaced (or removes them where there was nothing).
-fn roll_back(placed: Vec<Placed>) {
-    for p in placed.into_iter().rev() {
-        match p.previous {
-            Some(aside) => {
-                let _ = std::fs::rename(aside.keep(), &p.target);
-            }
-            None => {
-                let _ = std::fs::remove_file(&p.target);
-            }
-        }
-    }
 }
 
 /// Writes into a device or FIFO without replacing it. The open does not wait for a FIFO's
@@ -791,7 +891,7 @@ mod tests {
         };
         let files = vec![(out.clone(), b"new output".to_vec())];
         let targets = vec![Target::Replace(out.clone())];
-        write_all_with(&files, &targets, &mut names, READER_WAIT).unwrap();
+        write_all_with(&files, &targets, &mut names, READER_WAIT, None).unwrap();
         assert!(!first, "the planted name was tried");
         assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "new output");
@@ -803,11 +903,11 @@ mod tests {
         // link is replaced, not followed.
         let mut names = |_: &Path, _: Kind| planted.clone();
         let (aside, kind) = keep_aside(&out, &mut names, false).unwrap();
-        assert_eq!((aside.path(), kind), (planted.as_path(), Kind::Moved));
+        assert_eq!((aside.as_path(), kind), (planted.as_path(), Kind::Moved));
         assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
         assert_eq!(std::fs::read_to_string(&planted).unwrap(), "new output");
         assert!(!out.exists());
-        drop(aside);
+        std::fs::remove_file(&aside).unwrap();
         assert!(!planted.exists() && victim.exists());
     }
 
@@ -840,6 +940,106 @@ mod tests {
             assert_eq!(d, s.repeat(20_000), "round {round}: a mixed set");
             assert_eq!(names(dir.path()), ["d.csv", "d.input.csv"]);
         }
+    }
+
+    /// A commit stopped at each point where a kill could stop it, over a set spread on two
+    /// directories (a data file and its side file, and a figure elsewhere): the next commit in
+    /// either directory leaves the set all old (killed before the journal was written, or
+    /// while undoing after an error) or all new (killed during or after the renames), never
+    /// mixed, and no temporary or journal stays behind.
+    #[test]
+    fn a_kill_at_any_point_of_a_commit_leaves_a_set_the_next_run_makes_whole() {
+        use KillPoint::*;
+        let cases = [
+            (BeforeJournal, "old"),
+            (AfterRenames(0), "new"),
+            (AfterRenames(1), "new"),
+            (AfterRenames(2), "new"),
+            (AfterRenames(3), "new"),
+            (AfterJournal, "new"),
+            (WhileUndoing(0), "old"),
+            (WhileUndoing(2), "old"),
+        ];
+        for (kill, expected) in cases {
+            let root = tempfile::tempdir().unwrap();
+            let (dir, figs) = (root.path().join("out"), root.path().join("figs"));
+            std::fs::create_dir(&dir).unwrap();
+            std::fs::create_dir(&figs).unwrap();
+            let set = [
+                dir.join("d.csv"),
+                dir.join("d.input.csv"),
+                figs.join("f.svg"),
+            ];
+            let mut old = OutputSet::new();
+            for p in &set {
+                old.file(p, "old");
+            }
+            old.commit().unwrap();
+            let mut files: Vec<(PathBuf, Vec<u8>)> =
+                set.iter().map(|p| (p.clone(), b"new".to_vec())).collect();
+            if matches!(kill, WhileUndoing(_)) {
+                // A non-empty directory cannot be renamed over: the last rename fails, and the
+                // commit undoes the three before it.
+                let blocked = dir.join("blocked");
+                std::fs::create_dir(&blocked).unwrap();
+                std::fs::write(blocked.join("inside"), "x").unwrap();
+                files.push((blocked, b"never".to_vec()));
+            }
+            let targets: Vec<Target> = files
+                .iter()
+                .map(|(p, _)| Target::Replace(p.clone()))
+                .collect();
+            let e = write_all_with(&files, &targets, &mut fresh_name, READER_WAIT, Some(kill))
+                .unwrap_err();
+            assert!(e.message().contains("kill"), "{kill:?}: {e}");
+            // The next commit, writing into the figure directory only.
+            lock_and_clean(&[Target::Replace(figs.join("other.svg"))]).unwrap();
+            let now: Vec<String> = set
+                .iter()
+                .map(|p| std::fs::read_to_string(p).unwrap())
+                .collect();
+            assert_eq!(now, [expected; 3], "{kill:?}");
+            // And one in the other: nothing of the killed commit is left.
+            lock_and_clean(&[Target::Replace(dir.join("other.csv"))]).unwrap();
+            let mut want = vec!["d.csv", "d.input.csv"];
+            if matches!(kill, WhileUndoing(_)) {
+                want.insert(0, "blocked");
+            }
+            assert_eq!(names(&dir), want, "{kill:?}");
+            assert_eq!(names(&figs), ["f.svg"], "{kill:?}");
+        }
+    }
+
+    /// A recovery that is itself killed is taken up again by the next writer: a set killed
+    /// during its renames, then its recovery stopped half way (one staged file renamed by the
+    /// recovery, the journal still there), ends all new.
+    #[test]
+    fn a_recovery_killed_half_way_is_finished_by_the_next() {
+        let dir = tempfile::tempdir().unwrap();
+        let set = [dir.path().join("a.csv"), dir.path().join("b.csv")];
+        let mut old = OutputSet::new();
+        for p in &set {
+            old.file(p, "old");
+        }
+        old.commit().unwrap();
+        let files: Vec<(PathBuf, Vec<u8>)> =
+            set.iter().map(|p| (p.clone(), b"new".to_vec())).collect();
+        let targets: Vec<Target> = set.iter().map(|p| Target::Replace(p.clone())).collect();
+        let kill = Some(KillPoint::AfterRenames(0));
+        write_all_with(&files, &targets, &mut fresh_name, READER_WAIT, kill).unwrap_err();
+        // What the recovery does first, by hand: the first staged file renamed into place.
+        let staged: Vec<PathBuf> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.to_string_lossy().contains(".a.csv.jitterid-tmp-"))
+            .collect();
+        assert_eq!(staged.len(), 1);
+        std::fs::rename(&staged[0], &set[0]).unwrap();
+        lock_and_clean(&targets).unwrap();
+        for p in &set {
+            assert_eq!(std::fs::read_to_string(p).unwrap(), "new");
+        }
+        assert_eq!(names(dir.path()), ["a.csv", "b.csv"]);
     }
 
     /// Temporaries a killed writer left (named after a process that is gone) are removed by
@@ -933,6 +1133,7 @@ mod tests {
             &targets,
             &mut fresh_name,
             Duration::from_millis(200),
+            None,
         )
         .unwrap_err();
         assert!(
@@ -948,7 +1149,14 @@ mod tests {
             let fifo = fifo.clone();
             std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
         };
-        write_all_with(&files, &targets, &mut fresh_name, Duration::from_secs(30)).unwrap();
+        write_all_with(
+            &files,
+            &targets,
+            &mut fresh_name,
+            Duration::from_secs(30),
+            None,
+        )
+        .unwrap();
         assert_eq!(reader.join().unwrap(), "never read");
         assert_eq!(std::fs::read_to_string(&data).unwrap(), "new");
     }

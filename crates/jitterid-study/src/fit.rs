@@ -502,10 +502,21 @@ pub fn fit_values(
     data: &str,
     watch: &Watch,
 ) -> StudyResult<Fit> {
-    let method = exp.estimate.method;
     let record = record(&exp.grid, y).map_err(|e| study_err!("{data}: {e}"))?;
+    fit_record(exp, signal, &record, watch)
+}
+
+/// [`fit_values`] of a record already made: a caller that keeps the samples (for figures)
+/// shares them with the fit instead of handing it a copy.
+pub fn fit_record(
+    exp: &Experiment,
+    signal: AnySignal,
+    record: &Record,
+    watch: &Watch,
+) -> StudyResult<Fit> {
+    let method = exp.estimate.method;
     let s = structure(exp, signal, method)?;
-    fit(exp, &s, &record, method, 0, true, watch).map_err(|e| {
+    fit(exp, &s, record, method, 0, true, watch).map_err(|e| {
         study_err!(
             "{}: fit with method {} failed: {e}",
             exp.file,

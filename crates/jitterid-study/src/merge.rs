@@ -55,35 +55,56 @@ fn part_of(name: String, json: McJson) -> StudyResult<Part> {
     })
 }
 
-/// The first field in which `p` and `first` differ, as (what, this value, first value).
+/// A text from a shard file as a message quotes it: between double quotes as it was written
+/// (no escapes of quotes, backslashes or non-ASCII text, unlike Rust's `{:?}`), with only the
+/// characters a terminal would act on (control characters) escaped, and at most
+/// [`QUOTED_CHARS`] characters (`…` marks a cut) of a file that may not be the user's.
+fn quoted(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars().take(QUOTED_CHARS) {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    if s.chars().count() > QUOTED_CHARS {
+        out.push('…');
+    }
+    out.push('"');
+    out
+}
+
+/// Most characters of a text from a shard file that a message quotes (a fingerprint is 64).
+const QUOTED_CHARS: usize = 80;
+
+/// The first field in which `p` and `first` differ, as (what, this value, first value), each
+/// value as a message shows it: numbers as they are, texts [`quoted`].
 fn identity_mismatch(p: &Part, first: &Part) -> Option<(&'static str, String, String)> {
-    let fields: [(&'static str, String, String); 6] = [
+    let text = |a: &str, b: &str| (a != b).then(|| (quoted(a), quoted(b)));
+    let number = |a: u64, b: u64| (a != b).then(|| (a.to_string(), b.to_string()));
+    let fields: [(&'static str, Option<(String, String)>); 6] = [
         (
             "program version",
-            p.json.program.clone(),
-            first.json.program.clone(),
+            text(&p.json.program, &first.json.program),
         ),
-        ("seed", p.json.seed.to_string(), first.json.seed.to_string()),
-        ("method", p.json.method.clone(), first.json.method.clone()),
+        ("seed", number(p.json.seed, first.json.seed)),
+        ("method", text(&p.json.method, &first.json.method)),
         (
             "run count",
-            p.shard.runs_total.to_string(),
-            first.shard.runs_total.to_string(),
+            number(p.shard.runs_total, first.shard.runs_total),
         ),
-        (
-            "shard count",
-            p.shard.count.to_string(),
-            first.shard.count.to_string(),
-        ),
+        ("shard count", number(p.shard.count, first.shard.count)),
         // Last: the method is part of the parsed experiment too, so a more specific field
         // above names the difference when there is one.
         (
             "experiment (fingerprint of its contents)",
-            p.json.fingerprint.clone(),
-            first.json.fingerprint.clone(),
+            text(&p.json.fingerprint, &first.json.fingerprint),
         ),
     ];
-    fields.into_iter().find(|(_, a, b)| a != b)
+    fields
+        .into_iter()
+        .find_map(|(what, differ)| differ.map(|(this, theirs)| (what, this, theirs)))
 }
 
 /// An optional value as a message shows it: the number, or `none` (`null` in the file).
@@ -206,7 +227,7 @@ fn merge_parts(parts: &[Part]) -> StudyResult<McJson> {
     for p in parts {
         if let Some((what, this, theirs)) = identity_mismatch(p, first) {
             return Err(study_err!(
-                "{}: belongs to another study than {}: its {what} is {this:?}, not {theirs:?}",
+                "{}: belongs to another study than {}: its {what} is {this}, not {theirs}",
                 p.name,
                 first.name
             ));
@@ -269,4 +290,71 @@ fn merge_parts(parts: &[Part]) -> StudyResult<McJson> {
         realizations: None,
     };
     Ok(merged)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Shard `index` of a two-shard study of two runs, with no parameters.
+    fn shard(index: u64, program: &str, seed: u64) -> (String, McJson) {
+        let runs = vec![Realization {
+            run: index,
+            converged: true,
+            termination: "converged".into(),
+            values: Vec::new(),
+        }];
+        let json = McJson {
+            method: "bcls".into(),
+            runs: 1,
+            converged: 1,
+            terminations: terminations(&runs),
+            seconds: None,
+            seed,
+            experiment: "e.toml".into(),
+            fingerprint: "f".repeat(64),
+            program: program.into(),
+            parameters: Vec::new(),
+            shard: Some(ShardInfo {
+                index,
+                count: 2,
+                runs_total: 2,
+                first: index,
+                end: index + 1,
+            }),
+            realizations: Some(runs),
+        };
+        (format!("s{index}.json"), json)
+    }
+
+    /// A shard of another study is named with its value as written: a text between plain
+    /// double quotes (its quotes, backslash and accent as they are, unlike Rust's `{:?}`, with
+    /// only a control character escaped), a number bare.
+    #[test]
+    fn a_mismatch_quotes_the_values_as_written() {
+        let ours = "jitterid 0.1.0";
+        let theirs = "jitterid \"next\" C:\\build é\u{1b}";
+        let e = merge_values(vec![shard(0, ours, 5), shard(1, theirs, 5)]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "s1.json: belongs to another study than s0.json: its program version is \
+             \"jitterid \"next\" C:\\build é\\u{1b}\", not \"jitterid 0.1.0\""
+        );
+        let e = merge_values(vec![shard(0, ours, 5), shard(1, ours, 6)]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "s1.json: belongs to another study than s0.json: its seed is 6, not 5"
+        );
+        // A long text is cut.
+        let long = "x".repeat(500);
+        let e = merge_values(vec![shard(0, ours, 5), shard(1, &long, 5)]).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains(&format!("is \"{}…\", not", "x".repeat(QUOTED_CHARS))),
+            "{e}"
+        );
+        // The two shards of one study merge.
+        let merged = merge_values(vec![shard(0, ours, 5), shard(1, ours, 5)]).unwrap();
+        assert_eq!(merged.runs, 2);
+    }
 }

@@ -231,14 +231,20 @@ fn one_run(
         let text = |e: StudyError| e.to_string();
         let truth = realize_input(exp, rng).map_err(text)?;
         let signal = fit::signal_of(exp, truth.as_ref()).map_err(text)?;
-        let sim = simulate_record(exp, &signal, rng).map_err(text)?;
+        // Only the samples are fitted: the drawn jitter and noise go at once, and so does the
+        // true signal, so that a long record's fit holds no copy of what made it.
+        let y = simulate_record(exp, &signal, rng).map_err(text)?.y;
+        drop(signal);
         // The model sees the input from t0 on only, as a fit of measured data would.
         let seen = seen_input(exp, truth.as_ref()).map_err(text)?;
+        drop(truth);
         let model = fit::signal_of(exp, seen.as_ref()).map_err(text)?;
+        drop(seen);
         let s = fit::structure(exp, model, method).map_err(text)?;
         let start = fit::perturb(&s.params(), exp.estimate.perturb, rng);
         let s0 = s.with_params(&start).map_err(|e| e.to_string())?;
-        let record = fit::record(&exp.grid, sim.y).map_err(|e| e.to_string())?;
+        drop(s);
+        let record = fit::record(&exp.grid, y).map_err(|e| e.to_string())?;
         fit::fit(
             exp,
             &s0,
@@ -310,9 +316,13 @@ pub fn run_study(
     }
     // The names and truths, from realisation 0's setup (they do not depend on the input).
     let mut rng0 = realization_rng(seed, 0);
-    let truth0 = realize_input(exp, &mut rng0)?;
-    let input0 = seen_input(exp, truth0.as_ref())?;
-    let signal0 = fit::signal_of(exp, input0.as_ref())?;
+    // Only the signal is kept (for the figures): the inputs it was built from go at once, not
+    // at the end of the study.
+    let signal0 = {
+        let truth0 = realize_input(exp, &mut rng0)?;
+        let input0 = seen_input(exp, truth0.as_ref())?;
+        fit::signal_of(exp, input0.as_ref())?
+    };
     let names = fit::param_names(exp, &signal0, method)?;
     let truth = fit::truth_values(exp, &signal0, method)?;
     let part = shard.unwrap_or(Shard::WHOLE);

@@ -14,43 +14,94 @@ pub fn input_side_file(data: &Path) -> PathBuf {
     csvio::input_side_file(data)
 }
 
-/// The samples of a data file, checked against the experiment's grid.
-pub fn read_data(exp: &Experiment, path: &Path) -> StudyResult<csvio::Table> {
-    let table = csvio::read(path)?;
-    let y = table.column("y")?;
+/// The samples of a data file, as a fit needs them: the column `y` (and the jitter `tau`,
+/// where the file has one and it was asked for), checked against the experiment's grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataFile {
+    /// The file's name, for messages.
+    pub name: String,
+    /// The samples, one per instant of the experiment's grid.
+    pub y: Vec<f64>,
+    /// The jitter of each sample (`tau`, written by `jitterid simulate`), when asked for and
+    /// present.
+    pub tau: Option<Vec<f64>>,
+}
+
+/// The samples `y` of a data file, checked against the experiment's grid (the row count, and
+/// the columns `k` and `t` where present). The file is read row by row and only `y` is kept:
+/// its text and its other columns are never held (a record of 10⁷ samples takes 80 MB, not
+/// the half gigabyte of its text and table).
+pub fn read_data(exp: &Experiment, path: &Path) -> StudyResult<DataFile> {
+    read_data_columns(exp, path, false)
+}
+
+/// [`read_data`], keeping the column `tau` too where the file has one (for the figures of
+/// the jitter).
+pub fn read_data_and_tau(exp: &Experiment, path: &Path) -> StudyResult<DataFile> {
+    read_data_columns(exp, path, true)
+}
+
+fn read_data_columns(exp: &Experiment, path: &Path, keep_tau: bool) -> StudyResult<DataFile> {
+    let mut rows = csvio::open_rows(path, &path.display().to_string())?;
+    let name = rows.name().to_string();
+    // A missing `y` is reported after the rows are read, as a whole table's reading would:
+    // a row that does not parse comes first.
+    let iy = rows.index("y");
+    let (ik, it) = (rows.index("k"), rows.index("t"));
+    let itau = rows.index("tau").filter(|_| keep_tau);
     let n = exp.grid.len();
-    if y.len() != n {
+    let tol = 1e-6 * exp.grid.interval();
+    // Reserved at the grid's length, so that a long record does not grow by doubling (up to
+    // twice its size, at once, while it is copied).
+    let mut y = Vec::with_capacity(n);
+    let mut tau = itau.map(|_| Vec::with_capacity(n));
+    // The first rows whose `k` and whose `t` are wrong: reported after the row count, which a
+    // file of another experiment gets wrong first, and `k` before `t`.
+    let (mut bad_k, mut bad_t): (Option<String>, Option<String>) = (None, None);
+    let mut next_row = 0;
+    while let Some((line, row)) = rows.next_row()? {
+        let i = next_row;
+        next_row += 1;
+        let Some(iy) = iy.filter(|_| i < n) else {
+            // Counted, not kept: the errors below say what is wrong.
+            continue;
+        };
+        y.push(row[iy]);
+        if let (Some(tau), Some(j)) = (tau.as_mut(), itau) {
+            tau.push(row[j]);
+        }
+        if let Some(k) = ik
+            .map(|j| row[j])
+            .filter(|&k| bad_k.is_none() && k != i as f64)
+        {
+            bad_k = Some(format!(
+                "{name}:{line}: column `k`: expected {i} (rows in order from 0), found {k}"
+            ));
+        }
+        if let Some(t) = it
+            .map(|j| row[j])
+            .filter(|&t| bad_t.is_none() && (t - exp.grid.time(i)).abs() > tol + 1e-12 * t.abs())
+        {
+            bad_t = Some(format!(
+                "{name}:{line}: column `t`: expected {} (t0 + kT of the experiment's [sampling]), found {t}",
+                exp.grid.time(i)
+            ));
+        }
+    }
+    if rows.rows() == 0 {
+        return Err(rows.no_rows_error().into());
+    }
+    rows.required("y")?;
+    if rows.rows() != n {
         return Err(study_err!(
-            "{}: has {} data rows, expected {n} (the experiment's [sampling] samples)",
-            table.name,
-            y.len()
+            "{name}: has {} data rows, expected {n} (the experiment's [sampling] samples)",
+            rows.rows()
         ));
     }
-    if let Some(k) = table.optional("k") {
-        if let Some(i) = (0..n).find(|&i| k[i] != i as f64) {
-            return Err(study_err!(
-                "{}:{}: column `k`: expected {i} (rows in order from 0), found {}",
-                table.name,
-                table.lines[i],
-                k[i]
-            ));
-        }
+    if let Some(m) = bad_k.or(bad_t) {
+        return Err(study_err!("{m}"));
     }
-    if let Some(t) = table.optional("t") {
-        let tol = 1e-6 * exp.grid.interval();
-        if let Some(i) =
-            (0..n).find(|&i| (t[i] - exp.grid.time(i)).abs() > tol + 1e-12 * t[i].abs())
-        {
-            return Err(study_err!(
-                "{}:{}: column `t`: expected {} (t0 + kT of the experiment's [sampling]), found {}",
-                table.name,
-                table.lines[i],
-                exp.grid.time(i),
-                t[i]
-            ));
-        }
-    }
-    Ok(table)
+    Ok(DataFile { name, y, tau })
 }
 
 /// The experiment of `path` with the command line's iteration and wall-clock budgets, where

@@ -100,8 +100,7 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
             exp.file
         )
     })?;
-    let record = fit::record(&exp.grid, table.column("y")?.to_vec())
-        .map_err(|e| study_err!("{}: {e}", table.name))?;
+    let record = fit::record(&exp.grid, table.y).map_err(|e| study_err!("{}: {e}", table.name))?;
     // The candidates carry the system's delay (a parameter when the system is estimated,
     // else the input is delayed by it) and, with `initial = "estimate"`, a free response.
     let delay = exp.system.kind.get("delay").and_then(Value::as_f64);
@@ -120,8 +119,7 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
                 Some(vi) => delayed_input(&vi, known_delay).map_err(delay_err)?,
                 None => input.clone(),
             };
-            let r = fit::record(&exp.grid, t.column("y")?.to_vec())
-                .map_err(|e| study_err!("{}: {e}", t.name))?;
+            let r = fit::record(&exp.grid, t.y).map_err(|e| study_err!("{}: {e}", t.name))?;
             Some((r, vi))
         }
         None => None,

@@ -60,10 +60,8 @@ pub fn simulate_record(
     let sim = simulate(signal, &exp.jitter.truth, &exp.grid, exp.noise.std, rng)
         .map_err(|e| study_err!("{}: simulation: {e}", exp.file))?;
     let shape = &exp.noise.shape;
-    let v = if shape.is_white() {
-        sim.noise.clone()
-    } else {
-        // The ARMA model's parameters are `c1…` then `d1…`.
+    // The ARMA model's parameters are `c1…` then `d1…`.
+    let coloured = (!shape.is_white()).then(|| {
         let p = shape.params();
         let nc = shape
             .param_names()
@@ -71,14 +69,16 @@ pub fn simulate_record(
             .filter(|n| n.starts_with('c'))
             .count();
         arma_filter(&p[..nc], &p[nc..], &sim.noise)
-    };
-    let y = sim
-        .y
-        .iter()
-        .zip(&sim.noise)
-        .zip(&v)
-        .map(|((y, e), v)| y - e + v)
-        .collect::<Vec<f64>>();
+    });
+    // `y - e + v`, in place: the white noise drawn into `y` replaced by the filtered one. White
+    // noise is its own filtered noise (`v = e`, not a copy of it), and the same expression
+    // keeps its samples bit for bit those of earlier versions.
+    let mut y = sim.y;
+    let v = coloured.as_deref().unwrap_or(&sim.noise);
+    for ((y, e), v) in y.iter_mut().zip(&sim.noise).zip(v) {
+        *y = *y - e + v;
+    }
+    let v = coloured.unwrap_or(sim.noise);
     // The door refuses values outside the representable range; this catches a combination of
     // values inside it that still overflows, rather than writing NaN samples.
     if let Some(k) = y.iter().position(|x| !x.is_finite()) {

@@ -428,7 +428,7 @@ pub fn validate(
     watch: &Watch,
 ) -> StudyResult<Validation> {
     let table = read_data(exp, data)?;
-    let y = table.column("y")?.to_vec();
+    let y = table.y;
     let input = record_input(exp, data, &exp.grid)?;
     let signal = fit::signal_of(exp, input.as_ref())?;
     let (fitted, noise_std, covariance) = match model {

@@ -6,13 +6,13 @@ use crate::exit::{Outcome, Status};
 use crate::output::OutputSet;
 use crate::plots;
 use crate::progress::Ticker;
+use jitterid::estimate::Record;
 use jitterid::signal::{AnySignal, Input};
-use jitterid_study::csvio;
 use jitterid_study::error::StudyResult;
 use jitterid_study::experiment::{Experiment, Method, Paths, Purpose};
 use jitterid_study::export;
-use jitterid_study::fit::{self, fit_json, fit_values, Fit};
-use jitterid_study::records::{read_data, read_experiment, read_input};
+use jitterid_study::fit::{self, fit_json, fit_record, Fit};
+use jitterid_study::records::{read_data, read_data_and_tau, read_experiment, read_input};
 use jitterid_study::select::{auto_start, InitChoice};
 use jitterid_study::study_err;
 use jitterid_study::Watch;
@@ -57,24 +57,35 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
         o.time_limit,
     )?;
     let method = exp.estimate.method;
-    let table = read_data(&exp, &o.data)?;
-    let y = table.column("y")?.to_vec();
+    // The jitter column is kept only for the figures that draw it.
+    let data = if o.plot.is_some() {
+        read_data_and_tau(&exp, &o.data)?
+    } else {
+        read_data(&exp, &o.data)?
+    };
+    let (name, tau) = (data.name, data.tau);
+    // The one copy of the samples: the fit, the start and the figures share it.
+    let record = fit::record(&exp.grid, data.y).map_err(|e| study_err!("{name}: {e}"))?;
     let input = read_input(&exp, &o.data, o.input.as_deref())?;
     let mut signal = fit::signal_of(&exp, input.as_ref())?;
     if o.init == InitChoice::Auto {
-        signal = auto_start(&exp, &signal, input.as_ref(), &y, &table.name)?;
+        signal = auto_start(&exp, &signal, input.as_ref(), record.y(), &name)?;
     }
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let watch = Watch {
         iterations: crate::progress::active_fit_hook(),
         ..Watch::none()
     };
-    let f = fit_values(&exp, signal.clone(), y.clone(), &table.name, &watch)?;
+    let f = fit_record(&exp, signal.clone(), &record, &watch)?;
     drop(ticker);
 
     let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
-        write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &y, &table)?;
+        let data = Samples {
+            record: &record,
+            tau: tau.as_deref(),
+        };
+        write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &data)?;
     }
 
     if o.json {
@@ -85,8 +96,16 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
             })
             .map_err(|e| study_err!("JSON: {e}"));
     }
-    let out = fit_text(&exp, &f, &table.name, o.plot.as_deref());
+    let out = fit_text(&exp, &f, &name, o.plot.as_deref());
     Ok(Outcome { text: out, status })
+}
+
+/// The samples of the fitted file, as the figures draw them.
+struct Samples<'a> {
+    /// The record that was fitted.
+    record: &'a Record,
+    /// The jitter of each sample, where the file has it.
+    tau: Option<&'a [f64]>,
 }
 
 /// The figures of `fit --plot DIR`, written as one set (the naive LS fit beside the method's).
@@ -96,14 +115,11 @@ fn write_fit_figures(
     f: &Fit,
     signal: &AnySignal,
     input: Option<&Input>,
-    y: &[f64],
-    table: &csvio::Table,
+    data: &Samples<'_>,
 ) -> StudyResult<()> {
     let method = exp.estimate.method;
     // The naive LS fit of the system for comparison (when the system is estimated).
     let ls = if exp.system.estimate && method != Method::LS {
-        let record =
-            fit::record(&exp.grid, y.to_vec()).map_err(|e| study_err!("{}: {e}", table.name))?;
         let mut ls_exp = exp.clone();
         ls_exp.jitter.estimate = false;
         ls_exp.noise.estimate = false;
@@ -113,7 +129,7 @@ fn write_fit_figures(
                 fit::fit(
                     &ls_exp,
                     &ls_s,
-                    &record,
+                    data.record,
                     Method::LS,
                     0,
                     false,
@@ -134,7 +150,7 @@ fn write_fit_figures(
     };
     let figs = plots::fit_figures(&plots::FitPlots {
         exp,
-        y,
+        y: data.record.y(),
         input,
         file_model: signal,
         ls: if method == Method::LS {
@@ -143,7 +159,7 @@ fn write_fit_figures(
             ls.as_ref()
         },
         main: (main_label, &f.fitted),
-        tau: table.optional("tau"),
+        tau: data.tau,
     })?;
     let mut outputs = OutputSet::new();
     outputs.figures(dir, figs);

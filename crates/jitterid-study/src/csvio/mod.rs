@@ -13,8 +13,8 @@ pub use record_io::{
     record_to_csv, save_record,
 };
 pub use table::{
-    check_regular_file, excerpt, format, parse, read, read_as, read_text, Column, Table,
-    MAX_EXCERPT_CHARS, MAX_FILE_BYTES,
+    check_regular_file, excerpt, format, open_rows, parse, read, read_as, read_text, Column, Rows,
+    Table, MAX_EXCERPT_CHARS, MAX_FILE_BYTES,
 };
 
 impl From<CsvError> for crate::error::StudyError {

@@ -13,7 +13,8 @@
 //! cells. Writing is a plain join: numbers and the project's column names never need quoting.
 
 use super::error::{io_reason, CsvError};
-use std::collections::HashSet;
+use std::collections::{HashSet, VecDeque};
+use std::io::Read;
 use std::path::Path;
 
 /// A parsed CSV file: named numeric columns of equal length.
@@ -50,12 +51,11 @@ impl Table {
     pub fn column(&self, name: &str) -> Result<&[f64], CsvError> {
         match self.index(name) {
             Some(i) => Ok(&self.values[i]),
-            None => Err(self.error(
-                Some(self.header_line),
-                format!(
-                    "header: expected a column named `{name}`, found {}",
-                    some_names(&self.columns)
-                ),
+            None => Err(missing_column(
+                &self.name,
+                self.header_line,
+                &self.columns,
+                name,
             )),
         }
     }
@@ -93,63 +93,129 @@ fn clean_name(s: &str) -> &str {
 /// A reader of the format: no quoting (every field is kept as written), `,` between fields,
 /// records ending at LF, CR LF or a lone CR; a UTF-8 byte-order mark at the start is dropped
 /// and empty lines are skipped by the reader itself.
-fn reader(text: &str) -> csv::Reader<&[u8]> {
+fn reader<R: Read>(input: R) -> csv::Reader<LineEndLog<R>> {
     csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .quoting(false)
         .terminator(csv::Terminator::CRLF)
-        .from_reader(text.as_bytes())
+        .from_reader(LineEndLog::new(input))
+}
+
+/// The input of the `csv` reader, logging where the line-end bytes (`\r`, `\n`) it passes on
+/// are, so that a record's line can be told without keeping the text (the `csv` reader counts
+/// LF only). Only the line ends the reader has read ahead of the last record are kept (a few
+/// per buffer of the reader), so a file of any length is read in constant memory.
+struct LineEndLog<R> {
+    input: R,
+    /// Bytes passed on so far.
+    passed: u64,
+    /// The first three bytes (a byte-order mark?).
+    first: [u8; 3],
+    /// Offset and byte of each `\r` and `\n` passed on and not yet counted.
+    ends: VecDeque<(u64, u8)>,
+    /// Most bytes passed on before the read fails: the file's size bound.
+    limit: u64,
+}
+
+impl<R: Read> LineEndLog<R> {
+    fn new(input: R) -> Self {
+        Self {
+            input,
+            passed: 0,
+            first: [0; 3],
+            ends: VecDeque::new(),
+            limit: u64::MAX,
+        }
+    }
+
+    fn has_bom(&self) -> bool {
+        self.passed >= 3 && self.first == *"\u{feff}".as_bytes()
+    }
+}
+
+impl<R: Read> Read for LineEndLog<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.input.read(buf)?;
+        for (i, &b) in buf[..n].iter().enumerate() {
+            let at = self.passed + i as u64;
+            if at < 3 {
+                self.first[at as usize] = b;
+            }
+            if b == b'\r' || b == b'\n' {
+                self.ends.push_back((at, b));
+            }
+        }
+        self.passed += n as u64;
+        if self.passed > self.limit {
+            return Err(std::io::Error::other(format!(
+                "grew beyond {} bytes while being read",
+                self.limit
+            )));
+        }
+        Ok(n)
+    }
 }
 
 /// The 1-based line of each record, counted here because the `csv` reader counts LF only: a
 /// lone CR ends a line too, and CR LF is one line end.
-struct LineCounter<'a> {
-    bytes: &'a [u8],
+struct LineCounter {
     /// Bytes counted so far (up to the end of the last record).
-    at: usize,
+    at: u64,
     /// Line ends among them.
     ends: usize,
 }
 
-impl<'a> LineCounter<'a> {
-    fn new(text: &'a str) -> Self {
-        Self {
-            bytes: text.as_bytes(),
-            at: 0,
-            ends: 0,
-        }
+impl LineCounter {
+    fn new() -> Self {
+        Self { at: 0, ends: 0 }
     }
 
-    /// The line of a record of `len` bytes that the reader read from byte `from` on: past the
-    /// byte-order mark and the line ends (of empty lines) that the reader skipped before it.
-    /// A record holds no line end, so only the gaps between records are scanned.
-    fn line_of(&mut self, from: u64, len: usize) -> usize {
-        let b = self.bytes;
-        let mut start = usize::try_from(from).unwrap_or(b.len()).max(self.at);
-        if start == 0 && b.starts_with("\u{feff}".as_bytes()) {
+    /// The line of a record of `len` bytes that the reader read from byte `from` on, and the
+    /// offset of its first byte: past the byte-order mark and the line ends (of empty lines)
+    /// that the reader skipped before it. A record holds no line end, so only the line-end
+    /// bytes logged between records are counted: a `\n`, and a `\r` not followed by `\n`.
+    fn line_of(&mut self, log: &mut LineEndLog<impl Read>, from: u64, len: usize) -> (usize, u64) {
+        let mut start = from.max(self.at);
+        if start == 0 && log.has_bom() {
             start = 3;
         }
-        while start < b.len() && matches!(b[start], b'\r' | b'\n') {
-            start += 1;
+        let mut pending_cr: Option<u64> = None;
+        while let Some(&(at, b)) = log.ends.front() {
+            if at < start {
+                // A terminator of the record before, or a line end the reader skipped.
+            } else if at == start {
+                // The record starts after this run of line ends.
+                start += 1;
+            } else {
+                break;
+            }
+            log.ends.pop_front();
+            if let Some(cr) = pending_cr.take() {
+                if !(b == b'\n' && at == cr + 1) {
+                    self.ends += 1;
+                }
+            }
+            if b == b'\r' {
+                pending_cr = Some(at);
+            } else {
+                self.ends += 1;
+            }
         }
-        let gap = &b[self.at..start];
-        self.ends += gap
-            .iter()
-            .enumerate()
-            .filter(|&(i, &c)| c == b'\n' || (c == b'\r' && gap.get(i + 1) != Some(&b'\n')))
-            .count();
-        self.at = start + len;
-        self.ends + 1
+        if pending_cr.is_some() {
+            self.ends += 1;
+        }
+        self.at = start + len as u64;
+        (self.ends + 1, start)
     }
 }
 
 /// The cells of a record, each with its 1-based column (in characters) where it starts.
-fn cells_of(record: &csv::StringRecord) -> Vec<(usize, &str)> {
+fn cells_of<'a>(record: &[&'a str]) -> Vec<(usize, &'a str)> {
     let mut col = 1;
     record
         .iter()
-        .map(|cell| {
+        .map(|&cell| {
             let start = col + cell.chars().take_while(|c| c.is_whitespace()).count();
             col += cell.chars().count() + 1;
             (start, cell)
@@ -158,39 +224,290 @@ fn cells_of(record: &csv::StringRecord) -> Vec<(usize, &str)> {
 }
 
 /// The length of a record's line in characters.
-fn line_chars(record: &csv::StringRecord) -> usize {
+fn line_chars(record: &[&str]) -> usize {
     record.iter().map(|c| c.chars().count()).sum::<usize>() + record.len().saturating_sub(1)
 }
 
 /// Whether a record is a line to skip: blank, or a comment (`#` after optional white space).
-fn skipped(record: &csv::StringRecord) -> bool {
-    let first = record.get(0).unwrap_or("").trim_start();
+fn skipped(record: &[&str]) -> bool {
+    let first = record.first().copied().unwrap_or("").trim_start();
     (record.len() == 1 && first.is_empty()) || first.starts_with('#')
 }
 
-/// Reads the next record to check into `record`; its line, `None` at the end of the text.
-fn next_record(
+/// The fields of a record read as bytes, checked to be UTF-8 text; the error gives the
+/// offset in the file of the first byte that is not (the record starts at `start`).
+fn fields_of(record: &csv::ByteRecord, start: u64) -> Result<Vec<&str>, u64> {
+    let mut fields = Vec::with_capacity(record.len());
+    let mut offset = start;
+    for field in record.iter() {
+        match std::str::from_utf8(field) {
+            Ok(s) => fields.push(s),
+            Err(e) => return Err(offset + e.valid_up_to() as u64),
+        }
+        // The field and the comma after it.
+        offset += field.len() as u64 + 1;
+    }
+    Ok(fields)
+}
+
+/// The next record to check of `rdr` (read into `record`), with its line; `None` at the end
+/// of the input. Blank and comment lines are skipped.
+fn next_record<'r, R: Read>(
     name: &str,
-    rdr: &mut csv::Reader<&[u8]>,
-    lines: &mut LineCounter<'_>,
-    record: &mut csv::StringRecord,
-) -> Result<Option<usize>, CsvError> {
-    loop {
+    rdr: &mut csv::Reader<LineEndLog<R>>,
+    lines: &mut LineCounter,
+    record: &'r mut csv::ByteRecord,
+) -> Result<Option<(usize, Vec<&'r str>)>, CsvError> {
+    let (line, start) = loop {
         let from = rdr.position().byte();
-        // Reading `&str` text without quoting cannot fail (no I/O, fields split at ASCII
-        // bytes stay UTF-8); a failure would still be reported, not lost.
         let more = rdr
-            .read_record(record)
-            .map_err(|e| CsvError::at(name, None, None, e.to_string()))?;
+            .read_byte_record(record)
+            .map_err(|e| match e.into_kind() {
+                csv::ErrorKind::Io(e) => CsvError::Io {
+                    name: name.to_string(),
+                    reason: format!("cannot read: {}", io_reason(&e)),
+                },
+                // Reading without quoting fails only on I/O; anything else is still reported,
+                // not lost.
+                other => CsvError::at(name, None, None, format!("{other:?}")),
+            })?;
         if !more {
             return Ok(None);
         }
         let len = record.as_slice().len() + record.len().saturating_sub(1);
-        let line = lines.line_of(from, len);
-        if !skipped(record) {
-            return Ok(Some(line));
+        let (line, start) = lines.line_of(rdr.get_mut(), from, len);
+        let fields = fields_of(record, start).map_err(|offset| CsvError::Io {
+            name: name.to_string(),
+            reason: format!(
+                "not UTF-8 text (invalid byte at offset {offset}); expected a CSV file"
+            ),
+        })?;
+        if !skipped(&fields) {
+            break (line, start);
         }
+    };
+    // Checked in the loop; split again so that the fields borrow the record for the caller.
+    Ok(Some((line, fields_of(record, start).unwrap_or_default())))
+}
+
+/// The rows of a CSV text, read one at a time from any reader: a header of column names, then
+/// rows of finite numbers, each checked as it is read (line and column named on error). Only
+/// the current row is held, so a file of any length is read in constant memory; [`parse`] and
+/// [`read`] collect the rows into a [`Table`].
+pub struct Rows<R: Read> {
+    name: String,
+    rdr: csv::Reader<LineEndLog<R>>,
+    lines: LineCounter,
+    record: csv::ByteRecord,
+    header_line: usize,
+    columns: Vec<String>,
+    values: Vec<f64>,
+    rows: usize,
+}
+
+impl<R: Read> Rows<R> {
+    /// Reads the header of `input` (named `name` in messages).
+    ///
+    /// # Errors
+    ///
+    /// [`CsvError::At`] for an empty file or a header that is not a list of distinct names;
+    /// [`CsvError::Io`] if the input cannot be read or is not UTF-8 text.
+    pub fn new(name: &str, input: R) -> Result<Self, CsvError> {
+        let mut rows = Self {
+            name: name.to_string(),
+            rdr: reader(input),
+            lines: LineCounter::new(),
+            record: csv::ByteRecord::new(),
+            header_line: 0,
+            columns: Vec::new(),
+            values: Vec::new(),
+            rows: 0,
+        };
+        let Some((header_line, fields)) =
+            next_record(name, &mut rows.rdr, &mut rows.lines, &mut rows.record)?
+        else {
+            return Err(CsvError::at(
+                name,
+                None,
+                None,
+                "empty file; expected a header line of column names (for example k,t,y)",
+            ));
+        };
+        let columns = header_names(name, header_line, &fields)?;
+        rows.header_line = header_line;
+        rows.values = Vec::with_capacity(columns.len());
+        rows.columns = columns;
+        Ok(rows)
     }
+
+    /// At most this many bytes are read: more is an error (a file that grows while it is read
+    /// past the size checked before).
+    fn with_limit(mut self, limit: u64) -> Self {
+        self.rdr.get_mut().limit = limit;
+        self
+    }
+
+    /// The file's name, as messages give it.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Line of the header (1-based).
+    pub fn header_line(&self) -> usize {
+        self.header_line
+    }
+
+    /// Column names, in file order.
+    pub fn columns(&self) -> &[String] {
+        &self.columns
+    }
+
+    /// Index of a column.
+    pub fn index(&self, name: &str) -> Option<usize> {
+        self.columns.iter().position(|c| c == name)
+    }
+
+    /// Rows read so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// The index of a column that must be there, or an error naming the header and what was
+    /// expected.
+    ///
+    /// # Errors
+    ///
+    /// [`CsvError::At`] at the header line when there is no such column.
+    pub fn required(&self, name: &str) -> Result<usize, CsvError> {
+        self.index(name)
+            .ok_or_else(|| missing_column(&self.name, self.header_line, &self.columns, name))
+    }
+
+    /// The next row's line and values (in the order of [`columns`](Self::columns)); `None`
+    /// at the end of the input.
+    ///
+    /// # Errors
+    ///
+    /// [`CsvError::At`] naming the line and column of a row that does not have a finite
+    /// number in every column; [`CsvError::Io`] as [`new`](Self::new).
+    pub fn next_row(&mut self) -> Result<Option<(usize, &[f64])>, CsvError> {
+        let Self {
+            name,
+            rdr,
+            lines,
+            record,
+            columns,
+            values,
+            rows,
+            ..
+        } = self;
+        let Some((line, fields)) = next_record(name, rdr, lines, record)? else {
+            return Ok(None);
+        };
+        let err = |col: usize, m: String| CsvError::at(name, Some(line), Some(col), m);
+        let cells = cells_of(&fields);
+        if cells.len() != columns.len() {
+            // The column where the row goes wrong: its first extra cell, or its end.
+            let col = cells
+                .get(columns.len())
+                .map_or(line_chars(&fields) + 1, |(c, _)| *c);
+            return Err(err(
+                col,
+                format!(
+                    "expected {} cells ({}), found {}",
+                    columns.len(),
+                    some_names(columns),
+                    cells.len()
+                ),
+            ));
+        }
+        values.clear();
+        for (j, (col, cell)) in cells.into_iter().enumerate() {
+            let cell = cell.trim();
+            let column = || shorten(&columns[j]);
+            if cell.is_empty() {
+                return Err(err(
+                    col,
+                    format!(
+                        "column `{}`: expected a number, found an empty cell",
+                        column()
+                    ),
+                ));
+            }
+            let v: f64 = cell.parse().map_err(|_| {
+                err(
+                    col,
+                    format!(
+                        "column `{}`: expected a number, found `{}`",
+                        column(),
+                        shorten(cell)
+                    ),
+                )
+            })?;
+            if !v.is_finite() {
+                return Err(err(
+                    col,
+                    format!(
+                        "column `{}`: expected a finite number, found `{}`",
+                        column(),
+                        shorten(cell)
+                    ),
+                ));
+            }
+            values.push(v);
+        }
+        *rows += 1;
+        Ok(Some((line, values)))
+    }
+
+    /// The error of a file that ended before its first row.
+    pub fn no_rows_error(&self) -> CsvError {
+        CsvError::at(
+            &self.name,
+            Some(self.header_line),
+            None,
+            "no data rows after the header",
+        )
+    }
+
+    /// Every remaining row collected into a [`Table`].
+    ///
+    /// # Errors
+    ///
+    /// As [`next_row`](Self::next_row); [`CsvError::At`] when there is no data row.
+    pub fn into_table(mut self) -> Result<Table, CsvError> {
+        let mut values = vec![Vec::new(); self.columns.len()];
+        let mut lines = Vec::new();
+        while let Some((line, row)) = self.next_row()? {
+            for (column, &v) in values.iter_mut().zip(row) {
+                column.push(v);
+            }
+            lines.push(line);
+        }
+        if lines.is_empty() {
+            return Err(self.no_rows_error());
+        }
+        Ok(Table {
+            name: self.name,
+            header_line: self.header_line,
+            columns: self.columns,
+            values,
+            lines,
+        })
+    }
+}
+
+/// The error of a header without the column `wanted`.
+fn missing_column(name: &str, header_line: usize, columns: &[String], wanted: &str) -> CsvError {
+    CsvError::at(
+        name,
+        Some(header_line),
+        None,
+        format!(
+            "header: expected a column named `{wanted}`, found {}",
+            some_names(columns)
+        ),
+    )
 }
 
 /// At most a few column names, for a message.
@@ -228,11 +545,7 @@ fn shorten(s: &str) -> String {
 }
 
 /// The column names of a header line, checked: named, not numbers, each once.
-fn header_names(
-    name: &str,
-    line: usize,
-    header: &csv::StringRecord,
-) -> Result<Vec<String>, CsvError> {
+fn header_names(name: &str, line: usize, header: &[&str]) -> Result<Vec<String>, CsvError> {
     let err = |col: usize, m: String| CsvError::at(name, Some(line), Some(col), m);
     let mut columns: Vec<String> = Vec::new();
     // A set, so that a header of 200 000 names is checked in linear time.
@@ -268,84 +581,7 @@ fn header_names(
 ///
 /// [`CsvError::At`] naming the line and column of the first problem.
 pub fn parse(name: &str, text: &str) -> Result<Table, CsvError> {
-    let mut rdr = reader(text);
-    let mut lines = LineCounter::new(text);
-    let mut record = csv::StringRecord::new();
-    let Some(header_line) = next_record(name, &mut rdr, &mut lines, &mut record)? else {
-        return Err(CsvError::at(
-            name,
-            None,
-            None,
-            "empty file; expected a header line of column names (for example k,t,y)",
-        ));
-    };
-    let columns = header_names(name, header_line, &record)?;
-    let mut values = vec![Vec::new(); columns.len()];
-    let mut rows = Vec::new();
-    while let Some(line) = next_record(name, &mut rdr, &mut lines, &mut record)? {
-        let err = |col: usize, m: String| CsvError::at(name, Some(line), Some(col), m);
-        let cells = cells_of(&record);
-        if cells.len() != columns.len() {
-            // The column where the row goes wrong: its first extra cell, or its end.
-            let col = cells
-                .get(columns.len())
-                .map_or(line_chars(&record) + 1, |(c, _)| *c);
-            return Err(err(
-                col,
-                format!(
-                    "expected {} cells ({}), found {}",
-                    columns.len(),
-                    some_names(&columns),
-                    cells.len()
-                ),
-            ));
-        }
-        for (j, (col, cell)) in cells.into_iter().enumerate() {
-            let cell = cell.trim();
-            let column = shorten(&columns[j]);
-            if cell.is_empty() {
-                return Err(err(
-                    col,
-                    format!("column `{column}`: expected a number, found an empty cell"),
-                ));
-            }
-            let v: f64 = cell.parse().map_err(|_| {
-                err(
-                    col,
-                    format!(
-                        "column `{column}`: expected a number, found `{}`",
-                        shorten(cell)
-                    ),
-                )
-            })?;
-            if !v.is_finite() {
-                return Err(err(
-                    col,
-                    format!(
-                        "column `{column}`: expected a finite number, found `{}`",
-                        shorten(cell)
-                    ),
-                ));
-            }
-            values[j].push(v);
-        }
-        rows.push(line);
-    }
-    if rows.is_empty() {
-        return Err(CsvError::at(
-            name,
-            Some(header_line),
-            None,
-            "no data rows after the header",
-        ));
-    }
-    Ok(Table {
-        name: name.to_string(),
-        header_line,
-        columns,
-        values,
-        lines: rows,
-    })
+    Rows::new(name, text.as_bytes())?.into_table()
 }
 
 /// Largest input file accepted (1 GiB): the library's limit
@@ -390,8 +626,23 @@ pub fn read(path: &Path) -> Result<Table, CsvError> {
 ///
 /// As [`read`].
 pub fn read_as(path: &Path, name: &str) -> Result<Table, CsvError> {
-    let text = read_text(path, name, "a CSV file")?;
-    parse(name, &text)
+    open_rows(path, name)?.into_table()
+}
+
+/// The rows of the CSV file at `path`, named `name` in messages, read as they are asked for
+/// (the file's text is never held whole): opened only if it is a regular file of at most
+/// [`MAX_FILE_BYTES`], and read no further than that bound.
+///
+/// # Errors
+///
+/// [`CsvError::Io`] if the file cannot be read; those of [`Rows::new`].
+pub fn open_rows(path: &Path, name: &str) -> Result<Rows<std::fs::File>, CsvError> {
+    check_regular_file(path, name)?;
+    let file = std::fs::File::open(path).map_err(|e| CsvError::Io {
+        name: name.to_string(),
+        reason: format!("cannot read: {}", io_reason(&e)),
+    })?;
+    Ok(Rows::new(name, file)?.with_limit(MAX_FILE_BYTES))
 }
 
 /// The text of the file at `path`, named `name` in messages, read only if it is a regular
@@ -473,8 +724,37 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// A reader that hands out its text in the smallest pieces: the first four bytes (as a
+    /// file's first read would, so that a byte-order mark is seen whole), then one byte per
+    /// read, so that every CR LF pair and every record is split across reads.
+    struct Trickle<'a>(&'a [u8], bool);
+
+    impl Read for Trickle<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            let n = if self.1 { 1 } else { 4 }.min(self.0.len()).min(buf.len());
+            self.1 = true;
+            buf[..n].copy_from_slice(&self.0[..n]);
+            self.0 = &self.0[n..];
+            Ok(n)
+        }
+    }
+
+    /// The rows of `text` read from a [`Trickle`].
+    fn trickled(text: &str) -> Result<Table, CsvError> {
+        Rows::new("d.csv", Trickle(text.as_bytes(), false))?.into_table()
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// Read from a file piece by piece (the text never held whole), any text gives the
+        /// table or error of the whole text: lines are counted across the reads.
+        #[test]
+        fn reads_in_pieces_like_the_whole_text(
+            text in "(\u{feff})?([0-9a-c.,# \t\r\n\"e+-]|\u{feff}|\u{85}|é|NaN|inf){0,80}"
+        ) {
+            prop_assert_eq!(trickled(&text), parse("d.csv", &text));
+        }
 
         /// The `csv`-based reader gives the hand-written reader's table or error on any text
         /// made of the characters that matter (separators, line ends, comments, quotes, white
@@ -504,6 +784,28 @@ mod tests {
                 text.push_str(ends[i + 1]);
             }
             prop_assert_eq!(parse("d.csv", &text), reference::parse("d.csv", &text));
+            prop_assert_eq!(trickled(&text), parse("d.csv", &text));
+        }
+    }
+
+    /// Bytes that are not UTF-8 are named by their offset in the file, wherever they are:
+    /// in the header, a row or a comment, after line ends of every kind.
+    #[test]
+    fn a_byte_that_is_not_utf8_is_named_by_its_offset() {
+        for (bytes, offset) in [
+            (&b"k,\xffy\n0,1\n"[..], 2),
+            (&b"k,y\r\n0,1\r\n1,\xc3\n"[..], 12),
+            (&b"k,y\r\r# \xe9\n0,1\n"[..], 7),
+        ] {
+            let e = Rows::new("d.csv", bytes)
+                .and_then(Rows::into_table)
+                .unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                format!(
+                    "d.csv: not UTF-8 text (invalid byte at offset {offset}); expected a CSV file"
+                )
+            );
         }
     }
 
