@@ -157,6 +157,13 @@ impl Bfgs {
             if started.elapsed().as_secs_f64() >= self.max_seconds {
                 break Termination::TimeLimit;
             }
+            if self
+                .progress
+                .as_ref()
+                .is_some_and(ProgressHook::stop_requested)
+            {
+                break Termination::Stopped;
+            }
             let hg = mat_vec(&h, &g);
             if 0.5 * dot(&g, &hg) <= self.decrement_tol && updated {
                 break Termination::SmallGradient;
