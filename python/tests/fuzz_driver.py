@@ -16,7 +16,10 @@ batch's interpreter, or that ends in a finding, is run again alone in its own in
 that solo run is what is reported, so every finding comes with a one-call reproducer.
 
     python python/tests/fuzz_driver.py --calls 5000 --seed 1     # a long run
-    python python/tests/fuzz_driver.py --replay "J.sample(2**62, 1)"
+    python python/tests/fuzz_driver.py --replay "R['J'].sample(2**62, 1)"
+
+A reproducer runs after ``PRELUDE``: ``R['EXP']``, ``R['G']``, ``R['J']``… are the receivers
+its ``RECIPES`` make (the Table 2 experiment, a second-order system, a uniform-sum jitter…).
 
 ``python/tests/test_fuzz.py`` runs a small seeded version in CI (``JITTERID_FUZZ_CALLS`` sets
 its size).
@@ -137,6 +140,10 @@ HOSTILE_REALS: Sequence[str] = ("float('nan')", "float('inf')", "-float('inf')",
 #: library bounds them): many poles, tones, times. Added by ``--large``.
 LARGE: Sequence[str] = ("np.full(1000, -1.0)", "np.linspace(0.01, 0.49, 10_000)", "np.arange(10**6) * 1.0",
                         "[{'family': 'uniform-sum', 'a': 0.1}] * 40")
+
+#: Arguments that take arrays, which the ``LARGE`` values are aimed at.
+ARRAYS = frozenset(("poles", "zeros", "num", "den", "frequencies", "amplitudes", "phases", "edges", "levels",
+                    "values", "terms", "f", "t", "z", "y"))
 
 #: Plausible values by argument name, as Python expressions.
 PLAUSIBLE: Dict[str, Sequence[str]] = {
@@ -333,6 +340,8 @@ def _value(rng: random.Random, name: str, hostile: Optional[bool], pool: Sequenc
         hostile = not plausible or rng.random() >= 0.45
     if plausible and not hostile:
         return rng.choice(plausible)
+    if name in ARRAYS and LARGE[0] in pool and rng.random() < 0.3:
+        return rng.choice(LARGE)
     kind = _kind(plausible) if plausible else None
     if kind is not None and rng.random() < 0.5:
         return rng.choice(kind)
