@@ -412,7 +412,12 @@ def draw_calls(seed: int, count: int, large: bool = False) -> List[tuple]:
 #: The child: runs the prelude, then each call of the JSON list on its standard input,
 #: printing a line before and after each.
 CHILD = """
-import json, sys, traceback
+import json, resource, sys
+# The limits are set here rather than by a preexec_fn, which is unsafe in a parent with threads
+# (the driver runs its interpreters from a thread pool).
+resource.setrlimit(resource.RLIMIT_AS, ({memory}, {memory}))
+# No core files: an abort must not fill the disk.
+resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
 calls = json.loads(sys.stdin.read())
 exec(compile(PRELUDE, "<prelude>", "exec"))
 FINE = {fine!r}
@@ -433,23 +438,15 @@ for i, code in calls:
 """
 
 
-def _limits() -> None:
-    import resource
-
-    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
-    # No core files: an abort must not fill the disk.
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-
-
 def run_batch(calls: Sequence[tuple], timeout: float = CALL_TIMEOUT) -> Dict[int, Outcome]:
     """Runs ``calls`` (``(index, code)``) in one interpreter; the outcome of each call that
     ran. A call that killed or hung the interpreter has its outcome; the calls after it have
     none."""
-    source = f"PRELUDE = {PRELUDE!r}\n" + CHILD.format(fine=FINE)
+    source = f"PRELUDE = {PRELUDE!r}\n" + CHILD.format(fine=FINE, memory=MEMORY_LIMIT)
     env = dict(os.environ, RAYON_NUM_THREADS="2", RUST_BACKTRACE="0")
     env.pop("PYTHONFAULTHANDLER", None)
     child = subprocess.Popen([sys.executable, "-c", source], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True, preexec_fn=_limits, env=env, cwd=REPO)
+                             stderr=subprocess.PIPE, text=True, env=env, cwd=REPO)
     lines: "queue.Queue[Optional[str]]" = queue.Queue()
     errors: List[str] = []
 
