@@ -18,11 +18,12 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Iterable, Mapping, Optional, Tuple, Union
+from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
 from . import _jitterid, inputs, jitter, system
+from ._spec import integer, real_array, real_number
 from .inputs import Input
 from .system import System
 from .results import FitResult, MonteCarloResult
@@ -63,14 +64,24 @@ class Experiment(_jitterid.Experiment):
     in both constructors; kept when pickled).
     """
 
-    def fit(self, record: Mapping[str, Any], method: Optional[str] = None) -> FitResult:
+    def fit(self, record: Mapping[str, Any], method: Optional[str] = None, *,
+            progress: Optional[Callable[[int, float], Any]] = None) -> FitResult:
         """Fits ``record`` (a mapping with ``y``, and for a random-binary input the
         ``input_t``, ``input_u`` that ``simulate`` and ``read_record`` give) with ``method``
         (``"ls"``, ``"bcls"``, ``"bj"``, ``"ml"``, …; the file's by default). The same
-        result as ``jitterid fit --json``. The GIL is released while fitting."""
+        result as ``jitterid fit --json``. A ``t`` in the record must be the experiment's grid
+        ``start + k·interval``, as a data file's ``t`` column must.
+
+        The fit runs without the GIL. ``progress``, if given, is called as
+        ``progress(iteration, cost)`` after the solver's start and each of its iterations, on
+        the calling thread. Ctrl-C, or an exception raised by ``progress``, stops the solver
+        before its next iteration (Levenberg–Marquardt and BFGS; other solvers run to their
+        end) and is raised; a ``KeyboardInterrupt``'s ``__cause__`` says where the fit stopped.
+        """
         if not isinstance(record, Mapping) or "y" not in record:
             raise TypeError("record: expected a mapping with at least `y` (as simulate returns)")
-        return FitResult._of(self.fit_record(record["y"], record.get("input_t"), record.get("input_u"), method))
+        return FitResult._of(self.fit_record(record["y"], record.get("input_t"), record.get("input_u"), method,
+                                             record.get("t"), progress))
 
 
 def montecarlo(
@@ -80,15 +91,22 @@ def montecarlo(
     shard: Optional[Tuple[int, int]] = None,
     method: Optional[str] = None,
     threads: Optional[int] = None,
+    *,
+    progress: Optional[Callable[[int, int], Any]] = None,
 ) -> MonteCarloResult:
     """``runs`` realisations of ``experiment`` fitted with ``method`` under master ``seed``
     (or shard ``(i, n)`` of them), on ``threads`` worker threads (all cores by default).
     ``to_dict()`` equals ``jitterid montecarlo --json`` (``--shard i/n``) apart from
-    ``seconds``. The GIL is released while it runs; Ctrl-C stops the study before its next
-    realisations and raises ``KeyboardInterrupt``."""
+    ``seconds``.
+
+    The GIL is released while it runs. ``progress``, if given, is called as
+    ``progress(done, total)`` as realisations finish, on the calling thread. Ctrl-C, or an
+    exception raised by ``progress``, stops the study before its next realisations and is
+    raised once the running ones end (a study has no partial result); a
+    ``KeyboardInterrupt``'s ``__cause__`` says how many realisations ran."""
     if not isinstance(experiment, _jitterid.Experiment):
         raise TypeError(f"experiment: expected an Experiment, found {type(experiment).__name__}")
-    text = _jitterid.montecarlo(experiment, runs, seed, shard, method, threads)
+    text = _jitterid.montecarlo(experiment, runs, seed, shard, method, threads, progress)
     return MonteCarloResult(json.loads(text))
 
 
@@ -108,7 +126,17 @@ def read_record(path: Union[str, os.PathLike], input: Optional[Union[str, os.Pat
 
 
 def _grid(samples: int, interval: float, start: float) -> tuple:
-    return int(samples), float(interval), float(start)
+    return integer(samples, "samples"), real_number(interval, "interval"), real_number(start, "start")
+
+
+def _model(system: Any, jitter_model: Any, input: Any) -> None:
+    """Refuses a system, jitter model or input of the wrong type, naming the argument."""
+    if not isinstance(system, _jitterid.System):
+        raise TypeError(f"system: expected a System, found {type(system).__name__}")
+    if not isinstance(jitter_model, _jitterid.Jitter):
+        raise TypeError(f"jitter: expected a jitter model (jitterid.jitter), found {type(jitter_model).__name__}")
+    if input is not None and not isinstance(input, _jitterid.Input):
+        raise TypeError(f"input: expected an Input or None, found {type(input).__name__}")
 
 
 def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
@@ -118,32 +146,41 @@ def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = Non
     ``input`` at ``t_k = start + k·interval``, white noise of std ``noise_std``, seeded by
     ``seed``: a dict of arrays ``t``, ``y``, ``u`` (with an input), and with ``truth`` the drawn
     ``tau`` and ``v``. The GIL is released while it runs."""
-    return _jitterid.simulate(system, jitter, input, *_grid(samples, interval, start), float(noise_std),
-                              int(seed), bool(truth))
+    _model(system, jitter, input)
+    return _jitterid.simulate(system, jitter, input, *_grid(samples, interval, start),
+                              real_number(noise_std, "noise_std"), integer(seed, "seed"), bool(truth))
 
 
 def first_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
                  interval: float, start: float = 0.0) -> np.ndarray:
     """``m_k = E[s(t_k + τ)]`` at ``t_k = start + k·interval``, exact."""
+    _model(system, jitter, input)
     return _jitterid.first_moment(system, jitter, input, *_grid(samples, interval, start))
 
 
 def second_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
                   interval: float, start: float = 0.0, noise_std: float = 0.0) -> np.ndarray:
     """``λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²`` at ``t_k = start + k·interval``, exact."""
-    return _jitterid.second_moment(system, jitter, input, *_grid(samples, interval, start), float(noise_std))
+    _model(system, jitter, input)
+    return _jitterid.second_moment(system, jitter, input, *_grid(samples, interval, start),
+                                   real_number(noise_std, "noise_std"))
 
 
 def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method: str = "bcls", *,
         estimate: Iterable[str] = ("system",), interval: Optional[float] = None,
         start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
-        options: Optional[Mapping[str, Any]] = None) -> FitResult:
+        options: Optional[Mapping[str, Any]] = None,
+        progress: Optional[Callable[[int, float], Any]] = None) -> FitResult:
     """Fits a record's samples with ``method``, starting from ``system`` and ``jitter``.
 
     Arguments:
 
-    * ``record``: a mapping with the samples ``y`` and optionally ``T`` and ``t0`` (or ``t``)
-      and the input (``input``, or ``input_t`` and ``input_u`` as ``simulate`` gives them).
+    * ``record``: a mapping with the samples ``y`` (real, finite) and optionally ``T`` and
+      ``t0`` or the sample times ``t``, and the input (``input``, or ``input_t`` and ``input_u``
+      as ``simulate`` gives them). A ``t`` must have one finite time per sample, on the grid
+      ``start + k·interval`` (within the command line's tolerance for a data file's ``t``
+      column, ``1e-6·interval``); it gives the grid when ``interval``/``start`` and ``T``/``t0``
+      do not.
     * ``system``, ``jitter``: the model, and the start of the estimated parts.
     * ``method``: ``"ls"``, ``"bcls"``, ``"bj"``, ``"ml"``, … (the command line's methods).
     * ``estimate``: the estimated parts among ``"system"``, ``"jitter"`` and ``"noise"``.
@@ -152,10 +189,16 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
     * ``noise_std``: the measurement-noise level (known, or the start when estimated).
     * ``options``: further keys of the experiment file's ``[estimate]`` section
       (``solver``, ``frequencies``, ``max_iterations``, …).
+    * ``progress``: called as ``progress(iteration, cost)`` after the solver's start and each
+      of its iterations, on the calling thread (see ``Experiment.fit`` for Ctrl-C and for an
+      exception it raises).
 
     Returns a ``FitResult`` (``names``, ``params``, ``std_errors``, ``covariance``, …), equal
     to ``Experiment.fit`` on an experiment with the same sections. Raises ``ValueError``
-    naming the argument or key at fault, ``TypeError`` for a record that is not a mapping.
+    naming the argument or key at fault (NaN or infinite samples or times, a ``t`` off the
+    grid or of the wrong length), ``TypeError`` for a record that is not a mapping and for
+    arguments of the wrong type (complex or non-numeric samples, a system that is not a
+    ``System``).
     Each call reads the experiment its arguments spell: for many fits of one set-up, make an
     ``Experiment`` once and call its ``fit``.
 
@@ -167,35 +210,55 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
     """
     if not isinstance(record, Mapping) or "y" not in record:
         raise TypeError("record: expected a mapping with at least `y`")
+    _model(system, jitter, input)
+    if isinstance(estimate, str):
+        raise TypeError(f"estimate: expected a collection of parts such as ('system', 'jitter'), found the text "
+                        f"{estimate!r}")
     parts = set(estimate)
     unknown = parts - {"system", "jitter", "noise"}
     if unknown:
-        raise ValueError(f"estimate: unknown part(s) {sorted(unknown)}; expected 'system', 'jitter' or 'noise'")
-    y = np.asarray(record["y"], dtype=float)
+        raise ValueError(f"estimate: unknown part(s) {sorted(map(str, unknown))}; expected 'system', 'jitter' or "
+                         "'noise'")
+    y = real_array(record["y"], "y")
+    if y.ndim != 1:
+        raise ValueError(f"y: expected a one-dimensional array, found shape {y.shape}")
     t = record.get("t")
+    if t is not None:
+        # Checked here because the grid is taken from it; the extension checks it against that grid.
+        t = real_array(t, "t")
+        if t.ndim != 1 or t.size != y.size:
+            raise ValueError(f"t: has shape {t.shape}, expected ({y.size},) (one time per sample of y)")
+        bad = np.flatnonzero(~np.isfinite(t))
+        if bad.size:
+            raise ValueError(f"t: element {bad[0]} is {t[bad[0]]} (not a finite number)")
     if interval is None:
         interval = record.get("T")
-        if interval is None and t is not None and len(t) > 1:
-            interval = (float(t[-1]) - float(t[0])) / (len(t) - 1)
+        if interval is None and t is not None and t.size > 1:
+            interval = (t[-1] - t[0]) / (t.size - 1)
         if interval is None:
             raise ValueError("interval: not given and the record has no `T` or `t` to take it from")
     if start is None:
-        start = record.get("t0", float(t[0]) if t is not None and len(t) else 0.0)
-    sections: dict = {"sampling": {"interval": float(interval), "samples": int(y.size), "start": float(start)}}
+        start = record.get("t0", t[0] if t is not None and t.size else 0.0)
+    sections: dict = {"sampling": {"interval": real_number(interval, "interval"), "samples": int(y.size),
+                                   "start": real_number(start, "start")}}
     if input is None:
         input = record.get("input")
+        if input is not None and not isinstance(input, _jitterid.Input):
+            raise TypeError(f"record['input']: expected an Input, found {type(input).__name__}")
     if input is None and record.get("input_t") is not None:
-        u = np.asarray(record["input_u"], dtype=float)
-        t_in = np.asarray(record["input_t"], dtype=float)
+        u = real_array(record.get("input_u"), "input_u")
+        t_in = real_array(record["input_t"], "input_t")
         sections["input"] = {"kind": "piecewise", "times": t_in.tolist(),
-                             "values": (u[:-1] if len(u) >= 2 and u[-1] == 0.0 else u).tolist()}
+                             "values": (u[:-1] if u.ndim == 1 and len(u) >= 2 and u[-1] == 0.0 else u).tolist()}
     elif input is not None:
         sections["input"] = json.loads(input.section_json())
+    if options is not None and not isinstance(options, Mapping):
+        raise TypeError(f"options: expected a mapping of [estimate] keys, found {type(options).__name__}")
     sections["system"] = dict(system.spec, estimate="system" in parts)
     sections["jitter"] = dict(jitter.spec, estimate="jitter" in parts)
-    sections["noise"] = {"std": float(noise_std), "estimate": "noise" in parts}
+    sections["noise"] = {"std": real_number(noise_std, "noise_std"), "estimate": "noise" in parts}
     sections["estimate"] = {"method": method, **dict(options or {})}
     from ._spec import spec_json
 
     exp = Experiment.from_sections(spec_json(sections), "fit arguments")
-    return exp.fit({"y": y})
+    return exp.fit({"y": y} if t is None else {"y": y, "t": t}, progress=progress)

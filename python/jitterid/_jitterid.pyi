@@ -1,7 +1,7 @@
 """Type stubs of the compiled core (the public API is in ``jitterid`` and ``jitterid.jitter``)."""
 
 from os import PathLike
-from typing import Optional, Tuple, Union
+from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -77,8 +77,12 @@ class Experiment:
         input_t: Optional[npt.ArrayLike] = None,
         input_u: Optional[npt.ArrayLike] = None,
         method: Optional[str] = None,
+        t: Optional[npt.ArrayLike] = None,
+        progress: Optional[Callable[[int, float], Any]] = None,
     ) -> Fit:
-        """Fits the samples ``y`` (with the random input's realisation) as ``jitterid fit``."""
+        """Fits the samples ``y`` (with the random input's realisation; ``t``, if given, on the
+        experiment's grid) as ``jitterid fit``; ``progress(iteration, cost)`` follows the solver,
+        and Ctrl-C or an exception it raises stops it."""
 
 class Fit:
     """One fit as the library returns it (``jitterid.FitResult`` reads it)."""
@@ -102,6 +106,7 @@ def montecarlo(
     shard: Optional[Tuple[int, int]] = None,
     method: Optional[str] = None,
     threads: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
 ) -> str: ...
 def merge(shards: list[str]) -> str: ...
 def read_record(path: str, input: Optional[str] = None) -> dict[str, npt.NDArray[np.float64]]: ...

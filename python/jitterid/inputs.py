@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from . import _jitterid
+from ._spec import integer, real_number
 
 __all__ = ["Input", "piecewise", "zero_order_hold", "random_binary", "sine", "multisine"]
 
@@ -28,20 +29,23 @@ def piecewise(edges: Any, levels: Any) -> Input:
 
 def zero_order_hold(values: Any, interval: float, start: float = 0.0) -> Input:
     """``u = values[k]`` on ``[start + k·interval, start + (k+1)·interval)``."""
-    return _wrap(_jitterid.Input.zero_order_hold(values, float(interval), float(start)))
+    return _wrap(_jitterid.Input.zero_order_hold(values, real_number(interval, "interval"),
+                                                 real_number(start, "start")))
 
 
 def random_binary(start: float, end: float, seed: int, mean_dwell: float = 8.0, low: float = 0.0,
                   high: float = 1.0) -> Input:
     """A realisation on ``[start, end)`` of the random binary input (exponential dwell times of
     mean ``mean_dwell``, levels ``low``/``high``) from a generator seeded with ``seed``."""
-    return _wrap(_jitterid.Input.random_binary(float(start), float(end), int(seed), float(mean_dwell),
-                                               float(low), float(high)))
+    return _wrap(_jitterid.Input.random_binary(real_number(start, "start"), real_number(end, "end"),
+                                               integer(seed, "seed"), real_number(mean_dwell, "mean_dwell"),
+                                               real_number(low, "low"), real_number(high, "high")))
 
 
 def sine(frequency: float, amplitude: float = 1.0, phase: float = 0.0) -> Input:
     """``amplitude · sin(2π·frequency·t + phase)``."""
-    return multisine([frequency], [amplitude], [phase])
+    return multisine([real_number(frequency, "frequency")], [real_number(amplitude, "amplitude")],
+                     [real_number(phase, "phase")])
 
 
 def multisine(frequencies: Any, amplitudes: Optional[Any] = None, phases: Optional[Any] = None) -> Input:

@@ -18,7 +18,7 @@ import json
 from typing import Any, Dict, List
 
 from . import _jitterid
-from ._spec import SpecTable, spec_json
+from ._spec import SpecTable, real_number, spec_json
 
 __all__ = ["Jitter", "from_name", "from_std", "families"]
 
@@ -49,7 +49,7 @@ def from_std(family: str, sigma: float, **keys: Any) -> Jitter:
     family's structural keys, such as the uniform sum's ``n``."""
     # Built by the registry's standard-deviation form, then rewrapped through its spec table
     # (an exact round trip) so that it is this module's class.
-    return Jitter(Jitter.from_std_dev(family, float(sigma), spec_json(keys)).spec_json)
+    return Jitter(Jitter.from_std_dev(family, real_number(sigma, "sigma"), spec_json(keys)).spec_json)
 
 
 def families() -> List[Dict[str, Any]]:

@@ -7,9 +7,16 @@ from __future__ import annotations
 
 import copy
 import json
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Mapping, Optional
 
 import numpy as np
+
+
+def _table(data: Any, what: str) -> None:
+    """Refuses ``data`` that is not a mapping (what ``to_dict()`` gives) with ``TypeError``; a
+    mapping without the keys of ``what`` raises ``KeyError`` naming the key."""
+    if not isinstance(data, Mapping):
+        raise TypeError(f"data: expected the mapping of {what} (as to_dict() gives it), found {type(data).__name__}")
 
 __all__ = ["FitResult", "MonteCarloResult"]
 
@@ -29,6 +36,7 @@ class FitResult:
     _EXTRA = ("fitted_model", "estimated", "estimator_covariance")
 
     def __init__(self, data: Dict[str, Any]) -> None:
+        _table(data, "a fit")
         self._data: Optional[Dict[str, Any]] = data
         self._fit: Any = None
         self.method: str = data["method"]
@@ -111,6 +119,7 @@ class MonteCarloResult:
     """
 
     def __init__(self, data: Dict[str, Any]) -> None:
+        _table(data, "a Monte Carlo study")
         self._data = data
         params = data["parameters"]
 

@@ -15,7 +15,7 @@ from typing import Any, Dict, List, Tuple
 import numpy as np
 
 from . import _jitterid
-from ._spec import SpecTable, spec_json
+from ._spec import SpecTable, real_array, real_number, spec_json
 
 __all__ = ["System", "from_name", "kinds"]
 
@@ -26,12 +26,12 @@ class System(SpecTable, _jitterid.System):
     @staticmethod
     def zpk(zeros: Any, poles: Any, gain: float) -> "System":
         """``gain · Π(s − z) / Π(s − p)``; complex roots come in conjugate pairs, listed in full."""
-        return System(System.from_zpk(zeros, poles, float(gain)).spec_json)
+        return System(System.from_zpk(zeros, poles, real_number(gain, "gain")).spec_json)
 
     @staticmethod
     def tf(num: Any, den: Any) -> "System":
         """``N(s)/A(s)`` from coefficients, highest power first."""
-        return from_name("tf", num=np.asarray(num, dtype=float), den=np.asarray(den, dtype=float))
+        return from_name("tf", num=real_array(num, "num"), den=real_array(den, "den"))
 
     @property
     def names(self) -> List[str]:

@@ -1,9 +1,11 @@
 //! Experiments from the command line's TOML files: one record simulated as `jitterid simulate`
 //! writes it, and a record fitted as `jitterid fit --json` reports it.
 
-use crate::arrays::{finite_samples, SamplesIn};
+use crate::arrays::finite_samples;
 use crate::errors::{json_text, spec_table, value_error};
 use crate::toml_text;
+use crate::watching::{run_watched, Reporter, Stopped};
+use jitterid::estimate::solver::{ProgressHook, Termination};
 use jitterid::signal::Input;
 use jitterid::signal::{PiecewiseConstant, SampleGrid};
 use jitterid_study::csvio;
@@ -13,12 +15,14 @@ use jitterid_study::inputs;
 use jitterid_study::montecarlo::DEFAULT_SEED;
 use jitterid_study::{fit as fitting, records, simulate, Registries};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pyo3::exceptions::PyOSError;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 use serde::Serialize;
 use std::borrow::Cow;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// An experiment file, read and validated once, with its text kept for pickling.
 #[pyclass(module = "jitterid._jitterid", subclass, frozen, skip_from_py_object)]
@@ -225,24 +229,38 @@ impl Experiment {
 
     /// Fits the samples `y` (with the record's input switch times and levels `input_t`,
     /// `input_u` for a random-binary experiment) with `method` (the file's if `None`), as
-    /// `jitterid fit` does; the GIL is released while fitting.
-    #[pyo3(signature = (y, input_t = None, input_u = None, method = None))]
+    /// `jitterid fit` does; `t`, when given, holds the samples' times and must be the
+    /// experiment's grid, as a data file's `t` column must.
+    ///
+    /// The fit runs on a worker thread without the GIL while this thread looks for Python
+    /// signals every [`SIGNAL_POLL`](crate::watching::SIGNAL_POLL) and calls `progress(iteration,
+    /// cost)` after the solver's start and each of its iterations. Ctrl-C, or an exception
+    /// raised by `progress`, stops the solver before its next iteration (the
+    /// Levenberg–Marquardt and BFGS solvers; the others run to their end) and is raised then; a
+    /// `KeyboardInterrupt`'s `__cause__` says where the fit stopped.
+    #[pyo3(signature = (y, input_t = None, input_u = None, method = None, t = None, progress = None))]
+    #[allow(clippy::too_many_arguments)]
     fn fit_record(
         &self,
         py: Python<'_>,
-        y: SamplesIn<'_>,
-        input_t: Option<SamplesIn<'_>>,
-        input_u: Option<SamplesIn<'_>>,
+        y: &Bound<'_, PyAny>,
+        input_t: Option<&Bound<'_, PyAny>>,
+        input_u: Option<&Bound<'_, PyAny>>,
         method: Option<&str>,
+        t: Option<&Bound<'_, PyAny>>,
+        progress: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Fit> {
         let exp = self.for_method(method)?;
-        let y = finite_samples(&y, "y")?;
+        let y = finite_samples(y, "y")?;
         if y.len() != exp.grid.len() {
             return Err(value_error(format!(
                 "y: has {} samples, expected {} (the experiment's [sampling] samples)",
                 y.len(),
                 exp.grid.len()
             )));
+        }
+        if let Some(t) = t {
+            on_grid(&finite_samples(t, "t")?, &exp.grid)?;
         }
         let input = match &exp.input {
             InputSpec::None => None,
@@ -253,14 +271,63 @@ impl Experiment {
                         "input: the experiment's input is random-binary, so the fit needs the record's input realisation (input_t and input_u, as simulate returns them)",
                     ));
                 };
-                Some(Input::Piecewise(realisation(&t, &u, &exp.grid)?))
+                Some(Input::Piecewise(realisation(t, u, &exp.grid)?))
             }
         };
-        let fit = py.detach(|| {
+        if let Some(p) = &progress {
+            if !p.is_callable() {
+                return Err(PyTypeError::new_err(format!(
+                    "progress: expected a callable progress(iteration, cost) or None, found {}",
+                    p.get_type().name()?
+                )));
+            }
+        }
+        let cancel = Arc::new(AtomicBool::new(false));
+        let watched = progress.is_some();
+        let work = |reporter: Reporter<(u64, f64)>| {
+            // The hook always carries the stop flag; it reports only when someone listens.
+            let report = move |p: &jitterid::estimate::solver::Progress| {
+                if watched {
+                    reporter.report((p.iteration, p.cost));
+                }
+            };
+            let watch = jitterid_study::Watch {
+                iterations: Some(ProgressHook::new(report).stopping_on(Arc::clone(&cancel))),
+                ..jitterid_study::Watch::none()
+            };
             let signal = fitting::signal_of(&exp, input.as_ref())?;
-            fitting::fit_values(&exp, signal, y, "y", &jitterid_study::Watch::none())
-        });
-        fit.map(|fit| Fit { fit }).map_err(value_error)
+            fitting::fit_values(&exp, signal, y, "y", &watch)
+        };
+        let on_event = |(iteration, cost): (u64, f64)| -> PyResult<()> {
+            if let Some(p) = &progress {
+                p.call1((iteration, cost))?;
+            }
+            Ok(())
+        };
+        match run_watched(py, &cancel, work, on_event) {
+            Ok(Some(fit)) => fit.map(|fit| Fit { fit }).map_err(value_error),
+            Ok(None) => Err(PyRuntimeError::new_err("the fit's thread panicked")),
+            Err(Stopped { error, outcome }) => {
+                let report = match outcome {
+                    Some(Ok(fit)) if fit.termination == Termination::Stopped.to_string() => {
+                        format!(
+                            "interrupted: the fit was stopped after {} iterations ({})",
+                            fit.iterations, fit.termination
+                        )
+                    }
+                    Some(Ok(fit)) => format!(
+                        "interrupted: the fit ended ({}) before it could be stopped; its result was discarded",
+                        fit.termination
+                    ),
+                    Some(Err(e)) => format!("interrupted: {e}"),
+                    None => "interrupted: the fit's thread panicked".to_string(),
+                };
+                if error.cause(py).is_none() {
+                    error.set_cause(py, Some(PyRuntimeError::new_err(report)));
+                }
+                Err(error)
+            }
+        }
     }
 
     /// Pickling: the text, the file name, the directory and whether paths outside it are
@@ -290,8 +357,8 @@ impl Experiment {
 /// The random input's realisation from its switch times `t` and levels `u` (the side file's
 /// columns, levels closed by a 0), checked as `jitterid fit` checks the side file.
 fn realisation(
-    t: &SamplesIn<'_>,
-    u: &SamplesIn<'_>,
+    t: &Bound<'_, PyAny>,
+    u: &Bound<'_, PyAny>,
     grid: &SampleGrid,
 ) -> PyResult<PiecewiseConstant> {
     let values = vec![finite_samples(t, "input_t")?, finite_samples(u, "input_u")?];
@@ -310,6 +377,28 @@ fn realisation(
         values,
     };
     inputs::piecewise_from_table(&table, "t", "u", grid).map_err(value_error)
+}
+
+/// Refuses sample times `t` that are not the grid's `t0 + kT`, with the tolerance of
+/// `jitterid fit` for a data file's `t` column (`records::read_data`: `1e-6·T` plus
+/// `1e-12·|t|` for the rounding of large times).
+fn on_grid(t: &[f64], grid: &SampleGrid) -> PyResult<()> {
+    if t.len() != grid.len() {
+        return Err(value_error(format!(
+            "t: has {} times, expected {} (one per sample of y)",
+            t.len(),
+            grid.len()
+        )));
+    }
+    let tol = 1e-6 * grid.interval();
+    match (0..t.len()).find(|&k| (t[k] - grid.time(k)).abs() > tol + 1e-12 * t[k].abs()) {
+        Some(k) => Err(value_error(format!(
+            "t: element {k} is {}, expected {} (start + k·interval: the samples must be on a uniform grid)",
+            t[k],
+            grid.time(k)
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// One fit as the library returns it. `FitResult` takes its numbers from [`Fit::fields`] and

@@ -1,7 +1,7 @@
 //! Known inputs: piecewise constant (from edges and levels, from samples by zero-order hold,
 //! or a seeded random binary realisation) and sums of tones, as the library's `Input`.
 
-use crate::arrays::{finite_samples, map_reals, RealsIn, SamplesIn};
+use crate::arrays::{finite_reals, finite_samples, map_reals};
 use crate::errors::{json_text, value_error};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::SeedableRng;
@@ -27,11 +27,16 @@ fn piecewise(p: Result<PiecewiseConstant, impl std::fmt::Display>) -> PyResult<I
     p.map(|p| Input { input: p.into() }).map_err(value_error)
 }
 
-fn optional(x: Option<SamplesIn<'_>>, name: &str, len: usize, default: f64) -> PyResult<Vec<f64>> {
+fn optional(
+    x: Option<&Bound<'_, PyAny>>,
+    name: &str,
+    len: usize,
+    default: f64,
+) -> PyResult<Vec<f64>> {
     let Some(x) = x else {
         return Ok(vec![default; len]);
     };
-    let v = finite_samples(&x, name)?;
+    let v = finite_samples(x, name)?;
     if v.len() != len {
         return Err(value_error(format!(
             "{name}: expected {len} values (one per frequency), found {}",
@@ -53,16 +58,16 @@ impl Input {
 
     /// `u = levels[j]` on `[edges[j], edges[j+1])`, zero outside (one more edge than levels).
     #[staticmethod]
-    fn piecewise(edges: SamplesIn<'_>, levels: SamplesIn<'_>) -> PyResult<Self> {
-        let edges = finite_samples(&edges, "edges")?;
-        let levels = finite_samples(&levels, "levels")?;
+    fn piecewise(edges: &Bound<'_, PyAny>, levels: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let edges = finite_samples(edges, "edges")?;
+        let levels = finite_samples(levels, "levels")?;
         piecewise(PiecewiseConstant::new(edges, levels))
     }
 
     /// Zero-order hold of `values`: `u = values[k]` on `[start + kT, start + (k+1)T)`.
     #[staticmethod]
-    fn zero_order_hold(values: SamplesIn<'_>, interval: f64, start: f64) -> PyResult<Self> {
-        let values = finite_samples(&values, "values")?;
+    fn zero_order_hold(values: &Bound<'_, PyAny>, interval: f64, start: f64) -> PyResult<Self> {
+        let values = finite_samples(values, "values")?;
         piecewise(PiecewiseConstant::zero_order_hold(start, interval, &values))
     }
 
@@ -85,11 +90,11 @@ impl Input {
     #[staticmethod]
     #[pyo3(signature = (frequencies, amplitudes = None, phases = None))]
     fn multisine(
-        frequencies: SamplesIn<'_>,
-        amplitudes: Option<SamplesIn<'_>>,
-        phases: Option<SamplesIn<'_>>,
+        frequencies: &Bound<'_, PyAny>,
+        amplitudes: Option<&Bound<'_, PyAny>>,
+        phases: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let f = finite_samples(&frequencies, "frequencies")?;
+        let f = finite_samples(frequencies, "frequencies")?;
         let a = optional(amplitudes, "amplitudes", f.len(), 1.0)?;
         let p = optional(phases, "phases", f.len(), 0.0)?;
         let tones = (0..f.len())
@@ -144,9 +149,14 @@ impl Input {
         }
     }
 
-    /// `u(t)` at times `t` (s).
-    fn value<'py>(&self, py: Python<'py>, t: RealsIn<'py>) -> Bound<'py, PyArrayDyn<f64>> {
-        map_reals(py, &t, |t| self.input.value(t))
+    /// `u(t)` at times `t` (s, real and finite).
+    fn value<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let t = finite_reals(t, "t")?;
+        Ok(map_reals(py, &t, |t| self.input.value(t)))
     }
 
     /// The library's JSON form (what `Input(json)` reads back).

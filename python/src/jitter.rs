@@ -1,14 +1,14 @@
 //! Jitter models by name through the library's `JitterRegistry`: characteristic function,
 //! moment generating function, density and draws on NumPy arrays.
 
-use crate::arrays::{map_reals, RealsIn};
+use crate::arrays::{finite_complexes, finite_reals, map_reals};
 use crate::errors::{json_text, spec_table, value_error};
 use jitterid::jitter::registry::JitterRegistry;
 use jitterid::jitter::AnyJitter;
 use jitterid::num_complex::Complex64;
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::SeedableRng;
-use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyReadonlyArrayDyn};
+use numpy::{IntoPyArray, PyArray1, PyArrayDyn};
 use pyo3::prelude::*;
 use serde::Serialize;
 
@@ -97,30 +97,39 @@ impl Jitter {
         self.model.model().variance()
     }
 
-    /// Characteristic function `γ(f) = E[exp(-i2πfτ)]` at frequencies `f` (Hz).
-    fn cf<'py>(&self, py: Python<'py>, f: RealsIn<'py>) -> Bound<'py, PyArrayDyn<Complex64>> {
-        map_reals(py, &f, |f| self.model.model().cf(f))
+    /// Characteristic function `γ(f) = E[exp(-i2πfτ)]` at frequencies `f` (Hz): a number or
+    /// an array-like of real, finite numbers (any shape, kept).
+    fn cf<'py>(
+        &self,
+        py: Python<'py>,
+        f: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<Complex64>>> {
+        let f = finite_reals(f, "f")?;
+        Ok(map_reals(py, &f, |f| self.model.model().cf(f)))
     }
 
-    /// Moment generating function `E[exp(zτ)]` at complex `z`; NaN where it does not exist.
+    /// Moment generating function `E[exp(zτ)]` at complex `z` (finite real and imaginary
+    /// parts); NaN where it does not exist.
     fn mgf<'py>(
         &self,
         py: Python<'py>,
         z: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<Complex64>>> {
-        let z = py
-            .import("numpy")?
-            .call_method1("asarray", (z, "complex128"))?;
-        let z: PyReadonlyArrayDyn<'py, Complex64> = z.extract()?;
+        let z = finite_complexes(z, "z")?;
         let nan = Complex64::new(f64::NAN, f64::NAN);
         Ok(z.as_array()
             .map(|&z| self.model.model().mgf(z).unwrap_or(nan))
             .into_pyarray(py))
     }
 
-    /// Density of `τ` at `t` (1/s); atoms are not included.
-    fn pdf<'py>(&self, py: Python<'py>, t: RealsIn<'py>) -> Bound<'py, PyArrayDyn<f64>> {
-        map_reals(py, &t, |t| self.model.model().pdf(t))
+    /// Density of `τ` at `t` (1/s), `t` real and finite; atoms are not included.
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let t = finite_reals(t, "t")?;
+        Ok(map_reals(py, &t, |t| self.model.model().pdf(t)))
     }
 
     /// `size` independent draws of `τ` from a generator seeded with `seed`.

@@ -16,6 +16,7 @@ mod sampling;
 mod study;
 mod system;
 mod toml_text;
+mod watching;
 
 use pyo3::prelude::*;
 

@@ -2,7 +2,7 @@
 //! `jitterid_signal::forms` (transfer function, zeros/poles/gain, state space), the frequency
 //! response and the step response on NumPy arrays.
 
-use crate::arrays::{map_reals, RealsIn};
+use crate::arrays::{finite_complexes, finite_reals, map_reals};
 use crate::errors::{json_text, spec_table, value_error};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{TfForm, ZpkForm};
@@ -10,7 +10,7 @@ use jitterid::signal::registry::{SignalRegistry, SpecTable};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
 use jitterid_study::export::{delay_of, tf_of};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyReadonlyArrayDyn};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
 use pyo3::prelude::*;
 use serde_json::{json, Value};
 
@@ -84,12 +84,14 @@ fn roots_spec(roots: &[Complex64]) -> Value {
         .collect()
 }
 
-fn complex_in(py: Python<'_>, x: &Bound<'_, PyAny>) -> PyResult<Vec<Complex64>> {
-    let z = py
-        .import("numpy")?
-        .call_method1("asarray", (x, "complex128"))?;
-    let z: PyReadonlyArrayDyn<'_, Complex64> = z.extract()?;
-    Ok(z.as_array().iter().copied().collect())
+/// The roots in `x` (any array-like of finite real or complex numbers); `name` names the
+/// argument in messages.
+fn roots_in(x: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<Complex64>> {
+    Ok(finite_complexes(x, name)?
+        .as_array()
+        .iter()
+        .copied()
+        .collect())
 }
 
 #[pymethods]
@@ -103,13 +105,8 @@ impl System {
     /// `k Π(s − z_i) / Π(s − p_i)` from complex (or real) zeros and poles, conjugate pairs
     /// listed in full.
     #[staticmethod]
-    fn from_zpk(
-        py: Python<'_>,
-        zeros: &Bound<'_, PyAny>,
-        poles: &Bound<'_, PyAny>,
-        gain: f64,
-    ) -> PyResult<Self> {
-        let form = ZpkForm::new(gain, complex_in(py, zeros)?, complex_in(py, poles)?)
+    fn from_zpk(zeros: &Bound<'_, PyAny>, poles: &Bound<'_, PyAny>, gain: f64) -> PyResult<Self> {
+        let form = ZpkForm::new(gain, roots_in(zeros, "zeros")?, roots_in(poles, "poles")?)
             .map_err(value_error)?;
         let mut spec = SpecTable::new();
         spec.insert("kind".into(), "zpk".into());
@@ -189,12 +186,14 @@ impl System {
     }
 
     /// `G(i2πf) e^{−i2πfD}` at frequencies `f` (Hz): the rational part times the input
-    /// delay's phase (`D = 0` without a delay), the response the step response is of.
+    /// delay's phase (`D = 0` without a delay), the response the step response is of; `f`
+    /// real and finite.
     fn frequency_response<'py>(
         &self,
         py: Python<'py>,
-        f: RealsIn<'py>,
+        f: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArrayDyn<Complex64>>> {
+        let f = finite_reals(f, "f")?;
         let tf = self.rational()?;
         let d = delay_of(&self.model).unwrap_or(0.0);
         Ok(map_reals(py, &f, |f| {
@@ -203,15 +202,16 @@ impl System {
         }))
     }
 
-    /// The response to a unit step at `t = 0` at times `t` (s), exact; 0 before the step.
-    fn step<'py>(&self, py: Python<'py>, t: RealsIn<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    /// The response to a unit step at `t = 0` at times `t` (s, real and finite), exact; 0
+    /// before the step.
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let t = finite_reals(t, "t")?;
         self.rational()?;
-        let last = t
-            .as_array()
-            .iter()
-            .copied()
-            .filter(|x| x.is_finite())
-            .fold(0.0_f64, f64::max);
+        let last = t.as_array().iter().copied().fold(0.0_f64, f64::max);
         let signal = build(&self.spec, Some(&unit_step(last + 1.0)?))?;
         Ok(map_reals(py, &t, |t| signal.value(t)))
     }

@@ -186,6 +186,9 @@ pub enum Termination {
     NonFinite,
     /// The line search found no acceptable step along a non-negligible descent direction.
     LineSearchFailed,
+    /// The caller asked the solver to stop through its progress hook
+    /// ([`ProgressHook::stopping_on`]).
+    Stopped,
     /// Any other reason, described in words.
     Other(String),
 }
@@ -222,6 +225,7 @@ impl fmt::Display for Termination {
                 f.write_str("residuals or Jacobian not finite at every nearby trial point")
             }
             Termination::LineSearchFailed => f.write_str("line search failed"),
+            Termination::Stopped => f.write_str("stopped by the caller"),
             Termination::Other(why) => f.write_str(why),
         }
     }
@@ -252,7 +256,7 @@ fn from_argmin_reason(
 pub fn budget_termination() -> Option<Termination> {
     jitterid_numeric::budget::stop().map(|stop| match stop {
         jitterid_numeric::budget::Stop::TimeLimit { .. } => Termination::TimeLimit,
-        _ => Termination::Other(format!("stopped: {stop}")),
+        _ => Termination::Stopped,
     })
 }
 

@@ -284,3 +284,38 @@ fn solver_progress_hook_goes_through_the_trait_and_the_multistart_wrapper() {
         "gauss-newton"
     );
 }
+
+#[test]
+fn a_set_stop_flag_ends_the_run_where_it_is() {
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+    use std::sync::Arc;
+    let start = [-1.2, 1.0];
+    for table in [
+        serde_json::json!({ "solver": "lm" }),
+        serde_json::json!({ "solver": "lm", "starts": 2 }),
+        serde_json::json!({ "solver": "bfgs" }),
+    ] {
+        // The flag is set by the third report (the end of iteration 2), as a front end's
+        // Ctrl-C would set it while the solver runs.
+        let stop = Arc::new(AtomicBool::new(false));
+        let reports = Arc::new(AtomicU64::new(0));
+        let (flag, seen) = (Arc::clone(&stop), Arc::clone(&reports));
+        let hook = ProgressHook::new(move |_| {
+            if seen.fetch_add(1, Ordering::Relaxed) == 2 {
+                flag.store(true, Ordering::Relaxed);
+            }
+        })
+        .stopping_on(Arc::clone(&stop));
+        let plain = registry_solver(table.clone());
+        let report = Solver::minimize(&plain.with_progress(hook), &Rosenbrock, &start).unwrap();
+        assert_eq!(report.termination, Termination::Stopped, "{table}");
+        assert!(!report.converged, "{table}");
+        assert!(report.iterations <= 2, "{table}: {report:?}");
+        // Unstopped, the same solver runs on to Rosenbrock's minimum.
+        let whole = Solver::minimize(&plain, &Rosenbrock, &start).unwrap();
+        assert!(
+            whole.converged && whole.iterations > 2,
+            "{table}: {whole:?}"
+        );
+    }
+}
