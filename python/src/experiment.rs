@@ -285,14 +285,14 @@ impl Experiment {
         let cancel = Arc::new(AtomicBool::new(false));
         let watched = progress.is_some();
         let work = |reporter: Reporter<(u64, f64)>| {
-            // The hook always carries the stop flag; it reports only when someone listens.
             let report = move |p: &jitterid::estimate::solver::Progress| {
-                if watched {
-                    reporter.report((p.iteration, p.cost));
-                }
+                reporter.report((p.iteration, p.cost));
             };
+            // The stop flag is the fit's cancel flag: its budget stops any solver at its next
+            // iteration and skips the covariance of a stopped search.
             let watch = jitterid_study::Watch {
-                iterations: Some(ProgressHook::new(report).stopping_on(Arc::clone(&cancel))),
+                iterations: watched.then(|| ProgressHook::new(report)),
+                cancel: Some(Arc::clone(&cancel)),
                 ..jitterid_study::Watch::none()
             };
             let signal = fitting::signal_of(&exp, input.as_ref())?;
