@@ -139,14 +139,35 @@ def _model(system: Any, jitter_model: Any, input: Any) -> None:
         raise TypeError(f"input: expected an Input or None, found {type(input).__name__}")
 
 
+def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval: Any, start: Any,
+              noise_std: Any, what: str) -> None:
+    """Refuses what the command line refuses for the same set-up: the arguments are read as
+    the sections of an experiment file (``[sampling]``, ``[input]``, ``[system]``, ``[jitter]``,
+    ``[noise]``), whose reader checks every value against the grid (a zero gain, a pole or a
+    jitter width outside the representable range, a sample count beyond the limit) and names
+    the argument's key in its ``ValueError``."""
+    from ._spec import spec_json
+
+    _model(system, jitter_model, input)
+    samples, interval, start = _grid(samples, interval, start)
+    sections: dict = {"sampling": {"interval": interval, "samples": samples, "start": start}}
+    if input is not None:
+        sections["input"] = json.loads(input.section_json())
+    sections["system"] = dict(system.spec, estimate=False)
+    sections["jitter"] = dict(jitter_model.spec, estimate=False)
+    sections["noise"] = {"std": real_number(noise_std, "noise_std"), "estimate": False}
+    Experiment.from_sections(spec_json(sections), what)
+
+
 def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
              interval: float, start: float = 0.0, noise_std: float = 0.0, seed: int = DEFAULT_SEED,
              truth: bool = False) -> dict:
     """``samples`` jittered samples ``y_k = s(t_k + τ_k) + v_k`` of ``system`` driven by
     ``input`` at ``t_k = start + k·interval``, white noise of std ``noise_std``, seeded by
     ``seed``: a dict of arrays ``t``, ``y``, ``u`` (with an input), and with ``truth`` the drawn
-    ``tau`` and ``v``. The GIL is released while it runs."""
-    _model(system, jitter, input)
+    ``tau`` and ``v``. The GIL is released while it runs. The arguments are checked as the
+    command line checks an experiment file (``ValueError`` naming the key)."""
+    _in_range(system, jitter, input, samples, interval, start, noise_std, "simulate arguments")
     return _jitterid.simulate(system, jitter, input, *_grid(samples, interval, start),
                               real_number(noise_std, "noise_std"), integer(seed, "seed"), bool(truth))
 
@@ -154,14 +175,14 @@ def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = Non
 def first_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
                  interval: float, start: float = 0.0) -> np.ndarray:
     """``m_k = E[s(t_k + τ)]`` at ``t_k = start + k·interval``, exact."""
-    _model(system, jitter, input)
+    _in_range(system, jitter, input, samples, interval, start, 0.0, "first_moment arguments")
     return _jitterid.first_moment(system, jitter, input, *_grid(samples, interval, start))
 
 
 def second_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
                   interval: float, start: float = 0.0, noise_std: float = 0.0) -> np.ndarray:
     """``λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²`` at ``t_k = start + k·interval``, exact."""
-    _model(system, jitter, input)
+    _in_range(system, jitter, input, samples, interval, start, noise_std, "second_moment arguments")
     return _jitterid.second_moment(system, jitter, input, *_grid(samples, interval, start),
                                    real_number(noise_std, "noise_std"))
 

@@ -140,8 +140,8 @@ impl Jitter {
         seed: u64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let mut rng = StdRng::seed_from_u64(seed);
-        let draws = jitterid::jitter::sample_n(self.model.model(), size, &mut rng)
-            .map_err(value_error)?;
+        let draws =
+            jitterid::jitter::sample_n(self.model.model(), size, &mut rng).map_err(value_error)?;
         Ok(draws.into_pyarray(py))
     }
 

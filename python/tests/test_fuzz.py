@@ -20,27 +20,19 @@ import fuzz_driver  # noqa: E402
 CALLS = int(os.environ.get("JITTERID_FUZZ_CALLS", "300"))
 SEED = int(os.environ.get("JITTERID_FUZZ_SEED", "1"))
 
-#: Findings the library is being changed for (issue 30, item 1: every allocation sized by user
-#: input checked before it is made), as (what, predicate on a finding). Each has a one-call
-#: reproducer below, expected to fail until the library's limits arrive; a finding that matches
-#: none of them fails the test.
-KNOWN = [
-    # A vector of `size` draws allocated unchecked: 10**12 aborts the interpreter ("memory
-    # allocation of 8000000000000 bytes failed"), 2**62 panics ("capacity overflow").
-    ("Jitter.sample with a huge size",
-     lambda f: f.target.endswith(".sample") and f.outcome.kind in ("signal", "panic")),
-    # The same for the grid of `samples` times in simulate, first_moment and second_moment.
-    ("simulate / first_moment / second_moment with huge samples",
-     lambda f: f.target in ("jitterid.simulate", "jitterid.first_moment", "jitterid.second_moment")
-     and "samples=" in f.code and f.outcome.kind in ("signal", "panic")),
-]
+#: Findings that are known and accepted, as (what, predicate on a finding); a finding that
+#: matches none of them fails the test. Empty: the sizes that once aborted the interpreter
+#: (draws, grids of 10**12 or 2**62 samples) are refused by the library's limits, and their
+#: one-call reproducers below are now ordinary regression tests.
+KNOWN: list = []
 
-#: One-call reproducers of the known findings.
-KNOWN_REPRODUCERS = [
+#: One-call reproducers of what the driver once found: each must now end as a Python error.
+FIXED_REPRODUCERS = [
     "R['JG'].sample(10**12, 1)",
     "R['JG'].sample(2**62, 1)",
     "jitterid.simulate(R['G'], R['J'], R['U'], samples=10**12, interval=1.0)",
     "jitterid.second_moment(R['G'], R['J'], R['U'], samples=2**62, interval=1.0)",
+    "jitterid.System.zpk([], [-1.0]*1000, 1.0)",
 ]
 
 
@@ -77,8 +69,7 @@ def test_hostile_calls_end_in_a_return_or_a_clean_exception():
     assert not new, f"{len(new)} new finding(s) in {len(calls)} calls:\n" + "\n".join(f.report() for f in new)
 
 
-@pytest.mark.parametrize("code", KNOWN_REPRODUCERS)
-@pytest.mark.xfail(strict=False, reason="issue 30 item 1: the library's size limits are being added")
-def test_known_library_findings(code):
+@pytest.mark.parametrize("code", FIXED_REPRODUCERS)
+def test_what_the_driver_once_found_now_ends_as_a_python_error(code):
     outcome = fuzz_driver.run_batch([(0, code)])[0]
     assert not outcome.failed, f"{outcome.kind}: {outcome.detail}"

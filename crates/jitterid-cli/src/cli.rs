@@ -129,9 +129,8 @@ pub struct BudgetArgs {
     /// Iteration limit of every fit (overrides [estimate] max_iterations).
     #[arg(long, value_name = "N")]
     pub max_iterations: Option<u64>,
-    /// Wall-clock budget of every fit in seconds [default: 600], covering its search,
-    /// covariance and (in montecarlo) simulation; a fit that spends it stops, not converged,
-    /// with the reason.
+    /// Wall-clock budget of every fit in seconds [default: 600], covering its search and its
+    /// covariance; a fit that spends it stops, not converged, with the reason.
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
     /// Exit 0 even when the fit did not converge (montecarlo, merge: when no fit converged);

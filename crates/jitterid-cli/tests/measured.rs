@@ -59,11 +59,11 @@ refused_with_the_key_named! {
 #[test]
 fn a_history_too_long_for_its_switches_is_refused() {
     let text = example_with("initial-state.toml", "history", "history = 1e5")
-        .replace("mean_dwell = 8.0", "mean_dwell = 0.1");
+        .replace("mean_dwell = 8.0", "mean_dwell = 0.001");
     refused(
         "a_history_too_long",
         &text,
-        &["[input] mean_dwell", "at most 1e6 switches"],
+        &["[input] mean_dwell", "at most 1e7 switches"],
     );
 }
 

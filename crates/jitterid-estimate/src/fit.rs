@@ -268,6 +268,25 @@ where
     let start = structure.params();
     // Through the problem, so that the solver's first evaluation at the start is memoised.
     let r0 = problem.residuals(&start)?;
+    // A budget spent already (a time limit of 0, a cancel before the start was evaluated)
+    // leaves the start unevaluated: the fit stops there, as a solver would at its first check.
+    if let Some(stop) = jitterid_optim::budget_termination() {
+        return Ok(Fit {
+            criterion: criterion.name().to_string(),
+            names: structure.param_names(),
+            params: start,
+            covariance: None,
+            std_errors: None,
+            cost: f64::NAN,
+            cost_kind: CostKind::SumOfSquares,
+            iterations: 0,
+            termination: stop.into(),
+            converged: false,
+            residuals: Vec::new(),
+            noise_std: structure.noise_std.unwrap_or(f64::NAN),
+            residual_flatness: None,
+        });
+    }
     if let Some((index, &value)) = r0.iter().enumerate().find(|(_, r)| !r.is_finite()) {
         return Err(EstimateError::NonFiniteAtStart { index, value });
     }

@@ -173,6 +173,25 @@ where
             .unwrap_or_else(|| noise_start(structure, record)),
     };
     let start = likelihood_params(structure, sigma0);
+    // A budget spent already leaves the start unevaluated: the fit stops there, as a solver
+    // would at its first check (see the least-squares `estimate`).
+    if let Some(stop) = jitterid_optim::budget_termination() {
+        return Ok(Fit {
+            criterion: criterion.name().to_string(),
+            names: likelihood_param_names(structure),
+            params: start,
+            covariance: None,
+            std_errors: None,
+            cost: f64::NAN,
+            cost_kind: CostKind::NegLogLikelihood,
+            iterations: 0,
+            termination: stop.into(),
+            converged: false,
+            noise_std: sigma0,
+            residuals: Vec::new(),
+            residual_flatness: None,
+        });
+    }
     let objective = match data {
         Some(d) => LikelihoodObjective::with_data(structure, criterion, d.clone()),
         None => LikelihoodObjective::new(structure, criterion, record),

@@ -194,20 +194,6 @@ pub fn vec_with_capacity<T>(limit: Limit, len: usize) -> Result<Vec<T>, LimitExc
     Ok(v)
 }
 
-/// The limits as a Markdown table (limit, bound, of what), as the documentation prints it.
-pub fn markdown_table() -> String {
-    let mut s = String::from("| limit | largest | of |\n|---|---:|---|\n");
-    for l in Limit::ALL {
-        s.push_str(&format!(
-            "| {} | {} | {} |\n",
-            l.unit(),
-            l.max(),
-            l.of_what()
-        ));
-    }
-    s
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

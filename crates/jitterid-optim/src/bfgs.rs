@@ -160,13 +160,6 @@ impl Bfgs {
             if let Some(stop) = crate::budget_termination() {
                 break stop;
             }
-            if self
-                .progress
-                .as_ref()
-                .is_some_and(ProgressHook::stop_requested)
-            {
-                break Termination::Stopped;
-            }
             let hg = mat_vec(&h, &g);
             if 0.5 * dot(&g, &hg) <= self.decrement_tol && updated {
                 break Termination::SmallGradient;

@@ -186,8 +186,8 @@ pub enum Termination {
     NonFinite,
     /// The line search found no acceptable step along a non-negligible descent direction.
     LineSearchFailed,
-    /// The caller asked the solver to stop through its progress hook
-    /// ([`ProgressHook::stopping_on`]).
+    /// The caller stopped the work through the cancel flag of the budget the solver ran under
+    /// ([`jitterid_numeric::budget`]).
     Stopped,
     /// Any other reason, described in words.
     Other(String),

@@ -241,7 +241,7 @@ pub struct LevenbergMarquardt {
     stop: Option<Termination>,
     /// When the run started (set by `init`).
     started: Option<Instant>,
-    /// Receives the cost after every iteration, when set; its stop flag ends the run.
+    /// Receives the cost after every iteration, when set.
     progress: Option<ProgressHook>,
 }
 
@@ -611,14 +611,6 @@ where
         if self.stop.is_none() && self.out_of_time() {
             self.stop = Some(crate::budget_termination().unwrap_or(Termination::TimeLimit));
         }
-        if self.stop.is_none()
-            && self
-                .progress
-                .as_ref()
-                .is_some_and(ProgressHook::stop_requested)
-        {
-            self.stop = Some(Termination::Stopped);
-        }
         match &self.stop {
             None => TerminationStatus::NotTerminated,
             Some(t) if t.is_convergence() => {
@@ -639,8 +631,7 @@ impl<P: LeastSquares + ?Sized> super::Solver<P> for LevenbergMarquardt {
     fn minimize(&self, problem: &P, start: &[f64]) -> Result<SolverReport, SolverError> {
         self.options.validate()?;
         validate_start(problem, start)?;
-        // The run's own solver state; the hook goes with it for its stop flag, and to the
-        // observer for the reports.
+        // The run's own solver state; the hook goes to the observer for the reports.
         let mut run = LevenbergMarquardt::new(self.options.clone());
         run.progress = self.progress.clone();
         let mut executor = Executor::new(ArgminProblem::new(problem), run)

@@ -1,10 +1,9 @@
-//! Progress reports of a running solver: an observer hook that a front end can print, and
-//! through which it can ask the solver to stop.
+//! Progress reports of a running solver: an observer hook that a front end can print. (A
+//! front end stops a solver through the budget it runs under, `jitterid_numeric::budget`.)
 
 use argmin::core::observers::Observe;
 use argmin::core::{Error, State, KV};
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// Where a solver is after one iteration.
@@ -20,7 +19,7 @@ pub struct Progress {
 }
 
 /// A callback that receives a [`Progress`] after the start's evaluation and after every
-/// iteration, and optionally a flag that asks the solver to stop. Cheap to clone (shared).
+/// iteration. Cheap to clone (shared).
 ///
 /// ```
 /// use jitterid_optim::{LevenbergMarquardt, ProgressHook};
@@ -31,7 +30,6 @@ pub struct Progress {
 #[derive(Clone)]
 pub struct ProgressHook {
     report: Arc<dyn Fn(&Progress) + Send + Sync>,
-    stop: Option<Arc<AtomicBool>>,
 }
 
 impl ProgressHook {
@@ -39,42 +37,19 @@ impl ProgressHook {
     pub fn new(report: impl Fn(&Progress) + Send + Sync + 'static) -> Self {
         ProgressHook {
             report: Arc::new(report),
-            stop: None,
         }
-    }
-
-    /// The hook that also asks the solver to stop once `stop` is set (by a front end's
-    /// Ctrl-C, say): the Levenberg–Marquardt and BFGS solvers look at it before each
-    /// iteration and end with [`Termination::Stopped`](crate::Termination::Stopped) at their
-    /// current point; the other solvers run on.
-    #[must_use]
-    pub fn stopping_on(mut self, stop: Arc<AtomicBool>) -> Self {
-        self.stop = Some(stop);
-        self
     }
 
     /// Calls the hook.
     pub fn report(&self, progress: &Progress) {
         (self.report)(progress);
     }
-
-    /// Whether the solver was asked to stop.
-    pub fn stop_requested(&self) -> bool {
-        self.stop
-            .as_ref()
-            .is_some_and(|s| s.load(Ordering::Relaxed))
-    }
 }
 
-/// Two hooks are equal when they share the same callback and stop flag (so options holding a
-/// hook compare).
+/// Two hooks are equal when they share the same callback (so options holding a hook compare).
 impl PartialEq for ProgressHook {
     fn eq(&self, other: &Self) -> bool {
         Arc::ptr_eq(&self.report, &other.report)
-            && match (&self.stop, &other.stop) {
-                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
-                (a, b) => a.is_none() && b.is_none(),
-            }
     }
 }
 

@@ -286,7 +286,7 @@ fn solver_progress_hook_goes_through_the_trait_and_the_multistart_wrapper() {
 }
 
 #[test]
-fn a_set_stop_flag_ends_the_run_where_it_is() {
+fn a_cancelled_budget_ends_the_run_where_it_is() {
     use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
     use std::sync::Arc;
     let start = [-1.2, 1.0];
@@ -296,7 +296,7 @@ fn a_set_stop_flag_ends_the_run_where_it_is() {
         serde_json::json!({ "solver": "bfgs" }),
     ] {
         // The flag is set by the third report (the end of iteration 2), as a front end's
-        // Ctrl-C would set it while the solver runs.
+        // Ctrl-C would set it while the solver runs under the budget that carries it.
         let stop = Arc::new(AtomicBool::new(false));
         let reports = Arc::new(AtomicU64::new(0));
         let (flag, seen) = (Arc::clone(&stop), Arc::clone(&reports));
@@ -304,10 +304,13 @@ fn a_set_stop_flag_ends_the_run_where_it_is() {
             if seen.fetch_add(1, Ordering::Relaxed) == 2 {
                 flag.store(true, Ordering::Relaxed);
             }
-        })
-        .stopping_on(Arc::clone(&stop));
+        });
+        let budget = jitterid_numeric::budget::Budget::new(None, Some(Arc::clone(&stop)));
         let plain = registry_solver(table.clone());
-        let report = Solver::minimize(&plain.with_progress(hook), &Rosenbrock, &start).unwrap();
+        let watched = plain.with_progress(hook);
+        let report = budget
+            .run(|| Solver::minimize(&watched, &Rosenbrock, &start))
+            .unwrap();
         assert_eq!(report.termination, Termination::Stopped, "{table}");
         assert!(!report.converged, "{table}");
         assert!(report.iterations <= 2, "{table}: {report:?}");

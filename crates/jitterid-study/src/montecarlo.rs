@@ -10,6 +10,7 @@ use crate::fit::{self, Fit, Structure};
 use crate::simulate::{realize_input, seen_input, simulate_record};
 use crate::study_err;
 use crate::{RunsDone, Watch};
+use jitterid::budget::Budget;
 use jitterid::estimate::montecarlo::{realization_rng, realization_seed, run as mc_run, Summary};
 use jitterid::signal::AnySignal;
 use serde::{Deserialize, Serialize};
@@ -349,9 +350,10 @@ pub fn run_study(
             if watch.cancelled() {
                 return None;
             }
-            // The realisation's simulation and fit under the time limit of a fit and the
-            // front end's cancel flag, which a fit inside also stops on.
-            let budget = crate::budget_of(exp, watch.cancel.clone());
+            // The realisation under the front end's cancel flag (its simulation stops on it);
+            // its fit runs under the fit's own time limit, so that a spent limit is the fit's
+            // reported reason, not a failed realisation.
+            let budget = Budget::new(None, watch.cancel.clone());
             let out = budget.run(|| {
                 one_run(
                     exp,
