@@ -467,6 +467,11 @@ impl Confluent {
         let full = self.rule_after(jitter, lo, &[lo], 1.0);
         let mut mean = vec![0.0; d * d];
         for (&tau, &w) in full.nodes.iter().zip(&full.weights) {
+            // A matrix exponential per node: a spent budget leaves the mean unfinished, and
+            // the walk below then every sample (NaN).
+            if budget::spent() {
+                break;
+            }
             for (m, e) in mean.iter_mut().zip(self.exp(tau - lo)) {
                 *m += w * e;
             }
@@ -488,6 +493,10 @@ impl Confluent {
         self.walk(steps, grid, lo, hi, |_, t, z, in_reach| {
             late.iter_mut().for_each(|x| *x = 0.0);
             for &(tj, du) in in_reach {
+                if budget::spent() {
+                    late.iter_mut().for_each(|x| *x = f64::NAN);
+                    break;
+                }
                 let c = tj - t;
                 let rule = self.rule_after(jitter, c, &[c], 1.0);
                 for (&tau, &w) in rule.nodes.iter().zip(&rule.weights) {
