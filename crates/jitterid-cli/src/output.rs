@@ -8,7 +8,7 @@
 //!    one order), waiting up to 30 s for another writer, so that two commands writing the same
 //!    files never interleave (one's data file beside the other's side file);
 //! 3. a set that a killed writer left half renamed there is finished or undone from its
-//!    journal (step 6; [`journal`]), then stale temporaries
+//!    journal (step 6; `output::journal`), then stale temporaries
 //!    (`.<name>.jitterid-{tmp,old,moved}-<pid>-<hex>`; with the lock held every such file is
 //!    stale) are removed, and a replaced file that a kill left moved aside is put back where
 //!    its file is missing;
