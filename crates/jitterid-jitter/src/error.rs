@@ -1,3 +1,4 @@
+use jitterid_numeric::limits::Limit;
 use thiserror::Error;
 
 /// Why a jitter model could not be built from the given parameters.
@@ -139,6 +140,15 @@ impl JitterError {
             | JitterError::UnexpectedKey { key, .. }
             | JitterError::InvalidKey { key, .. } => Some(key),
             JitterError::UnknownFamily { .. } => Some("family"),
+            // The sizes of a composite family are those of its list of terms.
+            JitterError::Limit(e)
+                if matches!(
+                    e.limit,
+                    Limit::SumTerms | Limit::DensityTerms | Limit::MixtureComponents
+                ) =>
+            {
+                Some(crate::registry::TERMS_KEY)
+            }
             _ => None,
         }
     }
