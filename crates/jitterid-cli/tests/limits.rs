@@ -48,7 +48,10 @@ fn a_sum_with_three_terms_with_a_density_is_refused() {
     refused(
         "density-terms",
         &text,
-        &["[jitter] terms", "3 terms with a density exceed the limit of 2"],
+        &[
+            "[jitter] terms",
+            "3 terms with a density exceed the limit of 2",
+        ],
     );
 }
 
@@ -65,7 +68,10 @@ fn a_sum_of_more_terms_than_the_limit_is_refused() {
     refused(
         "sum-terms",
         &text,
-        &["[jitter] terms", "9 terms exceed the limit of 8 terms of a sum"],
+        &[
+            "[jitter] terms",
+            "9 terms exceed the limit of 8 terms of a sum",
+        ],
     );
 }
 
