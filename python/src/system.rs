@@ -36,7 +36,7 @@ impl System {
     /// The model of `spec`, checked by building it through the registry.
     pub fn of(spec: SpecTable) -> PyResult<Self> {
         let model = build(&spec, Some(&unit_step(1.0)?))?;
-        let tf = tf_of(&model);
+        let tf = tf_of(&model).map_err(value_error)?;
         Ok(System { spec, model, tf })
     }
 

@@ -34,38 +34,80 @@ pub fn delay_of(signal: &AnySignal) -> Option<f64> {
         .and_then(serde_json::Value::as_f64)
 }
 
-/// The coefficients of a rational system (rebuilt from the signal's spec table), `None` for
-/// other signal kinds.
-pub fn tf_of(signal: &AnySignal) -> Option<TfForm> {
-    let spec = signal.spec();
-    let kind = SignalRegistry::builtin().kind(signal.kind())?;
-    let rebuilt = || -> Result<Option<TfForm>, SignalError> {
+/// The signal's system rebuilt from its spec table in its own parameterisation (so that the
+/// rows of its covariance match): a [`Zpk`] or a [`TransferFunction`].
+///
+/// A fitted model is exported whatever its poles: the rebuild accepts poles right of the axis
+/// (an estimate with `unstable = true` may end there, and its export is still the model).
+enum RationalSystem {
+    Zpk(Zpk),
+    Tf(TransferFunction),
+}
+
+impl RationalSystem {
+    /// The system of `signal`, `None` for a signal kind that is not a rational system.
+    ///
+    /// # Errors
+    ///
+    /// The signal's spec table does not rebuild a rational system (the error says which key).
+    fn of(signal: &AnySignal) -> Result<Option<Self>, SignalError> {
+        let name = signal.kind();
+        if name != "zpk" && name != "tf" {
+            return Ok(None);
+        }
+        let spec = signal.spec();
+        let Some(kind) = SignalRegistry::builtin().kind(name) else {
+            return Ok(None);
+        };
         let r = kind.reader(&spec)?;
-        Ok(match signal.kind() {
-            "zpk" => Some(TfForm::of(&Zpk::new(
+        Ok(Some(if name == "zpk" {
+            Self::Zpk(Zpk::new_allowing_unstable(
                 r.f64("gain")?,
                 r.roots("zeros")?,
                 r.roots("poles")?,
-            )?)),
-            "tf" => Some(TfForm::of(&TransferFunction::new(
+            )?)
+        } else {
+            Self::Tf(TransferFunction::new_allowing_unstable(
                 &r.f64_list("num")?,
                 &r.f64_list("den")?,
-            )?)),
-            _ => None,
-        })
-    };
-    rebuilt().ok().flatten()
+            )?)
+        }))
+    }
+
+    fn tf(&self) -> TfForm {
+        match self {
+            Self::Zpk(z) => TfForm::of(z),
+            Self::Tf(t) => TfForm::of(t),
+        }
+    }
+}
+
+/// The coefficients of a rational system (rebuilt from the signal's spec table), `None` for
+/// other signal kinds.
+///
+/// # Errors
+///
+/// The spec table of a `zpk` or `tf` signal does not rebuild its system.
+pub fn tf_of(signal: &AnySignal) -> Result<Option<TfForm>, SignalError> {
+    Ok(RationalSystem::of(signal)?.map(|g| g.tf()))
 }
 
 /// The fitted model in every export form, `None` for signals that are not rational systems.
-pub fn model_forms(signal: &AnySignal) -> Option<ModelForms> {
-    let tf = tf_of(signal)?;
-    Some(ModelForms {
-        zpk: tf.to_zpk().ok()?,
+///
+/// # Errors
+///
+/// The system does not rebuild, or its zeros and poles cannot be found (non-finite
+/// coefficients): an export that cannot be made says why rather than going missing.
+pub fn model_forms(signal: &AnySignal) -> Result<Option<ModelForms>, SignalError> {
+    let Some(tf) = tf_of(signal)? else {
+        return Ok(None);
+    };
+    Ok(Some(ModelForms {
+        zpk: tf.to_zpk()?,
         ss: tf.to_state_space(),
         tf,
         delay: delay_of(signal),
-    })
+    }))
 }
 
 /// Where a reported parameter sits in the estimator's covariance: its index there and the
@@ -90,34 +132,6 @@ pub fn reported_covariance(
         .collect()
 }
 
-/// The signal's system as a [`Zpk`] in the signal's own parameterisation (so that the rows of
-/// its covariance match), `None` for other kinds.
-fn zpk_of(signal: &AnySignal) -> Option<Zpk> {
-    let kind = SignalRegistry::builtin().kind("zpk")?;
-    let spec = signal.spec();
-    let r = kind.reader(&spec).ok()?;
-    (signal.kind() == "zpk")
-        .then(|| {
-            Zpk::new(
-                r.f64("gain").ok()?,
-                r.roots("zeros").ok()?,
-                r.roots("poles").ok()?,
-            )
-            .ok()
-        })
-        .flatten()
-}
-
-/// The signal's system as a [`TransferFunction`], `None` for other kinds.
-fn transfer_function_of(signal: &AnySignal) -> Option<TransferFunction> {
-    let kind = SignalRegistry::builtin().kind("tf")?;
-    let spec = signal.spec();
-    let r = kind.reader(&spec).ok()?;
-    (signal.kind() == "tf")
-        .then(|| TransferFunction::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok())
-        .flatten()
-}
-
 /// The Bode diagram of a rational signal's system at `freqs` with delta-method bands from the
 /// covariance of its parameters; `None` for other signal kinds. For a delayed system the
 /// response is `G(i2πf) e^{−i2πfD}` and `covariance` covers the system's parameters then the
@@ -128,10 +142,12 @@ pub fn bode_of(
     covariance: Option<&[Vec<f64>]>,
 ) -> Option<Result<Vec<BodePoint>, EstimateError>> {
     let delay = delay_of(signal);
-    if let Some(z) = zpk_of(signal) {
-        return Some(delayed_bode(&z, delay, freqs, covariance));
-    }
-    transfer_function_of(signal).map(|t| delayed_bode(&t, delay, freqs, covariance))
+    Some(match RationalSystem::of(signal) {
+        Err(e) => Err(e.into()),
+        Ok(None) => return None,
+        Ok(Some(RationalSystem::Zpk(z))) => delayed_bode(&z, delay, freqs, covariance),
+        Ok(Some(RationalSystem::Tf(t))) => delayed_bode(&t, delay, freqs, covariance),
+    })
 }
 
 /// `G`'s Bode diagram, with the delay's phase and band for a delayed system.
@@ -156,10 +172,12 @@ pub fn step_of(
     covariance: Option<&[Vec<f64>]>,
 ) -> Option<Result<Vec<StepPoint>, EstimateError>> {
     let delay = delay_of(signal);
-    if let Some(z) = zpk_of(signal) {
-        return Some(delayed_step(&z, delay, times, covariance));
-    }
-    transfer_function_of(signal).map(|t| delayed_step(&t, delay, times, covariance))
+    Some(match RationalSystem::of(signal) {
+        Err(e) => Err(e.into()),
+        Ok(None) => return None,
+        Ok(Some(RationalSystem::Zpk(z))) => delayed_step(&z, delay, times, covariance),
+        Ok(Some(RationalSystem::Tf(t))) => delayed_step(&t, delay, times, covariance),
+    })
 }
 
 /// `G`'s step response, shifted by the delay (with its band) for a delayed system.
@@ -237,11 +255,55 @@ mod tests {
 
     const FREQS: [f64; 4] = [0.01, 0.1, 0.25, 0.45];
 
+    /// A system with `unstable = true` whose fit ended right of the axis: `1/(s² + s − 0.01)`
+    /// as `tf`, and its pole `0.0099…` as `zpk`.
+    fn unstable(kind: &str) -> AnySignal {
+        let spec = if kind == "tf" {
+            json!({"kind": "tf", "num": [1.0], "den": [1.0, 1.0, -0.01], "unstable": true})
+        } else {
+            json!({"kind": "zpk", "gain": 1.0, "poles": [0.01, -1.01], "unstable": true})
+        };
+        let input = Input::Piecewise(PiecewiseConstant::new(vec![0.0, 100.0], vec![1.0]).unwrap());
+        SignalRegistry::builtin()
+            .build(spec.as_object().unwrap(), Some(&input))
+            .unwrap()
+    }
+
+    #[test]
+    fn a_model_with_a_pole_right_of_the_axis_is_exported() {
+        for kind in ["tf", "zpk"] {
+            let s = unstable(kind);
+            let forms = model_forms(&s).unwrap().expect("a rational system");
+            let right = forms.zpk.poles().iter().filter(|p| p.re > 0.0).count();
+            assert_eq!(right, 1, "{kind}: {:?}", forms.zpk.poles());
+            // The static gain of 1/(s² + a1 s + a0) is 1/a0, whatever the sign of a0.
+            let a0 = *forms.tf.den().last().unwrap();
+            let bode = bode_of(&s, &[1e-9], None).unwrap().unwrap();
+            let db = 20.0 * (1.0 / a0.abs()).log10();
+            assert!((bode[0].magnitude_db - db).abs() < 1e-6, "{kind}: {bode:?}");
+            let step = step_of(&s, &[0.0, 1.0], None).unwrap().unwrap();
+            assert_eq!(step.len(), 2, "{kind}");
+        }
+    }
+
+    #[test]
+    fn other_signals_have_no_model() {
+        let spec = json!({"kind": "sinusoid", "amplitude": 1.0, "frequency": 0.1, "phase": 0.0});
+        let s = SignalRegistry::builtin()
+            .build(spec.as_object().unwrap(), None)
+            .unwrap();
+        assert!(model_forms(&s).unwrap().is_none());
+        assert!(bode_of(&s, &[0.1], None).is_none());
+    }
+
     #[test]
     fn exported_model_and_phase_carry_the_delay() {
         let s = signal(&THETA, Some(DELAY));
-        assert_eq!(model_forms(&s).unwrap().delay, Some(DELAY));
-        assert_eq!(model_forms(&signal(&THETA, None)).unwrap().delay, None);
+        assert_eq!(model_forms(&s).unwrap().unwrap().delay, Some(DELAY));
+        assert_eq!(
+            model_forms(&signal(&THETA, None)).unwrap().unwrap().delay,
+            None
+        );
         let points = bode_of(&s, &FREQS, None).unwrap().unwrap();
         for p in &points {
             let h = by_hand(&THETA, DELAY, p.f_hz);

@@ -489,6 +489,10 @@ pub struct FitJson<'a> {
     /// The fitted system in zpk, tf and state-space form (rational systems only).
     #[serde(skip_serializing_if = "Option::is_none")]
     model: Option<export::ModelForms>,
+    /// Why a rational system's export could not be made (absent when it was, or for a system
+    /// that is not rational): an export never goes missing without a word.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    model_error: Option<String>,
 }
 
 /// Fits the experiment's model with its method to the samples `y` of a record whose input
@@ -527,6 +531,13 @@ pub fn fit_record(
 
 /// The JSON of `jitterid fit --json`.
 pub fn fit_json(f: &Fit) -> FitJson<'_> {
+    let (model, model_error) = match export::model_forms(&f.fitted.signal) {
+        Ok(m) => (m, None),
+        Err(e) => (
+            None,
+            Some(format!("the fitted model could not be exported: {e}")),
+        ),
+    };
     FitJson {
         method: f.method.as_str(),
         converged: f.converged,
@@ -536,6 +547,7 @@ pub fn fit_json(f: &Fit) -> FitJson<'_> {
         noise_std: f.noise_std,
         parameters: &f.params,
         covariance: f.covariance.as_deref(),
-        model: export::model_forms(&f.fitted.signal),
+        model,
+        model_error,
     }
 }

@@ -328,7 +328,10 @@ pub fn step(
     cov: Option<&[Vec<f64>]>,
 ) -> StudyResult<Option<Vec<StepPoint>>> {
     let cov = system_covariance(s, cov);
+    // An export error surfaces from `step_of` below; here it only loses the horizon.
     let slowest = export::tf_of(&s.signal)
+        .ok()
+        .flatten()
         .and_then(|tf| tf.to_zpk().ok())
         .map(|z| {
             z.poles()

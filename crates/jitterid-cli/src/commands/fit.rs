@@ -212,10 +212,11 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
         );
     }
     // The exported model of a delayed system is two pieces: say how they combine.
-    if let (Some(d), Some(_)) = (
-        export::delay_of(&f.fitted.signal),
-        export::tf_of(&f.fitted.signal),
-    ) {
+    let tf = export::tf_of(&f.fitted.signal);
+    if let Err(e) = &tf {
+        let _ = writeln!(out, "model: not exported: {e}");
+    }
+    if let (Some(d), Ok(Some(_))) = (export::delay_of(&f.fitted.signal), &tf) {
         let _ = writeln!(
             out,
             "model: G(s) e^(-sD) with input delay D = {} s (the parameter delay; --json: model.zpk, model.tf, model.ss give G, model.delay gives D)",

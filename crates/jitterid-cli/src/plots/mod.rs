@@ -63,7 +63,11 @@ type Curve = Vec<(f64, f64)>;
 fn frequency_response(signal: &AnySignal, f: f64) -> Option<Complex64> {
     let w = std::f64::consts::TAU * f;
     let delay = export::delay_of(signal).unwrap_or(0.0);
+    // The signals drawn were built from the spec tables that `tf_of` rebuilds, so a rebuild
+    // cannot fail here; the fit's report names any export error.
     export::tf_of(signal)
+        .ok()
+        .flatten()
         .map(|tf| tf.response(Complex64::new(0.0, w)) * Complex64::from_polar(1.0, -w * delay))
 }
 
