@@ -160,8 +160,10 @@ pub struct FitArgs {
     /// Write SVG figures into this directory.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
-    /// The start: `experiment` (the experiment's values) or `auto` (the system from the
-    /// data-driven initializer, as `select` starts each candidate).
+    /// The start: `experiment` (the experiment's values; a likelihood fit of an estimated
+    /// system then starts at the BCLS estimate fitted from them), `auto` (the system from the
+    /// data-driven initializer, as `select` starts each candidate) or `experiment-only` (the
+    /// experiment's values as a likelihood fit's only start, checked against the BCLS route).
     #[arg(long, value_name = "START", default_value = "experiment", value_parser = InitChoice::parse)]
     pub init: InitChoice,
     #[command(flatten)]

@@ -367,7 +367,32 @@ impl Raw {
 
 /// Fits structure `s` (started at its parameters) to `record` with `method`; the error is a
 /// message.
+///
+/// A likelihood fit of an estimated system starts from the BCLS estimate (or, with
+/// [`LikelihoodStart::Given`](crate::experiment::LikelihoodStart::Given), from `s` with the
+/// BCLS route as a check) and is not reported as converged when it stopped at an optimum BCLS
+/// could not have given on this record (see `likelihood_start`): the whole under one time
+/// limit.
 pub fn fit(
+    exp: &Experiment,
+    s: &Structure,
+    record: &Record,
+    method: Method,
+    seed: u64,
+    covariance: bool,
+    watch: &Watch,
+) -> Result<Fit, String> {
+    let criterion = criterion_of(exp, s, method);
+    if criterion.is_likelihood() && s.estimate_signal && !profiled(exp) {
+        let budget = crate::budget_of(exp, watch.cancel.clone());
+        return budget
+            .run(|| crate::likelihood_start::fit(exp, s, record, method, seed, covariance, watch));
+    }
+    fit_once(exp, s, record, method, seed, covariance, watch)
+}
+
+/// One fit of `s` from its parameters, under its own time limit.
+pub(crate) fn fit_once(
     exp: &Experiment,
     s: &Structure,
     record: &Record,

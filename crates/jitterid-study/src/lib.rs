@@ -29,6 +29,7 @@ pub mod export;
 pub mod fingerprint;
 pub mod fit;
 pub mod inputs;
+pub mod likelihood_start;
 pub mod merge;
 pub mod montecarlo;
 pub mod records;

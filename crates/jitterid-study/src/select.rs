@@ -169,10 +169,14 @@ pub enum InitChoice {
     /// The data-driven initializer's model (as `select` starts each candidate), with the
     /// experiment's jitter, noise and the system's other keys (delay, initial state).
     Auto,
+    /// The experiment's values, and for a likelihood fit of an estimated system those values
+    /// as its only start ([`LikelihoodStart::Given`](crate::experiment::LikelihoodStart::Given));
+    /// by default a likelihood starts at the BCLS estimate.
+    ExperimentOnly,
 }
 
 impl InitChoice {
-    /// Parses `experiment` or `auto`.
+    /// Parses `experiment`, `auto` or `experiment-only`.
     ///
     /// # Errors
     ///
@@ -181,7 +185,18 @@ impl InitChoice {
         match s {
             "experiment" => Ok(Self::Experiment),
             "auto" => Ok(Self::Auto),
-            other => Err(format!("expected experiment or auto, found `{other}`")),
+            "experiment-only" => Ok(Self::ExperimentOnly),
+            other => Err(format!(
+                "expected experiment, auto or experiment-only, found `{other}`"
+            )),
+        }
+    }
+
+    /// Where a likelihood fit of an estimated system starts under this choice.
+    pub fn likelihood_start(self) -> crate::experiment::LikelihoodStart {
+        match self {
+            Self::ExperimentOnly => crate::experiment::LikelihoodStart::Given,
+            Self::Experiment | Self::Auto => crate::experiment::LikelihoodStart::Bcls,
         }
     }
 }

@@ -49,13 +49,14 @@ pub struct FitRequest {
 /// `jitterid fit`: the text to print, and exit status [`Status::NotConverged`] when the fit did
 /// not converge (unless `accept_unconverged`).
 pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
-    let exp = read_experiment(
+    let mut exp = read_experiment(
         &o.experiment,
         Purpose::Estimate(o.method),
         o.paths,
         o.max_iterations,
         o.time_limit,
     )?;
+    exp.estimate.likelihood_start = o.init.likelihood_start();
     let method = exp.estimate.method;
     // The jitter column is kept only for the figures that draw it.
     let data = if o.plot.is_some() {

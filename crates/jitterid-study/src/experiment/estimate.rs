@@ -3,7 +3,7 @@
 use super::checks::{describe, number};
 use super::diagnostics::Source;
 use super::raw::RawEstimate;
-use super::spec::{EstimateSpec, Method, SolverName};
+use super::spec::{EstimateSpec, LikelihoodStart, Method, SolverName};
 use crate::error::StudyResult;
 use jitterid::estimate::Frequencies;
 use jitterid::signal::SampleGrid;
@@ -69,6 +69,7 @@ pub(super) fn parse_estimate(
         perturb: relative_size(cx, "perturb", r.perturb.as_ref(), 0.2)?,
         max_iterations,
         max_seconds: None,
+        likelihood_start: LikelihoodStart::default(),
     })
 }
 

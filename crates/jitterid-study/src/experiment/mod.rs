@@ -26,8 +26,8 @@ pub use input::MAX_SWITCHES;
 pub use paths::Paths;
 pub use sampling::MAX_SAMPLES;
 pub use spec::{
-    name_table, EstimateSpec, Experiment, InputSpec, JitterSpec, Method, NoiseSpec, SolverName,
-    SystemSpec,
+    name_table, EstimateSpec, Experiment, InputSpec, JitterSpec, LikelihoodStart, Method,
+    NoiseSpec, SolverName, SystemSpec,
 };
 
 use crate::csvio;
@@ -174,6 +174,7 @@ pub fn parse_with(
             perturb: 0.2,
             max_iterations: None,
             max_seconds: None,
+            likelihood_start: LikelihoodStart::default(),
         },
     };
     if let Purpose::Estimate(chosen) = purpose {
