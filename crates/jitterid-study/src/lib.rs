@@ -32,6 +32,7 @@ pub mod inputs;
 pub mod merge;
 pub mod montecarlo;
 pub mod records;
+pub mod residual_tests;
 mod registries;
 pub mod select;
 pub mod simulate;
