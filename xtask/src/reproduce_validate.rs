@@ -94,7 +94,8 @@ fn param(f: &jitterid_study::fit::Fit, name: &str) -> Option<f64> {
 fn fit_and_check(exp: &Experiment, y: &[f64], input: &Input, r: u64) -> Result<Outcome, String> {
     let name = format!("run {r}");
     let signal = signal_of(exp, Some(input)).map_err(|e| e.to_string())?;
-    let f = fit_values(exp, signal, y.to_vec(), &name, &Watch::none()).map_err(|e| e.to_string())?;
+    let f =
+        fit_values(exp, signal, y.to_vec(), &name, &Watch::none()).map_err(|e| e.to_string())?;
     let (report, _) = check_record(
         &f.fitted,
         &exp.grid,

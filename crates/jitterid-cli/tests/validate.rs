@@ -385,7 +385,9 @@ fn validate_input_file_level_and_portmanteau_fields() {
     let data = dir.join("d.csv");
     let exp = example("validate-one-pole.toml");
     let truth = example("validate-true.toml");
-    assert!(run(&["simulate", &truth, "--out", s(&data)]).status.success());
+    assert!(run(&["simulate", &truth, "--out", s(&data)])
+        .status
+        .success());
     let moved = dir.join("u-elsewhere.csv");
     std::fs::rename(dir.join("d.input.csv"), &moved).unwrap();
     // Without the side file and without --input: the missing file is named.
@@ -411,14 +413,28 @@ fn validate_input_file_level_and_portmanteau_fields() {
     // The verdict is the p-value against the level: a level below the p-value passes.
     let level = format!("{:e}", p / 2.0);
     let o = run(&[
-        "validate", &exp, "--data", s(&data), "--input", s(&moved), "--level", &level,
+        "validate",
+        &exp,
+        "--data",
+        s(&data),
+        "--input",
+        s(&moved),
+        "--level",
+        &level,
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(j["cross_correlation"]["passed"], true, "{j}");
     for bad in ["0", "1", "1.5", "-0.2", "NaN"] {
         let o = run(&[
-            "validate", &exp, "--data", s(&data), "--input", s(&moved), "--level", bad,
+            "validate",
+            &exp,
+            "--data",
+            s(&data),
+            "--input",
+            s(&moved),
+            "--level",
+            bad,
         ]);
         assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
         let e = stderr(&o);

@@ -6,8 +6,8 @@ use jitterid_estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid_jitter::UniformSum;
 use jitterid_likelihood::validation::{
     bode, cross_correlation, default_max_lag, fit_initial_state, log_response_gradient,
-    residual_projection, standardized_residuals, step_response, step_value_and_gradient,
-    whiteness, DEFAULT_LEVEL,
+    residual_projection, standardized_residuals, step_response, step_value_and_gradient, whiteness,
+    DEFAULT_LEVEL,
 };
 use jitterid_signal::{
     simulate, Input, LtiResponse, PiecewiseConstant, RandomBinary, RationalModel, Root, SampleGrid,
@@ -154,9 +154,15 @@ fn verdicts<M: RationalModel + 'static>(
     let us: Vec<f64> = s.grid.times().map(|t| u.value(t)).collect();
     (
         whiteness(&e, m, 0, DEFAULT_LEVEL).unwrap().passed,
-        cross_correlation(&e, &us, m, &residual_projection(&[], y.len()), DEFAULT_LEVEL)
-            .unwrap()
-            .passed,
+        cross_correlation(
+            &e,
+            &us,
+            m,
+            &residual_projection(&[], y.len()),
+            DEFAULT_LEVEL,
+        )
+        .unwrap()
+        .passed,
     )
 }
 

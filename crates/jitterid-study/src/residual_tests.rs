@@ -68,7 +68,9 @@ fn mean_gradients(s: &Structure, grid: &SampleGrid, y: &[f64]) -> Vec<Vec<f64>> 
         let mut p = theta.clone();
         p[j] += h;
         let moved = s.with_params(&p).ok()?;
-        validation::compare(&moved, grid, y).ok().map(|c| c.expected)
+        validation::compare(&moved, grid, y)
+            .ok()
+            .map(|c| c.expected)
     };
     (0..ns + nj)
         .filter_map(|j| {

@@ -18,14 +18,28 @@ fn example(file: &str) -> Experiment {
 }
 
 /// Record `run` of `truth` (seed `seed`) fitted with `model` and checked at `level`.
-fn checked(truth: &Experiment, model: &Experiment, seed: u64, run: u64, level: f64) -> RecordReport {
+fn checked(
+    truth: &Experiment,
+    model: &Experiment,
+    seed: u64,
+    run: u64,
+    level: f64,
+) -> RecordReport {
     let d = simulate_data(truth, seed, run).unwrap();
     let input = d.input.as_ref();
     let signal = signal_of(model, input).unwrap();
     let f = fit_values(model, signal, d.y.clone(), "record", &Watch::none()).unwrap();
-    check_record(&f.fitted, &model.grid, &d.y, f.noise_std, input, level, "record")
-        .unwrap()
-        .0
+    check_record(
+        &f.fitted,
+        &model.grid,
+        &d.y,
+        f.noise_std,
+        input,
+        level,
+        "record",
+    )
+    .unwrap()
+    .0
 }
 
 /// The one-pole model leaves the second pole's and the zero's dynamics in the residuals: on
@@ -33,7 +47,10 @@ fn checked(truth: &Experiment, model: &Experiment, seed: u64, run: u64, level: f
 /// every record is rejected.
 #[test]
 fn a_one_pole_model_of_two_pole_records_is_rejected() {
-    let (truth, one_pole) = (example("validate-true.toml"), example("validate-one-pole.toml"));
+    let (truth, one_pole) = (
+        example("validate-true.toml"),
+        example("validate-one-pole.toml"),
+    );
     for run in 0..4 {
         let r = checked(&truth, &one_pole, 9, run, 0.01);
         let c = r.cross_correlation.unwrap();
@@ -57,6 +74,9 @@ fn the_fitted_true_structure_is_rejected_at_the_nominal_rate() {
     let white = rate(&|r| !r.whiteness.passed);
     let cross = rate(&|r| !r.cross_correlation.as_ref().unwrap().passed);
     for (what, x) in [("whiteness", white), ("cross-correlation", cross)] {
-        assert!((x - level).abs() < 3.0 * se, "{what}: rejected in {x} of records");
+        assert!(
+            (x - level).abs() < 3.0 * se,
+            "{what}: rejected in {x} of records"
+        );
     }
 }

@@ -9,8 +9,8 @@ use jitterid_study::experiment::{self, Experiment, Paths, Purpose};
 use jitterid_study::fit::Structure;
 use jitterid_study::study_err;
 use jitterid_study::validate::{
-    bode_csv, frequency_response, step, validate as run_validation, ValidateOptions as StudyValidateOptions,
-    ValidatedRecord,
+    bode_csv, frequency_response, step, validate as run_validation,
+    ValidateOptions as StudyValidateOptions, ValidatedRecord,
 };
 use jitterid_study::Watch;
 use std::path::{Path, PathBuf};

@@ -60,7 +60,11 @@ pub fn residual_projection(columns: &[Vec<f64>], n: usize) -> Vec<Vec<f64>> {
         .iter()
         .filter(|c| c.len() == n && c.iter().all(|v| v.is_finite()))
         .collect();
-    let a = Mat::from_fn(n, used.len() + 1, |i, j| if j == 0 { 1.0 } else { used[j - 1][i] });
+    let a = Mat::from_fn(
+        n,
+        used.len() + 1,
+        |i, j| if j == 0 { 1.0 } else { used[j - 1][i] },
+    );
     let Ok(svd) = a.thin_svd() else {
         // Cannot happen for finite input; the constant alone still centres the residuals.
         let c = 1.0 / (n as f64).sqrt();
@@ -157,7 +161,10 @@ mod tests {
     #[test]
     fn levels_outside_the_open_interval_are_refused() {
         for bad in [0.0, 1.0, -0.1, 1.5, f64::NAN] {
-            assert!(matches!(check_level(bad), Err(EstimateError::BadLevel { .. })));
+            assert!(matches!(
+                check_level(bad),
+                Err(EstimateError::BadLevel { .. })
+            ));
         }
         assert_eq!(check_level(0.05).unwrap(), 0.05);
     }
@@ -217,7 +224,9 @@ mod tests {
             let (ma, mb) = (col_mean(a), col_mean(b));
             (0..n).map(|j| (x(a, j) - ma) * (x(b, j) - mb)).sum::<f64>()
         });
-        let c = Mat::from_fn(lags + 1, 1, |a, _| (0..n).map(|j| x(a, j) * e[j]).sum::<f64>());
+        let c = Mat::from_fn(lags + 1, 1, |a, _| {
+            (0..n).map(|j| x(a, j) * e[j]).sum::<f64>()
+        });
         let sol = g.partial_piv_lu().solve(&c);
         let sigma2 = e.iter().map(|v| v * v).sum::<f64>() / (n - 1) as f64;
         let naive = (0..=lags).map(|a| c[(a, 0)] * sol[(a, 0)]).sum::<f64>() / sigma2;
