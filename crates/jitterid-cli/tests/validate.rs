@@ -411,22 +411,8 @@ fn validate_input_file_level_and_portmanteau_fields() {
     assert_eq!(w["dof"], 25);
     assert!(w["statistic"].as_f64().unwrap() > 0.0);
     // The verdict is the p-value against the level: a level below the p-value passes.
-    let level = format!("{:e}", p / 2.0);
-    let o = run(&[
-        "validate",
-        &exp,
-        "--data",
-        s(&data),
-        "--input",
-        s(&moved),
-        "--level",
-        &level,
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
-    assert_eq!(j["cross_correlation"]["passed"], true, "{j}");
-    for bad in ["0", "1", "1.5", "-0.2", "NaN"] {
-        let o = run(&[
+    let at_level = |level: &str| {
+        run(&[
             "validate",
             &exp,
             "--data",
@@ -434,8 +420,15 @@ fn validate_input_file_level_and_portmanteau_fields() {
             "--input",
             s(&moved),
             "--level",
-            bad,
-        ]);
+            level,
+        ])
+    };
+    let o = at_level(&format!("{:e}", p / 2.0));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["cross_correlation"]["passed"], true, "{j}");
+    for bad in ["0", "1", "1.5", "-0.2", "NaN"] {
+        let o = at_level(bad);
         assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
         let e = stderr(&o);
         assert!(e.contains("--level") && e.contains(bad), "{bad}: {e}");
