@@ -43,9 +43,11 @@ fn scaler<'a>(
     variance: &'a [f64],
 ) -> impl Fn(&[f64]) -> Option<Vec<f64>> + 'a {
     // `None` when the shape has its floor already, or the jitter adds no variance.
-    let floor = (!s.noise.is_white())
-        .then(|| s.jitter_floor_start(grid, Some(noise_std)).unwrap_or(0.0))
-        .unwrap_or(0.0);
+    let floor = if s.noise.is_white() {
+        0.0
+    } else {
+        s.jitter_floor_start(grid, Some(noise_std)).unwrap_or(0.0)
+    };
     move |x: &[f64]| {
         if s.noise.is_white() {
             Some(x.iter().zip(variance).map(|(v, l)| v / l.sqrt()).collect())

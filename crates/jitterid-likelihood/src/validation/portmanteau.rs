@@ -107,7 +107,7 @@ pub fn input_statistic(e: &[f64], u: &[f64], max_lag: usize, basis: &[Vec<f64>])
     let mean = u.iter().sum::<f64>() / n as f64;
     let lagged = |j: usize, tau: usize| if j >= tau { u[j - tau] - mean } else { 0.0 };
     // (I − QQᵀ)U, column by column.
-    let mut pu = Mat::from_fn(n, m, |j, tau| lagged(j, tau));
+    let mut pu = Mat::from_fn(n, m, lagged);
     for q in basis {
         for tau in 0..m {
             let c: f64 = (0..n).map(|j| q[j] * pu[(j, tau)]).sum();
