@@ -58,7 +58,7 @@ pub struct ValidateArgs {
     pub input: Option<PathBuf>,
     /// Level of the residual tests' verdicts: a true model fails each test in this fraction of
     /// records; strictly between 0 and 1.
-    #[arg(long, default_value_t = 0.01, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = jitterid::estimate::validation::DEFAULT_LEVEL, allow_negative_numbers = true)]
     pub level: f64,
     /// A validation record of the same system (same T, its own length and input side file).
     #[arg(long, value_name = "FILE")]
