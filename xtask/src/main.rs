@@ -10,6 +10,7 @@ mod reproduce_initial;
 mod reproduce_ml;
 mod reproduce_select;
 mod reproduce_starts;
+mod reproduce_validate;
 mod scale;
 
 use std::process::ExitCode;
@@ -24,7 +25,7 @@ const USAGE: &str = "usage:
   cargo xtask memory [N] [--out DIR]
       peak memory of the release binary's simulate, fit and montecarlo at N samples (default 10^7)
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
-      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, all";
+      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate, all";
 
 /// Options of `reproduce`.
 #[derive(Debug, Clone)]

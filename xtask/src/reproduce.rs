@@ -80,6 +80,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "starts" => crate::reproduce_starts::starts(o),
         "initial" => crate::reproduce_initial::initial(o),
         "select" => crate::reproduce_select::select_case(o),
+        "validate" => crate::reproduce_validate::validate_case(o),
         "all" => {
             for c in [
                 "table2",
@@ -91,13 +92,14 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
                 "starts",
                 "initial",
                 "select",
+                "validate",
             ] {
                 run(c, &Options { json: None, ..o.clone() })?;
             }
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate or all)"
         )),
     }
 }

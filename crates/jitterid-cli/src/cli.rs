@@ -52,6 +52,14 @@ pub struct ValidateArgs {
     /// The estimation record (CSV as for `fit`; a random-binary input from <stem>.input.csv).
     #[arg(long)]
     pub data: PathBuf,
+    /// The estimation record's input realisation (CSV with columns t,u) for a random-binary
+    /// experiment [default: <data stem>.input.csv].
+    #[arg(long, value_name = "FILE")]
+    pub input: Option<PathBuf>,
+    /// Level of the residual tests' verdicts: a true model fails each test in this fraction of
+    /// records; strictly between 0 and 1.
+    #[arg(long, default_value_t = jitterid::estimate::validation::DEFAULT_LEVEL, allow_negative_numbers = true)]
+    pub level: f64,
     /// A validation record of the same system (same T, its own length and input side file).
     #[arg(long, value_name = "FILE")]
     pub validation: Option<PathBuf>,
@@ -306,6 +314,8 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             experiment: a.experiment,
             paths: a.paths.paths(),
             data: a.data,
+            input: a.input,
+            level: a.level,
             validation: a.validation,
             model: a.model,
             bode: a.bode,

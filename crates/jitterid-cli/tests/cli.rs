@@ -62,14 +62,13 @@ fn the_examples_are_all_there() {
     }
 }
 
-/// The method an example file names (`bcls` unless it says `method = "bj"`).
+/// The method an example file names (`bcls` unless it says `method = "bj"` or `"ml"`).
 fn method_of(exp: &Path) -> &'static str {
     let text = std::fs::read_to_string(exp).unwrap();
-    if text.contains("method = \"bj\"") {
-        "bj"
-    } else {
-        "bcls"
-    }
+    ["bj", "ml"]
+        .into_iter()
+        .find(|m| text.contains(&format!("method = \"{m}\"")))
+        .unwrap_or("bcls")
 }
 
 #[test]

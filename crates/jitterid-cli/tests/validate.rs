@@ -374,3 +374,63 @@ fn validate_bode_band_of_a_system_with_a_free_initial_response() {
         assert!(v[7] > v[3] && v[6] < v[3], "{row}");
     }
 }
+
+/// `validate --input FILE` reads a record's input from a file of another name, as `fit` does;
+/// the JSON carries each test's statistic, degrees of freedom, p-value and level, and the
+/// verdict follows the p-value at `--level`; a level outside (0, 1) is refused with the flag
+/// and the value named, exit status 2.
+#[test]
+fn validate_input_file_level_and_portmanteau_fields() {
+    let dir = scratch("validate-input");
+    let data = dir.join("d.csv");
+    let exp = example("validate-one-pole.toml");
+    let truth = example("validate-true.toml");
+    assert!(run(&["simulate", &truth, "--out", s(&data)])
+        .status
+        .success());
+    let moved = dir.join("u-elsewhere.csv");
+    std::fs::rename(dir.join("d.input.csv"), &moved).unwrap();
+    // Without the side file and without --input: the missing file is named.
+    let o = run(&["validate", &exp, "--data", s(&data)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("d.input.csv"), "{}", stderr(&o));
+    let o = run(&["validate", &exp, "--data", s(&data), "--input", s(&moved)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["level"], 0.01);
+    // A one-pole model of a 2-pole, 1-zero system: Ljung's S on the cross-correlation with the
+    // input rejects it (on this record S ≈ 230 against 26 degrees of freedom).
+    let c = &j["cross_correlation"];
+    assert_eq!(c["test"], "ljung-s");
+    assert_eq!(c["dof"], 26);
+    let p = c["p_value"].as_f64().unwrap();
+    assert!(p < 0.01, "{c}");
+    assert_eq!(c["passed"], false);
+    let w = &j["whiteness"];
+    assert_eq!(w["test"], "ljung-box");
+    assert_eq!(w["dof"], 25);
+    assert!(w["statistic"].as_f64().unwrap() > 0.0);
+    // The verdict is the p-value against the level: a level below the p-value passes.
+    let at_level = |level: &str| {
+        run(&[
+            "validate",
+            &exp,
+            "--data",
+            s(&data),
+            "--input",
+            s(&moved),
+            "--level",
+            level,
+        ])
+    };
+    let o = at_level(&format!("{:e}", p / 2.0));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["cross_correlation"]["passed"], true, "{j}");
+    for bad in ["0", "1", "1.5", "-0.2", "NaN"] {
+        let o = at_level(bad);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("--level") && e.contains(bad), "{bad}: {e}");
+    }
+}

@@ -74,6 +74,12 @@ pub enum EstimateError {
         /// The value given.
         value: f64,
     },
+    /// A test level (the false-rejection probability of a validation test) outside `(0, 1)`.
+    #[error("test level must lie strictly between 0 and 1, got {value}")]
+    BadLevel {
+        /// The value given.
+        value: f64,
+    },
     /// The noise model is invalid (for example a non-minimum-phase or unstable ARMA filter).
     #[error("noise model: {0}")]
     Noise(String),

@@ -6,7 +6,8 @@ use jitterid_estimate::{fit, Bcls, FitOptions, ModelStructure, Record};
 use jitterid_jitter::UniformSum;
 use jitterid_likelihood::validation::{
     bode, cross_correlation, default_max_lag, fit_initial_state, log_response_gradient,
-    standardized_residuals, step_response, step_value_and_gradient, whiteness,
+    residual_projection, standardized_residuals, step_response, step_value_and_gradient, whiteness,
+    DEFAULT_LEVEL,
 };
 use jitterid_signal::{
     simulate, Input, LtiResponse, PiecewiseConstant, RandomBinary, RationalModel, Root, SampleGrid,
@@ -152,8 +153,16 @@ fn verdicts<M: RationalModel + 'static>(
     let m = default_max_lag(y.len());
     let us: Vec<f64> = s.grid.times().map(|t| u.value(t)).collect();
     (
-        whiteness(&e, m).unwrap().passed,
-        cross_correlation(&e, &us, m).unwrap().passed,
+        whiteness(&e, m, 0, DEFAULT_LEVEL).unwrap().passed,
+        cross_correlation(
+            &e,
+            &us,
+            m,
+            &residual_projection(&[], y.len()),
+            DEFAULT_LEVEL,
+        )
+        .unwrap()
+        .passed,
     )
 }
 

@@ -34,6 +34,7 @@ pub mod merge;
 pub mod montecarlo;
 pub mod records;
 mod registries;
+pub mod residual_tests;
 pub mod select;
 pub mod simulate;
 pub mod validate;

@@ -6,7 +6,7 @@ use crate::error::StudyResult;
 use crate::experiment::{self, Experiment, InputSpec, Paths, Purpose};
 use crate::inputs;
 use crate::study_err;
-use jitterid::signal::Input;
+use jitterid::signal::{Input, SampleGrid};
 use std::path::{Path, PathBuf};
 
 /// The side file holding the input of a simulated record: `data.csv` → `data.input.csv`.
@@ -140,6 +140,16 @@ pub fn read_input(
     data: &Path,
     input: Option<&Path>,
 ) -> StudyResult<Option<Input>> {
+    read_input_on(exp, data, input, &exp.grid)
+}
+
+/// [`read_input`] for a record on `grid` (a validation record has its own length and start).
+pub fn read_input_on(
+    exp: &Experiment,
+    data: &Path,
+    input: Option<&Path>,
+    grid: &SampleGrid,
+) -> StudyResult<Option<Input>> {
     Ok(match &exp.input {
         InputSpec::None => None,
         InputSpec::Known(i) => Some(i.clone()),
@@ -153,7 +163,7 @@ pub fn read_input(
             }
             let t = csvio::read(&side)?;
             Some(Input::Piecewise(inputs::piecewise_from_table(
-                &t, "t", "u", &exp.grid,
+                &t, "t", "u", grid,
             )?))
         }
     })

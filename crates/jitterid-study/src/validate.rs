@@ -4,16 +4,15 @@
 
 use crate::csvio;
 use crate::error::StudyResult;
-use crate::experiment::{Experiment, InputSpec};
+use crate::experiment::Experiment;
 use crate::export;
 use crate::fit::{self, Structure};
-use crate::inputs;
-use crate::records::{input_side_file, read_data};
+use crate::records::{read_data, read_input_on};
+use crate::residual_tests::tested_residuals;
 use crate::study_err;
-use crate::whiten;
 use crate::Watch;
+use jitterid::estimate::residual_flatness;
 use jitterid::estimate::validation::{self, BodePoint, CorrelationTest, StepPoint};
-use jitterid::estimate::{residual_flatness, NoiseModel};
 use jitterid::signal::{Input, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use serde::Serialize;
@@ -31,6 +30,9 @@ pub struct RecordReport {
     pub samples: usize,
     /// Normalised fit of the expected samples, in percent.
     pub fit_percent: f64,
+    /// How many fitted parameters' directions were removed from the residuals before the
+    /// correlation tests ([`crate::residual_tests`]).
+    pub removed_directions: usize,
     /// Autocorrelation of the standardised residuals.
     pub whiteness: CorrelationTest,
     /// Cross-correlation of the standardised residuals with the input (`null` without input).
@@ -46,6 +48,8 @@ pub struct RecordReport {
 /// The JSON of `validate`, borrowed from a [`Validation`].
 #[derive(Debug, Serialize)]
 pub struct ValidateJson<'a> {
+    /// The level of the tests' verdicts.
+    level: f64,
     fit_percent: FitPercent,
     whiteness: &'a CorrelationTest,
     cross_correlation: Option<&'a CorrelationTest>,
@@ -73,21 +77,6 @@ struct FitFile {
 struct FitParam {
     name: String,
     estimate: f64,
-}
-
-/// The input of a record: the experiment's, or a random-binary realisation's side file.
-fn record_input(exp: &Experiment, data: &Path, grid: &SampleGrid) -> StudyResult<Option<Input>> {
-    Ok(match &exp.input {
-        InputSpec::None => None,
-        InputSpec::Known(i) => Some(i.clone()),
-        InputSpec::RandomBinary(_) => {
-            let side = input_side_file(data);
-            let t = csvio::read(&side)?;
-            Some(Input::Piecewise(inputs::piecewise_from_table(
-                &t, "t", "u", grid,
-            )?))
-        }
-    })
 }
 
 /// The fitted structure, its noise level and the covariance of its signal parameters.
@@ -167,26 +156,31 @@ fn signal_block(c: Option<&[Vec<Option<f64>>]>, ns: usize) -> Option<Vec<Vec<f64
         .flatten()
 }
 
-/// The validation checks of `y` on `grid` under `s`, and the expected samples `m_k`.
-fn check_record(
+/// The validation checks of `y` on `grid` under `s` (a fitted structure, noise level
+/// `noise_std`, driven by `input`), with the correlation tests' verdicts at `level`, and the
+/// expected samples `m_k`. `name` names the record in messages.
+pub fn check_record(
     s: &Structure,
     grid: &SampleGrid,
     y: &[f64],
     noise_std: f64,
     input: Option<&Input>,
+    level: f64,
     name: &str,
 ) -> StudyResult<(RecordReport, Vec<f64>)> {
     let e = |e: jitterid::estimate::EstimateError| study_err!("{name}: validation: {e}");
     let cmp = validation::compare(s, grid, y).map_err(e)?;
     let r = validation::standardized_residuals(s, grid, y, noise_std).map_err(e)?;
     let raw: Vec<f64> = y.iter().zip(&cmp.expected).map(|(y, m)| y - m).collect();
-    let tested = tested_residuals(s, grid, noise_std, &raw, r.standardized, name)?;
+    let tested = tested_residuals(s, grid, noise_std, y, &raw, &r.variance, name)?;
     let m = validation::default_max_lag(y.len());
-    let whiteness = validation::whiteness(&tested, m).map_err(e)?;
+    let whiteness =
+        validation::whiteness(&tested.residuals, m, tested.noise_params, level).map_err(e)?;
     let cross = match input {
         Some(input) => {
             let u: Vec<f64> = grid.times().map(|t| input.value(t)).collect();
-            validation::cross_correlation(&tested, &u, m).ok()
+            // A constant input has no cross-correlation to test.
+            validation::cross_correlation(&tested.residuals, &u, m, &tested.basis, level).ok()
         }
         None => None,
     };
@@ -197,37 +191,13 @@ fn check_record(
         record: name.to_string(),
         samples: y.len(),
         fit_percent: cmp.fit_percent,
+        removed_directions: tested.removed,
         whiteness,
         cross_correlation: cross,
         flatness,
         initial_state: None,
     };
     Ok((report, cmp.expected))
-}
-
-/// The residuals the correlation tests see: the standardised residuals for white noise; for a
-/// coloured noise model the raw residuals whitened by the fitted residual spectrum, the noise
-/// model's shape plus the jitter's floor `ρ = λ̄/σ_e²` at this record's model
-/// ([`whiten::whitened`]).
-fn tested_residuals(
-    s: &Structure,
-    grid: &SampleGrid,
-    noise_std: f64,
-    raw: &[f64],
-    standardized: Vec<f64>,
-    name: &str,
-) -> StudyResult<Vec<f64>> {
-    if s.noise.is_white() {
-        return Ok(standardized);
-    }
-    // `None` when the shape has its floor already, or the jitter adds no variance.
-    let floor = s.jitter_floor_start(grid, Some(noise_std)).unwrap_or(0.0);
-    whiten::whitened(raw, grid.interval(), |f| {
-        s.noise.shape(f, grid.interval()) + floor
-    })
-    .ok_or_else(|| {
-        study_err!("{name}: validation: the noise model's spectrum is not positive and finite")
-    })
 }
 
 /// The fitted model on a validation record: driven by the record's input and, for a model with
@@ -400,6 +370,8 @@ pub struct Validation {
     pub estimation: ValidatedRecord,
     /// The validation record's checks.
     pub validation: Option<ValidatedRecord>,
+    /// The level of the tests' verdicts.
+    pub level: f64,
 }
 
 impl Validation {
@@ -408,6 +380,7 @@ impl Validation {
         let e = &self.estimation.report;
         let v = self.validation.as_ref().map(|v| &v.report);
         ValidateJson {
+            level: self.level,
             fit_percent: FitPercent {
                 estimation: e.fit_percent,
                 validation: v.map(|v| v.fit_percent),
@@ -421,20 +394,52 @@ impl Validation {
     }
 }
 
+/// What `validate` checks besides the estimation record.
+#[derive(Debug, Clone, Copy)]
+pub struct ValidateOptions<'a> {
+    /// A validation record (same `T`, its own input side file).
+    pub validation: Option<&'a Path>,
+    /// A `fit --json` output to validate instead of fitting.
+    pub model: Option<&'a Path>,
+    /// The estimation record's input realisation (a random-binary experiment), default
+    /// `<data stem>.input.csv`.
+    pub input: Option<&'a Path>,
+    /// The level of the correlation tests' verdicts, in `(0, 1)`.
+    pub level: f64,
+}
+
+impl Default for ValidateOptions<'_> {
+    fn default() -> Self {
+        ValidateOptions {
+            validation: None,
+            model: None,
+            input: None,
+            level: validation::DEFAULT_LEVEL,
+        }
+    }
+}
+
+/// `level` if it lies in `(0, 1)`; otherwise an error naming `flag` and the value.
+pub fn check_level(level: f64, flag: &str) -> StudyResult<f64> {
+    validation::check_level(level).map_err(|_| {
+        study_err!("{flag}: expected a test level strictly between 0 and 1, found {level}")
+    })
+}
+
 /// Validates the experiment's model on the record in `data` and, when given, on the record in
-/// `validation`: the model is read from `model` (a `fit --json` output) or fitted here.
+/// `o.validation`: the model is read from `o.model` (a `fit --json` output) or fitted here.
 pub fn validate(
     exp: &Experiment,
     data: &Path,
-    validation: Option<&Path>,
-    model: Option<&Path>,
+    o: &ValidateOptions<'_>,
     watch: &Watch,
 ) -> StudyResult<Validation> {
+    let level = check_level(o.level, "--level")?;
     let table = read_data(exp, data)?;
     let y = table.y;
-    let input = record_input(exp, data, &exp.grid)?;
+    let input = read_input_on(exp, data, o.input, &exp.grid)?;
     let signal = fit::signal_of(exp, input.as_ref())?;
-    let (fitted, noise_std, covariance) = match model {
+    let (fitted, noise_std, covariance) = match o.model {
         Some(path) => {
             let s = fit::structure(exp, signal, exp.estimate.method)?;
             model_from_file(exp, s, path)?
@@ -452,6 +457,7 @@ pub fn validate(
         &y,
         noise_std,
         input.as_ref(),
+        level,
         &table.name,
     )?;
     let estimation = ValidatedRecord {
@@ -460,12 +466,13 @@ pub fn validate(
         y,
         expected,
     };
-    let validation = match validation {
+    let validation = match o.validation {
         Some(path) => {
             let (grid, y, name) = read_validation(exp, path)?;
-            let u = record_input(exp, path, &grid)?;
+            let u = read_input_on(exp, path, None, &grid)?;
             let s = for_validation_record(&fitted, &grid, &y, u.as_ref(), &name)?;
-            let (mut report, expected) = check_record(&s, &grid, &y, noise_std, u.as_ref(), &name)?;
+            let (mut report, expected) =
+                check_record(&s, &grid, &y, noise_std, u.as_ref(), level, &name)?;
             report.initial_state = initial_state(&s.signal);
             Some(ValidatedRecord {
                 report,
@@ -482,5 +489,6 @@ pub fn validate(
         covariance,
         estimation,
         validation,
+        level,
     })
 }

@@ -9,7 +9,8 @@ use jitterid_study::experiment::{self, Experiment, Paths, Purpose};
 use jitterid_study::fit::Structure;
 use jitterid_study::study_err;
 use jitterid_study::validate::{
-    bode_csv, frequency_response, step, validate as run_validation, ValidatedRecord,
+    bode_csv, frequency_response, step, validate as run_validation,
+    ValidateOptions as StudyValidateOptions, ValidatedRecord,
 };
 use jitterid_study::Watch;
 use std::path::{Path, PathBuf};
@@ -23,6 +24,10 @@ pub struct ValidateOptions {
     pub paths: Paths,
     /// The estimation record.
     pub data: PathBuf,
+    /// Its input realisation (a random-binary experiment), default `<data>.input.csv`.
+    pub input: Option<PathBuf>,
+    /// The level of the residual tests' verdicts.
+    pub level: f64,
     /// A validation record (same `T`, its own input side file).
     pub validation: Option<PathBuf>,
     /// A `fit --json` output to validate instead of fitting.
@@ -80,8 +85,12 @@ pub fn validate(o: &ValidateOptions) -> StudyResult<Outcome> {
     let v = run_validation(
         &exp,
         &o.data,
-        o.validation.as_deref(),
-        o.model.as_deref(),
+        &StudyValidateOptions {
+            validation: o.validation.as_deref(),
+            model: o.model.as_deref(),
+            input: o.input.as_deref(),
+            level: o.level,
+        },
         &Watch::none(),
     )?;
     let mut outputs = OutputSet::new();

@@ -126,12 +126,17 @@ fn correlation_panel(c: &CorrelationTest, heading: &str, skip_zero: bool) -> Pan
         .collect();
     let from = pts.first().map_or(0.0, |p| p.0);
     let verdict = if c.passed { "passed" } else { "failed" };
+    // The verdict is the portmanteau test's; the count of lags outside is shown beside it.
     let mut series = vec![Series {
         label: format!(
-            "{} of {} lags outside (≤ {} allowed): {verdict}",
+            "{} = {:.1}, χ²({}) p = {:.3}: {verdict} at level {}; {} of {} lags outside",
+            if c.test == "ljung-box" { "Q" } else { "S" },
+            c.statistic,
+            c.dof,
+            c.p_value,
+            c.level,
             c.outside,
             pts.len(),
-            c.allowed
         ),
         color: BLUE,
         opacity: 1.0,
