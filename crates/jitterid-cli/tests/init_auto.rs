@@ -108,7 +108,10 @@ fn a_bad_init_value_exits_2_naming_the_flag() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("--init") && err.contains("auto"), "{err}");
+    assert!(
+        err.contains("--init") && err.contains("auto") && err.contains("experiment-only"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -1,23 +1,16 @@
 //! Where a likelihood fit starts, through the binary: from a start in another basin of the
 //! likelihood, `fit --method ml --init experiment-only` stops at a local optimum and is
 //! reported as not converged with the reason (exit 1); the default starts at the BCLS estimate
-//! and reaches the optimum of a fit started at the truth.
+//! and reaches the optimum of a fit started at the truth (a bad `--init` value: `init_auto.rs`).
 
+mod common;
+
+use common::{example, run as jitterid};
 use std::path::Path;
-use std::process::Command;
 
-fn jitterid(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_jitterid"))
-        .args(args)
-        .output()
-        .expect("runs")
-}
-
-fn example() -> String {
-    std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/experiments/ml-start.toml"),
-    )
-    .unwrap()
+/// The example experiment's text.
+fn text() -> String {
+    std::fs::read_to_string(example("ml-start.toml")).unwrap()
 }
 
 fn json(out: &std::process::Output) -> serde_json::Value {
@@ -35,11 +28,11 @@ fn a_likelihood_fit_does_not_report_a_local_optimum_as_converged() {
     let dir = tempfile::tempdir().unwrap();
     let s = |p: &Path| p.display().to_string();
     let truth = dir.path().join("truth.toml");
-    std::fs::write(&truth, example()).unwrap();
-    let wrong_text = example()
+    std::fs::write(&truth, text()).unwrap();
+    let wrong_text = text()
         .replace("gain = 2.0", "gain = -2.0")
         .replace("poles = [[-1.0, 2.0]]", "poles = [[-3.0, 0.3]]");
-    assert_ne!(wrong_text, example());
+    assert_ne!(wrong_text, text());
     let wrong = dir.path().join("wrong.toml");
     std::fs::write(&wrong, &wrong_text).unwrap();
     let data = dir.path().join("d.csv");
@@ -93,25 +86,4 @@ fn a_likelihood_fit_does_not_report_a_local_optimum_as_converged() {
         let se = b["stderr"].as_f64().unwrap();
         assert!((x - y).abs() < 1e-3 * se, "{}: {x} against {y}", a["name"]);
     }
-}
-
-#[test]
-fn a_bad_init_names_every_value() {
-    let dir = tempfile::tempdir().unwrap();
-    let exp = dir.path().join("e.toml");
-    std::fs::write(&exp, example()).unwrap();
-    let out = jitterid(&[
-        "fit",
-        &exp.display().to_string(),
-        "--data",
-        "d.csv",
-        "--init",
-        "bcls",
-    ]);
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("experiment-only") && err.contains("--init"),
-        "{err}"
-    );
 }

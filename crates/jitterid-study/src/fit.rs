@@ -382,25 +382,42 @@ pub fn fit(
     covariance: bool,
     watch: &Watch,
 ) -> Result<Fit, String> {
-    let criterion = criterion_of(exp, s, method);
-    if criterion.is_likelihood() && s.estimate_signal && !profiled(exp) {
+    let call = FitCall {
+        exp,
+        record,
+        method,
+        seed,
+        covariance,
+        watch,
+    };
+    if criterion_of(exp, s, method).is_likelihood() && s.estimate_signal && !profiled(exp) {
         let budget = crate::budget_of(exp, watch.cancel.clone());
-        return budget
-            .run(|| crate::likelihood_start::fit(exp, s, record, method, seed, covariance, watch));
+        return budget.run(|| crate::likelihood_start::fit(&call, s));
     }
-    fit_once(exp, s, record, method, seed, covariance, watch)
+    call.once(s)
+}
+
+/// Everything of a fit but its start: what [`fit`] runs once or several times.
+pub(crate) struct FitCall<'a> {
+    pub(crate) exp: &'a Experiment,
+    pub(crate) record: &'a Record,
+    pub(crate) method: Method,
+    pub(crate) seed: u64,
+    pub(crate) covariance: bool,
+    pub(crate) watch: &'a Watch,
+}
+
+impl FitCall<'_> {
+    /// One fit from `s`'s parameters, under its own time limit.
+    pub(crate) fn once(&self, s: &Structure) -> Result<Fit, String> {
+        fit_once(self, s)
+    }
 }
 
 /// One fit of `s` from its parameters, under its own time limit.
-pub(crate) fn fit_once(
-    exp: &Experiment,
-    s: &Structure,
-    record: &Record,
-    method: Method,
-    seed: u64,
-    covariance: bool,
-    watch: &Watch,
-) -> Result<Fit, String> {
+fn fit_once(call: &FitCall<'_>, s: &Structure) -> Result<Fit, String> {
+    let (exp, record, method, seed) = (call.exp, call.record, call.method, call.seed);
+    let (covariance, watch) = (call.covariance, call.watch);
     let criterion = criterion_of(exp, s, method);
     if criterion.is_likelihood() && !cfg!(feature = "ml") {
         return Err("maximum likelihood is not available in this build of jitterid".into());

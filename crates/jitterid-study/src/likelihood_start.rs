@@ -23,9 +23,8 @@
 //! well than BCLS (by some `p/N` of the residual), and only a difference beyond the two
 //! estimators' sampling difference says that the likelihood stopped elsewhere.
 
-use crate::experiment::{Experiment, LikelihoodStart, Method};
-use crate::fit::{fit_once, structure, Fit, Structure};
-use crate::Watch;
+use crate::experiment::{LikelihoodStart, Method};
+use crate::fit::{structure, Fit, FitCall, Structure};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use jitterid::estimate::validation::fit_percent;
@@ -42,51 +41,43 @@ pub const CHECK_LEVEL: f64 = 1e-3;
 /// any difference a likelihood-ratio test would see (its 50 % point is 0.23 units).
 pub const LIKELIHOOD_TOLERANCE: f64 = 1e-3;
 
-/// Fits `s` with the likelihood `method` as [`LikelihoodStart`] says, then checks the end.
-pub(crate) fn fit(
-    exp: &Experiment,
-    s: &Structure,
-    record: &Record,
-    method: Method,
-    seed: u64,
-    covariance: bool,
-    watch: &Watch,
-) -> Result<Fit, String> {
-    let bcls = bcls_estimate(exp, s, record, seed, watch);
+/// Fits `s` with the likelihood of `call` as [`LikelihoodStart`] says, then checks the end.
+pub(crate) fn fit(call: &FitCall<'_>, s: &Structure) -> Result<Fit, String> {
+    let bcls = bcls_estimate(call, s);
     let bcls_start = bcls.as_ref().and_then(|b| start_at(s, &b.fitted));
     let mut f;
     let mut other = None;
-    match exp.estimate.likelihood_start {
-        LikelihoodStart::Bcls => {
-            let start = bcls_start.as_ref().unwrap_or(s);
-            f = fit_once(exp, start, record, method, seed, covariance, watch)?;
-        }
+    match call.exp.estimate.likelihood_start {
+        LikelihoodStart::Bcls => f = call.once(bcls_start.as_ref().unwrap_or(s))?,
         LikelihoodStart::Given => {
-            f = fit_once(exp, s, record, method, seed, covariance, watch)?;
-            other = bcls_start
-                .and_then(|start| fit_once(exp, &start, record, method, seed, false, watch).ok());
+            f = call.once(s)?;
+            // The check's fit needs no covariance.
+            let check = FitCall {
+                covariance: false,
+                ..*call
+            };
+            other = bcls_start.and_then(|start| check.once(&start).ok());
         }
     }
     if let Some(reason) = other.as_ref().and_then(|o| worse_than(&f, o)) {
         not_converged(&mut f, &reason);
-    } else if let Some(reason) = bcls.as_ref().and_then(|b| elsewhere(record, &f, b)) {
+    } else if let Some(reason) = bcls.as_ref().and_then(|b| elsewhere(call.record, &f, b)) {
         not_converged(&mut f, &reason);
     }
     Ok(f)
 }
 
 /// The converged BCLS fit from `s`'s start (with its covariance), `None` when it fails.
-fn bcls_estimate(
-    exp: &Experiment,
-    s: &Structure,
-    record: &Record,
-    seed: u64,
-    watch: &Watch,
-) -> Option<Fit> {
-    let mut b = structure(exp, s.signal.clone(), Method::BCLS).ok()?;
+fn bcls_estimate(call: &FitCall<'_>, s: &Structure) -> Option<Fit> {
+    let mut b = structure(call.exp, s.signal.clone(), Method::BCLS).ok()?;
     // The given start's jitter, which may differ from the experiment's (a perturbed start).
     b.jitter = s.jitter.clone();
-    let f = fit_once(exp, &b, record, Method::BCLS, seed, true, watch).ok()?;
+    let bcls = FitCall {
+        method: Method::BCLS,
+        covariance: true,
+        ..*call
+    };
+    let f = bcls.once(&b).ok()?;
     f.converged.then_some(f)
 }
 
