@@ -57,7 +57,9 @@ pub enum SignalError {
     },
     /// A pole with a positive real part: the model is unstable. (Poles on the imaginary axis,
     /// integrators and undamped modes, are accepted: a record is finite.)
-    #[error("pole {re}{im:+}i is unstable (its real part must be ≤ 0; `unstable = true` accepts it)")]
+    #[error(
+        "pole {re}{im:+}i is unstable (its real part must be ≤ 0; `unstable = true` accepts it)"
+    )]
     Unstable {
         /// Real part of the pole.
         re: f64,

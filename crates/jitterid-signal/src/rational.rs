@@ -483,12 +483,7 @@ impl TransferFunction {
                 poles: den.len() - 1,
             });
         }
-        Self::from_monic(
-            self.num().to_vec(),
-            den.to_vec(),
-            self.rational.unstable,
-            n,
-        )
+        Self::from_monic(self.num().to_vec(), den.to_vec(), self.rational.unstable, n)
     }
 
     /// The number of poles held at the origin ([`with_integrators`](Self::with_integrators)).

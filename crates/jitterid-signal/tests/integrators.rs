@@ -57,7 +57,10 @@ fn a_tf_integrator_is_held_and_the_rest_estimated() {
         .with_integrators(1)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("`integrators` = 1") && e.contains("0 of them"), "{e}");
+    assert!(
+        e.contains("`integrators` = 1") && e.contains("0 of them"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -90,7 +93,10 @@ fn a_zpk_integrator_is_held_and_named_by_its_place() {
             let fd = (g.with_params(&up).unwrap().response(s)
                 - g.with_params(&down).unwrap().response(s))
                 / (2.0 * h);
-            assert!((fd - d).norm() < 1e-7 * d.norm().max(1.0), "{j}: {fd} vs {d}");
+            assert!(
+                (fd - d).norm() < 1e-7 * d.norm().max(1.0),
+                "{j}: {fd} vs {d}"
+            );
         }
     }
     assert!(matches!(

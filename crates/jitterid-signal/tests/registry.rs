@@ -21,9 +21,7 @@ fn specs() -> Vec<SpecTable> {
         table(json!({"kind": "tf", "num": [0.3, 1.0], "den": [1.0, 1.5, 0.9]})),
         // Structural integrators: held at the origin, kept by the spec.
         table(json!({"kind": "tf", "num": [0.5], "den": [1.0, 1.5, 0.0], "integrators": 1})),
-        table(
-            json!({"kind": "zpk", "gain": 0.5, "poles": [0.0, -1.5, 0.0], "integrators": 2}),
-        ),
+        table(json!({"kind": "zpk", "gain": 0.5, "poles": [0.0, -1.5, 0.0], "integrators": 2})),
         table(json!({"kind": "sinusoid", "amplitude": 1.3, "frequency": 0.27, "phase": 0.4})),
         table(
             json!({"kind": "pulse-response", "coefficients": [0.6, 0.3, -0.15], "interval": 0.5}),
