@@ -58,7 +58,7 @@ fn plain_search(
     SolverReport,
 ) {
     let (structure, record) = setup(r);
-    let grid = record.grid().clone();
+    let grid = *record.grid();
     let data = FrequencyData::new(record, DirichletWindow, FrequencySet::dft(&grid)).expect("data");
     let stalled = LevenbergMarquardt::default()
         .minimize(

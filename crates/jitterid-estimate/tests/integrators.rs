@@ -66,9 +66,9 @@ fn a_structural_integrator_fits_unbiased() {
         let fitted = start.with_params(&f.params).expect("fitted model");
         assert_eq!(fitted.den()[2], 0.0, "record {r}: the integrator moved");
         let se = f.std_errors.clone().expect("standard errors");
-        for i in 0..2 {
+        for (i, se) in se.iter().enumerate() {
             sum[i] += f.params[i];
-            se_sum[i] += se[i];
+            se_sum[i] += se;
         }
     }
     let n = RUNS as f64;
@@ -118,9 +118,9 @@ fn a_search_that_reaches_the_axis_ends_converged_on_it() {
             .and_then(|g| g.with_integrators(1))
             .expect("start");
         let g = fit_with(held, u, &record);
-        for i in 0..2 {
+        for (i, se) in se.iter().take(2).enumerate() {
             assert!(
-                (f.params[i] - g.params[i]).abs() < 1e-3 * se[i],
+                (f.params[i] - g.params[i]).abs() < 1e-3 * se,
                 "record {r}: {:?} vs {:?}",
                 f.params,
                 g.params
