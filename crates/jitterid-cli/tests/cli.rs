@@ -836,6 +836,22 @@ fn bad_experiment_files() {
         &GOOD.replace("[[-0.25, 0.3]]", "[[0.25, 0.3]]"),
         &["exp.toml:13:", "poles", "stable"],
     );
+    // Structural integrators: more than the poles at the origin, or more than the poles.
+    bad_experiment(
+        "integrators-at-origin",
+        &GOOD.replace("estimate = true\n", "estimate = true\nintegrators = 1\n"),
+        &[
+            "exp.toml:15:",
+            "integrators",
+            "`integrators` = 1",
+            "0 of them",
+        ],
+    );
+    bad_experiment(
+        "integrators-too-many",
+        &GOOD.replace("estimate = true\n", "estimate = true\nintegrators = 3\n"),
+        &["exp.toml:15:", "integrators", "[0, 2]", "found 3"],
+    );
     bad_experiment(
         "bad-pair",
         &GOOD.replace("[[-0.25, 0.3]]", "[[-0.25, -0.3]]"),

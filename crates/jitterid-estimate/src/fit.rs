@@ -5,11 +5,12 @@ use crate::boundary::{bound_params, positive_params, settle_at_bounds};
 use crate::covariance::sandwich;
 use crate::criterion::Criterion;
 use crate::data::Record;
+use crate::edges::{candidate_edges, settle_on_edge, EdgeKind, EdgeOutcome};
 use crate::evaluation_memo::{EvaluationMemo, MEMO_MAX_SAMPLES};
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::result::{CostKind, Fit};
-use crate::solver::{LeastSquares, NormalEquations, Solver, SolverError};
+use crate::solver::{LeastSquares, NormalEquations, Solver, SolverError, SolverReport};
 use crate::structure::ModelStructure;
 use crate::EstimateError;
 use faer::Mat;
@@ -196,6 +197,60 @@ where
     }
 }
 
+/// The solver's search from `start`, with the domain's edges: a width that went to 0 stalls
+/// the solver at the edge, and a search may stop short of an edge it was heading for (a width
+/// creeping to 0, a pole pushed onto the axis); the edge is the answer when it is a constrained
+/// minimum, and otherwise the search goes on from the point on the edge it reached (at most
+/// [`EDGE_ROUNDS`] times). Returns the report, the parameters held on their edge, and the one
+/// held on the stability boundary, if any.
+fn search<P, V>(
+    problem: &P,
+    structure: &ModelStructure<impl Signal + Clone, impl JitterModel + Clone, impl NoiseModel>,
+    solver: &V,
+    start: &[f64],
+) -> Result<(SolverReport, Vec<usize>, Option<usize>), EstimateError>
+where
+    P: LeastSquares,
+    V: Solver<P>,
+{
+    let positive = positive_params(structure);
+    let mut from = start.to_vec();
+    // Iterations of the rounds before the current one.
+    let mut before = 0;
+    let total = |r: SolverReport, before: u64| SolverReport {
+        iterations: before + r.iterations,
+        ..r
+    };
+    // Ends: the last round tries no edge, so it ends as `Nothing` at the latest.
+    let mut round = 0;
+    loop {
+        let report = solver.minimize(problem, &from)?;
+        let held = bound_params(&report, start, &positive);
+        // Its iterations include the refit's.
+        let report = settle_at_bounds(problem, report, &held)?;
+        let edges = if round < EDGE_ROUNDS {
+            candidate_edges(structure, &report, start, &positive)
+        } else {
+            Vec::new()
+        };
+        match settle_on_edge(problem, &report, &edges)? {
+            EdgeOutcome::AtEdge(settled, edge, kind) => {
+                let on_axis = (kind == EdgeKind::Axis).then_some(edge.index);
+                return Ok((total(settled, before), vec![edge.index], on_axis));
+            }
+            EdgeOutcome::Inside(settled) => {
+                before += settled.iterations;
+                from = settled.params;
+                round += 1;
+            }
+            EdgeOutcome::Nothing => return Ok((total(report, before), held, None)),
+        }
+    }
+}
+
+/// How many times a search goes on from an edge it stopped against (see [`search`]).
+const EDGE_ROUNDS: usize = 3;
+
 /// The jitter's reach `(lo, hi)` and the grid's duration when the reach does not fit in the
 /// record (not finite, or wider than the duration): outside the model's domain for every
 /// criterion ([`EstimateError::ReachExceedsRecord`], `MlError::ReachExceedsRecord`).
@@ -291,10 +346,7 @@ where
         return Err(EstimateError::NonFiniteAtStart { index, value });
     }
     drop(r0);
-    let report = options.solver.minimize(&problem, &start)?;
-    // A width that went to 0 stalls the solver at the domain's edge: that is an answer.
-    let held = bound_params(&report, &start, &positive_params(structure));
-    let report = settle_at_bounds(&problem, report, &held)?;
+    let (report, held, on_axis) = search(&problem, structure, &options.solver, &start)?;
     let fitted = structure.with_params(&report.params)?;
     let residuals = problem.residuals(&report.params)?;
     let (mut covariance, noise_std) = if options.covariance && !budget::spent() {
@@ -327,7 +379,21 @@ where
         (None, Some(f)) if report.converged && f > crate::FLATNESS_LIMIT => {
             (false, crate::FitTermination::ResidualNotFlat)
         }
-        _ => (report.converged, report.termination.into()),
+        _ => match on_axis {
+            Some(i) => (
+                report.converged,
+                crate::FitTermination::AtStabilityBoundary {
+                    params: vec![i],
+                    names: structure
+                        .param_names()
+                        .into_iter()
+                        .skip(i)
+                        .take(1)
+                        .collect(),
+                },
+            ),
+            None => (report.converged, report.termination.into()),
+        },
     };
     Ok(Fit {
         criterion: criterion.name().to_string(),

@@ -58,6 +58,7 @@ mod boundary;
 mod covariance;
 mod criterion;
 mod data;
+mod edges;
 mod error;
 mod evaluation_memo;
 mod fit;

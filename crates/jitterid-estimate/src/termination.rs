@@ -19,6 +19,17 @@ pub enum FitTermination {
     /// [`FLATNESS_LIMIT`](crate::FLATNESS_LIMIT)): a local minimum, or a model that does not
     /// describe the data. Set by [`fit`](crate::fit), not by the solvers.
     ResidualNotFlat,
+    /// Converged on the boundary of the stable models: the search reached the imaginary axis
+    /// (a pole at the origin, or an undamped pair) and stopped there, so the system
+    /// parameters `params` (indices into the free parameters, named `names`) are held at 0 and
+    /// the others fitted with them held. Set by [`fit`](crate::fit) for a model that refuses
+    /// unstable poles; the parameters held get no standard error, as at any bound.
+    AtStabilityBoundary {
+        /// Indices of the parameters held at 0.
+        params: Vec<usize>,
+        /// Their names.
+        names: Vec<String>,
+    },
 }
 
 impl FitTermination {
@@ -29,6 +40,7 @@ impl FitTermination {
         match self {
             FitTermination::Solver(t) => t.is_convergence(),
             FitTermination::ResidualNotFlat => false,
+            FitTermination::AtStabilityBoundary { .. } => true,
         }
     }
 
@@ -36,7 +48,7 @@ impl FitTermination {
     pub fn solver(&self) -> Option<&Termination> {
         match self {
             FitTermination::Solver(t) => Some(t),
-            FitTermination::ResidualNotFlat => None,
+            FitTermination::ResidualNotFlat | FitTermination::AtStabilityBoundary { .. } => None,
         }
     }
 }
@@ -61,6 +73,13 @@ impl fmt::Display for FitTermination {
                 "converged, but the residual spectrum is not flat (a local minimum, or a model \
                  that does not describe the data)",
             ),
+            FitTermination::AtStabilityBoundary { names, .. } => write!(
+                f,
+                "converged at the stability boundary with {} held at 0 (a pole on the imaginary \
+                 axis: the model refuses poles right of it; `unstable = true` lets the search \
+                 cross, `integrators = n` holds known integrators at the origin)",
+                names.join(", ")
+            ),
         }
     }
 }
@@ -68,6 +87,9 @@ impl fmt::Display for FitTermination {
 /// The variant name and index `ResidualNotFlat` had in the solver's `Termination`.
 const NOT_FLAT: &str = "ResidualNotFlat";
 const NOT_FLAT_INDEX: u32 = 8;
+/// The variant name and index of [`FitTermination::AtStabilityBoundary`] in the same enum.
+const AT_AXIS: &str = "AtStabilityBoundary";
+const AT_AXIS_INDEX: u32 = 9;
 
 impl Serialize for FitTermination {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
@@ -75,6 +97,18 @@ impl Serialize for FitTermination {
             FitTermination::Solver(t) => t.serialize(serializer),
             FitTermination::ResidualNotFlat => {
                 serializer.serialize_unit_variant("Termination", NOT_FLAT_INDEX, NOT_FLAT)
+            }
+            FitTermination::AtStabilityBoundary { params, names } => {
+                use serde::ser::SerializeStructVariant;
+                let mut v = serializer.serialize_struct_variant(
+                    "Termination",
+                    AT_AXIS_INDEX,
+                    AT_AXIS,
+                    2,
+                )?;
+                v.serialize_field("params", params)?;
+                v.serialize_field("names", names)?;
+                v.end()
             }
         }
     }
@@ -85,6 +119,10 @@ impl<'de> Deserialize<'de> for FitTermination {
         #[derive(Deserialize)]
         enum Verdict {
             ResidualNotFlat,
+            AtStabilityBoundary {
+                params: Vec<usize>,
+                names: Vec<String>,
+            },
         }
         #[derive(Deserialize)]
         #[serde(untagged)]
@@ -94,6 +132,9 @@ impl<'de> Deserialize<'de> for FitTermination {
         }
         Ok(match Repr::deserialize(deserializer)? {
             Repr::Verdict(Verdict::ResidualNotFlat) => FitTermination::ResidualNotFlat,
+            Repr::Verdict(Verdict::AtStabilityBoundary { params, names }) => {
+                FitTermination::AtStabilityBoundary { params, names }
+            }
             Repr::Solver(t) => FitTermination::Solver(t),
         })
     }
@@ -117,6 +158,10 @@ mod tests {
             Termination::SmallStep.into(),
             Termination::AtBound { params: vec![1] }.into(),
             Termination::Other("why".into()).into(),
+            FitTermination::AtStabilityBoundary {
+                params: vec![2],
+                names: vec!["a0".into()],
+            },
         ] {
             let json = serde_json::to_string(&t).unwrap();
             if let Some(s) = t.solver() {

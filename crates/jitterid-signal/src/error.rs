@@ -57,12 +57,24 @@ pub enum SignalError {
     },
     /// A pole with a positive real part: the model is unstable. (Poles on the imaginary axis,
     /// integrators and undamped modes, are accepted: a record is finite.)
-    #[error("pole {re}{im:+}i is unstable (its real part must be ≤ 0)")]
+    #[error(
+        "pole {re}{im:+}i is unstable (its real part must be ≤ 0; `unstable = true` accepts it)"
+    )]
     Unstable {
         /// Real part of the pole.
         re: f64,
         /// Imaginary part of the pole.
         im: f64,
+    },
+    /// `integrators` asks for more poles at the origin than the system has there.
+    #[error("`integrators` = {integrators}: the system has {poles} pole(s), {at_origin} of them exactly at the origin (list the integrators as poles at 0.0, or as trailing zeros of `den`)")]
+    Integrators {
+        /// The number asked for.
+        integrators: usize,
+        /// Poles of the system at exactly 0.
+        at_origin: usize,
+        /// Poles of the system.
+        poles: usize,
     },
     /// More zeros than poles: the transfer function is improper.
     #[error("improper transfer function: {zeros} zeros but only {poles} poles")]

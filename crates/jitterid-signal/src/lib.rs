@@ -48,6 +48,7 @@ pub mod forms;
 mod grid;
 mod initial;
 mod input;
+mod integrators;
 mod lti;
 pub mod poly;
 mod pulse;

@@ -448,6 +448,9 @@ pub trait RationalModel: fmt::Debug + Clone + Send + Sync {
 pub struct TransferFunction {
     rational: Rational,
     num_len: usize,
+    /// Poles held exactly at the origin: the denominator's last coefficients, 0 and not
+    /// parameters.
+    integrators: usize,
 }
 
 impl TransferFunction {
@@ -456,29 +459,64 @@ impl TransferFunction {
     /// the imaginary axis are accepted).
     pub fn new(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
         let form = crate::forms::TfForm::new(num, den)?;
-        Self::from_monic(form.num().to_vec(), form.den().to_vec(), false)
+        Self::from_monic(form.num().to_vec(), form.den().to_vec(), false, 0)
     }
 
     /// As [`new`](Self::new), but poles right of the imaginary axis are accepted, here and in
     /// every `with_params` of the model (an estimate may cross the axis).
     pub fn new_allowing_unstable(num: &[f64], den: &[f64]) -> Result<Self, SignalError> {
         let form = crate::forms::TfForm::new(num, den)?;
-        Self::from_monic(form.num().to_vec(), form.den().to_vec(), true)
+        Self::from_monic(form.num().to_vec(), form.den().to_vec(), true, 0)
     }
 
-    fn from_monic(num: Vec<f64>, den: Vec<f64>, unstable: bool) -> Result<Self, SignalError> {
-        let poles = poly::roots(&den).ok_or(SignalError::Roots { name: "den" })?;
-        let (nb, na) = (num.len(), den.len() - 1);
+    /// The same model with its last `n` poles at the origin structural: `den`'s last `n`
+    /// coefficients are held at exactly 0 (not parameters), so that every `with_params` keeps
+    /// `n` exact integrators. Refused ([`SignalError::Integrators`]) unless `den` ends in at
+    /// least `n` zeros.
+    pub fn with_integrators(&self, n: usize) -> Result<Self, SignalError> {
+        let den = self.den();
+        let at_origin = den.iter().rev().take_while(|&&c| c == 0.0).count();
+        if n > at_origin {
+            return Err(SignalError::Integrators {
+                integrators: n,
+                at_origin,
+                poles: den.len() - 1,
+            });
+        }
+        Self::from_monic(self.num().to_vec(), den.to_vec(), self.rational.unstable, n)
+    }
+
+    /// The number of poles held at the origin ([`with_integrators`](Self::with_integrators)).
+    pub fn integrators(&self) -> usize {
+        self.integrators
+    }
+
+    /// `den`'s last `integrators` coefficients are 0 (checked by the callers).
+    fn from_monic(
+        num: Vec<f64>,
+        den: Vec<f64>,
+        unstable: bool,
+        integrators: usize,
+    ) -> Result<Self, SignalError> {
+        // The held poles exactly at 0, the others the roots of the rest of `den`.
+        let poles = if integrators == 0 {
+            poly::roots(&den)
+        } else {
+            crate::integrators::roots_with_origin(&den, integrators)
+        }
+        .ok_or(SignalError::Roots { name: "den" })?;
+        let (nb, na) = (num.len(), den.len() - 1 - integrators);
         let mut d_num = Vec::with_capacity(nb + na);
         let mut d_den = Vec::with_capacity(nb + na);
         for j in 0..nb {
             let mut e = vec![0.0; nb];
             e[j] = 1.0;
             d_num.push(e);
-            d_den.push(vec![0.0; na + 1]);
+            d_den.push(vec![0.0; den.len()]);
         }
         for j in 0..na {
-            let mut e = vec![0.0; na + 1];
+            // Full length: the held coefficients of the integrators are the last ones.
+            let mut e = vec![0.0; den.len()];
             e[j + 1] = 1.0;
             d_num.push(vec![0.0; nb]);
             d_den.push(e);
@@ -487,6 +525,7 @@ impl TransferFunction {
         Ok(Self {
             rational: Rational::with_poles(num, den, poles, d_num, d_den, unstable)?,
             num_len,
+            integrators,
         })
     }
 
@@ -506,20 +545,22 @@ impl RationalModel for TransferFunction {
     fn param_names(&self) -> Vec<String> {
         let nb = self.num_len;
         let na = self.rational.den.len() - 1;
+        // The held coefficients a_{n-1} … a_0 of the integrators are not parameters.
         (0..nb)
             .map(|i| format!("b{}", nb - 1 - i))
-            .chain((0..na).map(|i| format!("a{}", na - 1 - i)))
+            .chain((0..na - self.integrators).map(|i| format!("a{}", na - 1 - i)))
             .collect()
     }
 
     fn params(&self) -> Vec<f64> {
         let mut p = self.num().to_vec();
-        p.extend_from_slice(&self.rational.den[1..]);
+        let den = &self.rational.den;
+        p.extend_from_slice(&den[1..den.len() - self.integrators]);
         p
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        let na = self.rational.den.len() - 1;
+        let na = self.rational.den.len() - 1 - self.integrators;
         if params.len() != self.num_len + na {
             return Err(SignalError::WrongParamCount {
                 expected: self.num_len + na,
@@ -530,7 +571,8 @@ impl RationalModel for TransferFunction {
         let num = params[..self.num_len].to_vec();
         let mut den = vec![1.0];
         den.extend_from_slice(&params[self.num_len..]);
-        Self::from_monic(num, den, self.rational.unstable)
+        den.extend(std::iter::repeat_n(0.0, self.integrators));
+        Self::from_monic(num, den, self.rational.unstable, self.integrators)
     }
 
     fn rational(&self) -> &Rational {
@@ -609,10 +651,14 @@ pub struct Zpk {
     gain: f64,
     zeros: Vec<Root>,
     poles: Vec<Root>,
+    /// Per pole: held at the origin (an integrator, not a parameter).
+    held: Vec<bool>,
     rational: Rational,
 }
 
-fn expand(roots: &[Root]) -> (Vec<f64>, Vec<Vec<f64>>) {
+/// `Π` of the roots' factors, and its derivatives with respect to the parameters of the roots
+/// not `held` (a missing entry of `held` is false).
+fn expand(roots: &[Root], held: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) {
     let factors: Vec<_> = roots.iter().map(Root::factor).collect();
     let mut prod = vec![1.0];
     for (f, _) in &factors {
@@ -620,6 +666,9 @@ fn expand(roots: &[Root]) -> (Vec<f64>, Vec<Vec<f64>>) {
     }
     let mut d = Vec::new();
     for (i, (_, dfs)) in factors.iter().enumerate() {
+        if held.get(i).copied().unwrap_or(false) {
+            continue;
+        }
         for df in dfs {
             let mut p = vec![1.0];
             for (l, (f, _)) in factors.iter().enumerate() {
@@ -635,7 +684,32 @@ impl Zpk {
     /// Validates finite values, pairs with `im > 0`, at most as many zeros as poles, at least
     /// one pole, poles with real part `≤ 0` (repeated poles and integrators are accepted).
     pub fn new(gain: f64, zeros: Vec<Root>, poles: Vec<Root>) -> Result<Self, SignalError> {
-        Self::build(gain, zeros, poles, false)
+        Self::build(gain, zeros, poles, false, &[])
+    }
+
+    /// The same model with `n` of its real poles at exactly 0 (the first `n` in the list)
+    /// structural: held there in every `with_params` and not parameters. Refused
+    /// ([`SignalError::Integrators`]) when the list has fewer than `n` poles at 0.
+    pub fn with_integrators(&self, n: usize) -> Result<Self, SignalError> {
+        let held = crate::integrators::held_poles(&self.poles, n).ok_or_else(|| {
+            SignalError::Integrators {
+                integrators: n,
+                at_origin: crate::integrators::at_origin(&self.poles),
+                poles: self.poles.iter().map(Root::num_params).sum(),
+            }
+        })?;
+        Self::build(
+            self.gain,
+            self.zeros.clone(),
+            self.poles.clone(),
+            self.rational.unstable,
+            &held,
+        )
+    }
+
+    /// The number of poles held at the origin ([`with_integrators`](Self::with_integrators)).
+    pub fn integrators(&self) -> usize {
+        self.held.iter().filter(|&&h| h).count()
     }
 
     /// As [`new`](Self::new), but poles right of the imaginary axis are accepted, here and in
@@ -645,14 +719,17 @@ impl Zpk {
         zeros: Vec<Root>,
         poles: Vec<Root>,
     ) -> Result<Self, SignalError> {
-        Self::build(gain, zeros, poles, true)
+        Self::build(gain, zeros, poles, true, &[])
     }
 
+    /// `held[i]`: pole `i` is an integrator held at 0 (checked by the callers; missing
+    /// entries are false).
     fn build(
         gain: f64,
         zeros: Vec<Root>,
         poles: Vec<Root>,
         unstable: bool,
+        held: &[bool],
     ) -> Result<Self, SignalError> {
         finite("gain", gain)?;
         zeros.iter().try_for_each(|z| z.validate("zero"))?;
@@ -674,8 +751,8 @@ impl Zpk {
         }
         // Before the expansion, whose sensitivities take `np²` numbers.
         jitterid_numeric::limits::check(jitterid_numeric::limits::Limit::Poles, np)?;
-        let (zn, dzn) = expand(&zeros);
-        let (den, dden_p) = expand(&poles);
+        let (zn, dzn) = expand(&zeros, &[]);
+        let (den, dden_p) = expand(&poles, held);
         let num: Vec<f64> = zn.iter().map(|c| gain * c).collect();
         let mut d_num = vec![zn.clone()];
         let mut d_den = vec![vec![0.0; den.len()]];
@@ -689,10 +766,14 @@ impl Zpk {
         }
         let pole_values = poles.iter().flat_map(Root::values).collect();
         let rational = Rational::with_poles(num, den, pole_values, d_num, d_den, unstable)?;
+        let held = (0..poles.len())
+            .map(|i| held.get(i).copied().unwrap_or(false))
+            .collect();
         Ok(Self {
             gain,
             zeros,
             poles,
+            held,
             rational,
         })
     }
@@ -713,8 +794,12 @@ impl Zpk {
     }
 }
 
-fn root_names(prefix: &str, roots: &[Root], out: &mut Vec<String>) {
+/// The parameter names of the roots not `held` (by their index in the whole list).
+fn root_names(prefix: &str, roots: &[Root], held: &[bool], out: &mut Vec<String>) {
     for (i, r) in roots.iter().enumerate() {
+        if held.get(i).copied().unwrap_or(false) {
+            continue;
+        }
         match r {
             Root::Real(_) => out.push(format!("{prefix}{i}")),
             Root::Pair { .. } => {
@@ -725,8 +810,11 @@ fn root_names(prefix: &str, roots: &[Root], out: &mut Vec<String>) {
     }
 }
 
-fn push_root_params(roots: &[Root], out: &mut Vec<f64>) {
-    for r in roots {
+fn push_root_params(roots: &[Root], held: &[bool], out: &mut Vec<f64>) {
+    for (i, r) in roots.iter().enumerate() {
+        if held.get(i).copied().unwrap_or(false) {
+            continue;
+        }
         match *r {
             Root::Real(x) => out.push(x),
             Root::Pair { re, im } => out.extend([re, im]),
@@ -734,10 +822,17 @@ fn push_root_params(roots: &[Root], out: &mut Vec<f64>) {
     }
 }
 
-fn roots_from(template: &[Root], params: &mut impl Iterator<Item = f64>) -> Vec<Root> {
+/// Roots shaped as `template`, the `held` ones copied, the others read from `params`.
+fn roots_from(
+    template: &[Root],
+    held: &[bool],
+    params: &mut impl Iterator<Item = f64>,
+) -> Vec<Root> {
     template
         .iter()
-        .map(|r| match r {
+        .enumerate()
+        .map(|(i, r)| match r {
+            _ if held.get(i).copied().unwrap_or(false) => *r,
             Root::Real(_) => Root::Real(params.next().unwrap_or(f64::NAN)),
             Root::Pair { .. } => Root::Pair {
                 re: params.next().unwrap_or(f64::NAN),
@@ -750,15 +845,15 @@ fn roots_from(template: &[Root], params: &mut impl Iterator<Item = f64>) -> Vec<
 impl RationalModel for Zpk {
     fn param_names(&self) -> Vec<String> {
         let mut names = vec!["gain".to_string()];
-        root_names("zero", &self.zeros, &mut names);
-        root_names("pole", &self.poles, &mut names);
+        root_names("zero", &self.zeros, &[], &mut names);
+        root_names("pole", &self.poles, &self.held, &mut names);
         names
     }
 
     fn params(&self) -> Vec<f64> {
         let mut p = vec![self.gain];
-        push_root_params(&self.zeros, &mut p);
-        push_root_params(&self.poles, &mut p);
+        push_root_params(&self.zeros, &[], &mut p);
+        push_root_params(&self.poles, &self.held, &mut p);
         p
     }
 
@@ -771,9 +866,9 @@ impl RationalModel for Zpk {
             });
         }
         let mut it = params[1..].iter().copied();
-        let zeros = roots_from(&self.zeros, &mut it);
-        let poles = roots_from(&self.poles, &mut it);
-        Self::build(params[0], zeros, poles, self.rational.unstable)
+        let zeros = roots_from(&self.zeros, &[], &mut it);
+        let poles = roots_from(&self.poles, &self.held, &mut it);
+        Self::build(params[0], zeros, poles, self.rational.unstable, &self.held)
     }
 
     fn rational(&self) -> &Rational {
@@ -788,13 +883,20 @@ struct TfFields {
     den: Vec<f64>,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     unstable: bool,
+    #[serde(default, skip_serializing_if = "crate::integrators::is_zero")]
+    integrators: usize,
 }
 
 impl TryFrom<TfFields> for TransferFunction {
     type Error = SignalError;
     fn try_from(t: TfFields) -> Result<Self, SignalError> {
         let form = crate::forms::TfForm::new(&t.num, &t.den)?;
-        Self::from_monic(form.num().to_vec(), form.den().to_vec(), t.unstable)
+        let g = Self::from_monic(form.num().to_vec(), form.den().to_vec(), t.unstable, 0)?;
+        if t.integrators == 0 {
+            Ok(g)
+        } else {
+            g.with_integrators(t.integrators)
+        }
     }
 }
 
@@ -804,6 +906,7 @@ impl From<TransferFunction> for TfFields {
             num: t.num().to_vec(),
             den: t.den().to_vec(),
             unstable: t.rational.unstable,
+            integrators: t.integrators,
         }
     }
 }
@@ -816,18 +919,26 @@ struct ZpkFields {
     poles: Vec<Root>,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     unstable: bool,
+    #[serde(default, skip_serializing_if = "crate::integrators::is_zero")]
+    integrators: usize,
 }
 
 impl TryFrom<ZpkFields> for Zpk {
     type Error = SignalError;
     fn try_from(z: ZpkFields) -> Result<Self, SignalError> {
-        Self::build(z.gain, z.zeros, z.poles, z.unstable)
+        let g = Self::build(z.gain, z.zeros, z.poles, z.unstable, &[])?;
+        if z.integrators == 0 {
+            Ok(g)
+        } else {
+            g.with_integrators(z.integrators)
+        }
     }
 }
 
 impl From<Zpk> for ZpkFields {
     fn from(z: Zpk) -> Self {
         Self {
+            integrators: z.integrators(),
             unstable: z.rational.unstable,
             gain: z.gain,
             zeros: z.zeros,

@@ -19,6 +19,9 @@ fn specs() -> Vec<SpecTable> {
     vec![
         table(json!({"kind": "zpk", "gain": 0.2, "zeros": [-0.5], "poles": [[-0.25, 0.3]]})),
         table(json!({"kind": "tf", "num": [0.3, 1.0], "den": [1.0, 1.5, 0.9]})),
+        // Structural integrators: held at the origin, kept by the spec.
+        table(json!({"kind": "tf", "num": [0.5], "den": [1.0, 1.5, 0.0], "integrators": 1})),
+        table(json!({"kind": "zpk", "gain": 0.5, "poles": [0.0, -1.5, 0.0], "integrators": 2})),
         table(json!({"kind": "sinusoid", "amplitude": 1.3, "frequency": 0.27, "phase": 0.4})),
         table(
             json!({"kind": "pulse-response", "coefficients": [0.6, 0.3, -0.15], "interval": 0.5}),
@@ -74,6 +77,19 @@ fn bad_tables_name_the_key() {
             "unstable",
         ),
         (json!({"kind": "zpk", "gain": "x", "poles": [-1.0]}), "gain"),
+        // More integrators than poles at the origin, or not a whole number.
+        (
+            json!({"kind": "tf", "num": [1.0], "den": [1.0, 1.0, 0.0], "integrators": 2}),
+            "integrators",
+        ),
+        (
+            json!({"kind": "zpk", "gain": 1.0, "poles": [-1.0], "integrators": 1}),
+            "integrators",
+        ),
+        (
+            json!({"kind": "zpk", "gain": 1.0, "poles": [0.0], "integrators": 0.5}),
+            "integrators",
+        ),
         (
             json!({"kind": "zpk", "gain": 1.0, "zeros": [1.0, 2.0], "poles": [-1.0]}),
             "zeros",

@@ -71,6 +71,7 @@ fn zpk() -> SignalKind {
                 "at least one; real part ≤ 0 (unless `unstable`), im > 0",
             ),
             unstable_key(),
+            integrators_key(),
         ]
         .into_iter()
         .chain(response_keys())
@@ -97,18 +98,27 @@ fn zpk() -> SignalKind {
                 };
                 r.invalid(&key_of(&e, &keys, fallback), e)
             })?;
+            let g = match integrators(r)? {
+                0 => g,
+                n => g
+                    .with_integrators(n)
+                    .map_err(|e| r.invalid("integrators", e))?,
+            };
             lti_signal(
                 "zpk",
                 r,
                 LtiResponse::new(g, input_of(input)?),
                 |g: &Zpk| {
-                    with_unstable(
-                        spec([
-                            ("gain", json!(g.gain())),
-                            ("zeros", roots_json(g.zeros())),
-                            ("poles", roots_json(g.poles())),
-                        ]),
-                        g,
+                    with_integrators(
+                        with_unstable(
+                            spec([
+                                ("gain", json!(g.gain())),
+                                ("zeros", roots_json(g.zeros())),
+                                ("poles", roots_json(g.poles())),
+                            ]),
+                            g,
+                        ),
+                        g.integrators(),
                     )
                 },
             )
@@ -134,6 +144,7 @@ fn tf() -> SignalKind {
                 "finite, leading ≠ 0, poles with real part ≤ 0 (unless `unstable`)",
             ),
             unstable_key(),
+            integrators_key(),
         ]
         .into_iter()
         .chain(response_keys())
@@ -155,12 +166,21 @@ fn tf() -> SignalKind {
                 };
                 r.invalid(&key_of(&e, &keys, fallback), e)
             })?;
+            let g = match integrators(r)? {
+                0 => g,
+                n => g
+                    .with_integrators(n)
+                    .map_err(|e| r.invalid("integrators", e))?,
+            };
             lti_signal(
                 "tf",
                 r,
                 LtiResponse::new(g, input_of(input)?),
                 |g: &TransferFunction| {
-                    with_unstable(spec([("num", json!(g.num())), ("den", json!(g.den()))]), g)
+                    with_integrators(
+                        with_unstable(spec([("num", json!(g.num())), ("den", json!(g.den()))]), g),
+                        g.integrators(),
+                    )
                 },
             )
         },
@@ -176,6 +196,34 @@ fn unstable_key() -> ParamSpec {
         "",
         "optional; true or false",
     )
+}
+
+/// The structural integrators: poles at the origin held there, not estimated.
+fn integrators_key() -> ParamSpec {
+    ParamSpec::new(
+        "integrators",
+        "how many of the poles at exactly 0 (tf: trailing zeros of `den`; zpk: poles 0.0) are \
+         structural integrators, held at the origin and not parameters",
+        "",
+        "optional; a whole number, at most the number of poles at 0",
+    )
+    .with_default(0.0)
+    .integer()
+}
+
+/// The `integrators` key (0 when absent), bounded by the pole-count limit.
+fn integrators(r: &SpecReader<'_>) -> Result<usize, SignalError> {
+    // MAX_POLES (30) fits a u32; a larger count is refused by the poles themselves.
+    let max = u32::try_from(jitterid_numeric::limits::MAX_POLES).unwrap_or(u32::MAX);
+    Ok(r.u32("integrators", max)? as usize)
+}
+
+/// `spec` with the `integrators` key when there are any.
+fn with_integrators(mut spec: SpecTable, n: usize) -> SpecTable {
+    if n > 0 {
+        spec.insert("integrators".into(), json!(n));
+    }
+    spec
 }
 
 /// `spec` with `unstable = true` when the model accepts unstable poles.

@@ -70,6 +70,7 @@ section!(RawSystem, "table [system]" {
     initial: String,
     delay: f64,
     unstable: bool,
+    integrators: i64,
 });
 
 section!(RawNoise, "table [noise]" {

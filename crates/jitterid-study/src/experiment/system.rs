@@ -128,16 +128,25 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> 
     };
     let zpk = zpk.map_err(|e| cx.err(S, "poles", &p.span(), e))?;
     range::response(&zpk, grid).map_err(|m| cx.err(S, "gain", &g.span(), m))?;
-    Ok(with_unstable(
-        spec(
-            "zpk",
-            [
-                ("gain", json!(zpk.gain())),
-                ("zeros", roots_json(zpk.zeros())),
-                ("poles", roots_json(zpk.poles())),
-            ],
+    let order = zpk
+        .poles()
+        .iter()
+        .map(|p| if matches!(p, Root::Pair { .. }) { 2 } else { 1 })
+        .sum();
+    let n = integrators(cx, r, order, |n| zpk.with_integrators(n).map(|_| ()))?;
+    Ok(with_integrators(
+        with_unstable(
+            spec(
+                "zpk",
+                [
+                    ("gain", json!(zpk.gain())),
+                    ("zeros", roots_json(zpk.zeros())),
+                    ("poles", roots_json(zpk.poles())),
+                ],
+            ),
+            unstable,
         ),
-        unstable,
+        n,
     ))
 }
 
@@ -163,9 +172,14 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
             "expected a nonzero numerator (a zero gain gives no signal to identify)",
         ));
     }
-    Ok(with_unstable(
-        spec("tf", [("num", json!(tf.num())), ("den", json!(tf.den()))]),
-        unstable,
+    let order = tf.den().len() - 1;
+    let n = integrators(cx, r, order, |n| tf.with_integrators(n).map(|_| ()))?;
+    Ok(with_integrators(
+        with_unstable(
+            spec("tf", [("num", json!(tf.num())), ("den", json!(tf.den()))]),
+            unstable,
+        ),
+        n,
     ))
 }
 
@@ -239,6 +253,38 @@ fn zpk_order(kind: &SpecTable) -> usize {
 fn with_unstable(mut spec: SpecTable, unstable: bool) -> SpecTable {
     if unstable {
         spec.insert("unstable".into(), json!(true));
+    }
+    spec
+}
+
+/// `[system] integrators`: a whole number in `[0, order]` (0 when absent) that `check` (the
+/// model's `with_integrators`) accepts; every refusal names the key and the value.
+fn integrators(
+    cx: &Source,
+    r: &RawSystem,
+    order: usize,
+    check: impl FnOnce(usize) -> Result<(), jitterid::signal::SignalError>,
+) -> StudyResult<usize> {
+    let Some(v) = &r.integrators else {
+        return Ok(0);
+    };
+    let n = *v.get_ref();
+    let Some(n) = usize::try_from(n).ok().filter(|&n| n <= order) else {
+        return Err(cx.err(
+            S,
+            "integrators",
+            &v.span(),
+            format!("expected a whole number of poles in [0, {order}] (the system's), found {n}"),
+        ));
+    };
+    check(n).map_err(|e| cx.err(S, "integrators", &v.span(), e))?;
+    Ok(n)
+}
+
+/// `spec` with `integrators = n` when there are any.
+fn with_integrators(mut spec: SpecTable, n: usize) -> SpecTable {
+    if n > 0 {
+        spec.insert("integrators".into(), json!(n));
     }
     spec
 }
