@@ -50,6 +50,7 @@ pub fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
         "estimates": estimates,
         "validation_fit_percent": validation,
         "failure": c.failure,
+        "failure_kind": c.failure_kind,
     })
 }
 

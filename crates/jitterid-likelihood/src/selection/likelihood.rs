@@ -24,7 +24,8 @@ use rayon::prelude::*;
 
 /// Index of the best screened candidate of every family, in the order the families first
 /// appear: the converged one of lowest BCLS BIC, else (no converged fit in the family) the
-/// fitted one of lowest BIC; families without any fitted candidate have no finalist.
+/// fitted one of lowest BIC that did not stop at the stability boundary; families without
+/// such a candidate have no finalist.
 pub(super) fn finalists(candidates: &[Candidate]) -> Vec<usize> {
     let mut families: Vec<&str> = Vec::new();
     for c in candidates {
@@ -38,7 +39,13 @@ pub(super) fn finalists(candidates: &[Candidate]) -> Vec<usize> {
             (0..candidates.len())
                 .filter(|&i| {
                     let c = &candidates[i];
-                    c.family == *family && c.fitted.is_some() && c.bcls_criterion.is_finite()
+                    c.family == *family
+                        && c.fitted.is_some()
+                        && c.bcls_criterion.is_finite()
+                        // An undamped mode makes the exact likelihood's quadrature follow
+                        // `|p|/|Re p|` oscillations per sample: a refit that would spend the
+                        // whole time limit on a candidate that is no model of the record.
+                        && c.failure_kind != Some(super::FailureKind::StabilityBoundary)
                 })
                 .min_by(|&a, &b| {
                     let (ca, cb) = (&candidates[a], &candidates[b]);
@@ -190,6 +197,7 @@ pub(super) fn refine_finalists(
                     c.criterion = bic;
                     c.converged = true;
                     c.failure = None;
+                    c.failure_kind = None;
                     c.parameters = fit.names.iter().cloned().zip(fit.params).collect();
                     c.fitted = Some((structure.signal, structure.jitter));
                 } else {

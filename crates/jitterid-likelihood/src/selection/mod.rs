@@ -37,6 +37,7 @@
 //! The two BICs are never compared with each other.
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
+use jitterid_signal::forms::TfForm;
 use jitterid_signal::registry::{SignalRegistry, SpecTable};
 use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
@@ -120,10 +121,29 @@ pub struct Candidate {
     pub parameters: Vec<(String, f64)>,
     /// Why the candidate failed, if it did.
     pub failure: Option<String>,
+    /// What kind of failure [`failure`](Self::failure) is.
+    pub failure_kind: Option<FailureKind>,
     /// The fitted system and jitter (absent for a failed candidate): the rational model
     /// (registry kind `tf`), with the [`SelectionOptions::delay`] and
     /// [`SelectionOptions::initial_state`] the selection ran with.
     pub fitted: Option<(AnySignal, AnyJitter)>,
+}
+
+/// What kind of outcome a failed candidate's screen fit had.
+#[non_exhaustive]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FailureKind {
+    /// The search reached the imaginary axis (a pole with real part 0, an undamped mode) and
+    /// every step beyond was refused, since the candidates are stable models. A candidate
+    /// that needs an undamped mode to approach the record is not a model of it: typically an
+    /// order with a pole to spare, its extra pair pushed to the axis while the jitter's
+    /// spread grows to absorb the misfit.
+    StabilityBoundary,
+    /// The fit ran but did not converge (the solver's reason in the failure).
+    NotConverged,
+    /// The fit could not be made (the start, the initializer or the criterion failed).
+    FitError,
 }
 
 impl Candidate {
@@ -342,6 +362,7 @@ fn fit_candidate(
         likelihood_failure: None,
         parameters: Vec::new(),
         failure: Some(reason),
+        failure_kind: Some(FailureKind::FitError),
         fitted: None,
     };
     // "none" has no scale: one start is enough.
@@ -383,6 +404,22 @@ fn fit_candidate(
     } else {
         return failed(format!("cost {} is not positive and finite", fit.cost));
     };
+    let (failure, failure_kind) = if fit.converged {
+        (None, None)
+    } else {
+        match axis_poles(&structure, &fit.params) {
+            Some(on_axis) => (
+                Some(format!(
+                    "reached the stability boundary: pole(s) {on_axis} on the imaginary axis, every step beyond refused (a candidate that needs an undamped mode is not a model of this record)"
+                )),
+                Some(FailureKind::StabilityBoundary),
+            ),
+            None => (
+                Some(fit.termination.to_string()),
+                Some(FailureKind::NotConverged),
+            ),
+        }
+    };
     Candidate {
         poles,
         zeros,
@@ -400,12 +437,42 @@ fn fit_candidate(
             .cloned()
             .zip(fit.params.iter().copied())
             .collect(),
-        failure: (!fit.converged).then(|| fit.termination.to_string()),
+        failure,
+        failure_kind,
         fitted: structure
             .with_params(&fit.params)
             .ok()
             .map(|s| (s.signal, s.jitter)),
     }
+}
+
+/// A pole's real part within this fraction of its magnitude (at least 1 rad/s) of 0 is on the
+/// imaginary axis: far inside the search's refused steps, far outside any damping a record of
+/// at most 10⁷ samples resolves.
+const ON_AXIS: f64 = 1e-6;
+
+/// The poles of the candidate at `params` that lie on the imaginary axis, written out, or
+/// `None` when there are none (or the system is not a transfer function).
+fn axis_poles(structure: &Structure, params: &[f64]) -> Option<String> {
+    let at = structure.with_params(params).ok()?;
+    let spec = at.signal.spec();
+    let coefficients = |key: &str| -> Option<Vec<f64>> {
+        spec.get(key)?
+            .as_array()?
+            .iter()
+            .map(serde_json::Value::as_f64)
+            .collect()
+    };
+    let tf = TfForm::new(&coefficients("num")?, &coefficients("den")?).ok()?;
+    let on_axis: Vec<String> = tf
+        .to_zpk()
+        .ok()?
+        .poles()
+        .iter()
+        .filter(|p| p.re.abs() <= ON_AXIS * p.norm().max(1.0))
+        .map(|p| format!("{:.4}{:+.4}i", p.re, p.im))
+        .collect();
+    (!on_axis.is_empty()).then(|| on_axis.join(", "))
 }
 
 /// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first

@@ -155,6 +155,7 @@ fn screened(poles: usize, family: &str, bic: f64, converged: bool) -> Candidate 
         likelihood_failure: None,
         parameters: Vec::new(),
         failure: None,
+        failure_kind: None,
         fitted: bic.is_finite().then_some((model, none)),
     }
 }
@@ -175,6 +176,10 @@ fn finalists_are_the_screens_best_of_each_family() {
         screened(1, "two-point", f64::INFINITY, false),
     ];
     assert_eq!(likelihood::finalists(&c), vec![2, 1, 6]);
+    // A fit that stopped with an undamped mode is never refitted: periodic's next best is.
+    let mut c = c;
+    c[6].failure_kind = Some(FailureKind::StabilityBoundary);
+    assert_eq!(likelihood::finalists(&c), vec![2, 1, 5]);
 }
 
 /// `c` with its fitted jitter replaced by its family's at standard deviation `std`.
@@ -321,4 +326,32 @@ fn validation_fit_starts_from_the_validation_records_own_state() {
     assert!(fit > 99.999, "own state: {fit} %");
     assert!(carried < 95.0, "carried state: {carried} %");
     assert!(rest < 95.0, "from rest: {rest} %");
+}
+
+/// A candidate whose search ended with an undamped pair is told apart, with its poles named:
+/// `(s² + 2.25)(s + 0.5)` has `±1.5i` on the axis; `(s² + 0.2 s + 2.25)(s + 0.5)` has none.
+#[test]
+fn poles_on_the_axis_are_found_and_named() {
+    let (record, input) = record();
+    let candidate = |den: &[f64]| {
+        let model = TransferFunction::new(&[1.0], den).unwrap();
+        let signal =
+            candidate_signal(&model, &input, &record, &SelectionOptions::default()).unwrap();
+        structure_of(
+            "none",
+            signal,
+            JitterRegistry::builtin()
+                .from_std_dev("none", 0.0, &serde_json::Map::new())
+                .unwrap(),
+        )
+    };
+    // Parameters [b0, a2, a1, a0]; (s² + 2.25)(s + 0.5) = s³ + 0.5 s² + 2.25 s + 1.125.
+    let s = candidate(&[1.0, 1.0, 1.0, 1.0]);
+    let found = axis_poles(&s, &[1.0, 0.5, 2.25, 1.125]).expect("an undamped pair");
+    assert!(
+        found.contains("+1.5000i") && found.contains("-1.5000i"),
+        "{found}"
+    );
+    // (s² + 0.2 s + 2.25)(s + 0.5) = s³ + 0.7 s² + 2.35 s + 1.125
+    assert_eq!(axis_poles(&s, &[1.0, 0.7, 2.35, 1.125]), None);
 }
