@@ -60,17 +60,19 @@ impl RationalSystem {
             return Ok(None);
         };
         let r = kind.reader(&spec)?;
+        // Structural integrators are not parameters: the covariance's rows follow the model
+        // with them held.
+        let held = r.u32("integrators", u32::MAX)? as usize;
         Ok(Some(if name == "zpk" {
-            Self::Zpk(Zpk::new_allowing_unstable(
-                r.f64("gain")?,
-                r.roots("zeros")?,
-                r.roots("poles")?,
-            )?)
+            Self::Zpk(
+                Zpk::new_allowing_unstable(r.f64("gain")?, r.roots("zeros")?, r.roots("poles")?)?
+                    .with_integrators(held)?,
+            )
         } else {
-            Self::Tf(TransferFunction::new_allowing_unstable(
-                &r.f64_list("num")?,
-                &r.f64_list("den")?,
-            )?)
+            Self::Tf(
+                TransferFunction::new_allowing_unstable(&r.f64_list("num")?, &r.f64_list("den")?)?
+                    .with_integrators(held)?,
+            )
         }))
     }
 
@@ -283,6 +285,27 @@ mod tests {
             assert!((bode[0].magnitude_db - db).abs() < 1e-6, "{kind}: {bode:?}");
             let step = step_of(&s, &[0.0, 1.0], None).unwrap().unwrap();
             assert_eq!(step.len(), 2, "{kind}");
+        }
+    }
+
+    /// `1/(s(s + 1))` with its integrator held: exported with the pole at the origin, and its
+    /// Bode band built from the covariance of the two free parameters (`b0`, `a1`).
+    #[test]
+    fn a_model_with_integrators_is_exported_with_them() {
+        for spec in [
+            json!({"kind": "tf", "num": [1.0], "den": [1.0, 1.0, 0.0], "integrators": 1}),
+            json!({"kind": "zpk", "gain": 1.0, "poles": [0.0, -1.0], "integrators": 1}),
+        ] {
+            let input =
+                Input::Piecewise(PiecewiseConstant::new(vec![0.0, 100.0], vec![1.0]).unwrap());
+            let s = SignalRegistry::builtin()
+                .build(spec.as_object().unwrap(), Some(&input))
+                .unwrap();
+            let forms = model_forms(&s).unwrap().unwrap();
+            assert_eq!(forms.tf.den(), &[1.0, 1.0, 0.0], "{spec}");
+            let cov = vec![vec![0.01, 0.0], vec![0.0, 0.01]];
+            let bode = bode_of(&s, &[0.1], Some(&cov)).unwrap().unwrap();
+            assert!(bode[0].magnitude_db_lo.is_some(), "{spec}");
         }
     }
 
