@@ -27,9 +27,8 @@ use crate::experiment::{LikelihoodStart, Method};
 use crate::fit::{structure, Fit, FitCall, Structure};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-use jitterid::estimate::validation::fit_percent;
+use jitterid::estimate::validation::compare;
 use jitterid::estimate::Record;
-use jitterid::signal::Signal;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// The level of the check: a correct likelihood fit is reported as not converged in at most
@@ -120,11 +119,9 @@ fn elsewhere(record: &Record, f: &Fit, b: &Fit) -> Option<String> {
         return None;
     }
     let percent = |x: &Fit| {
-        let m = x
-            .fitted
-            .signal
-            .expected_values(record.grid(), &x.fitted.jitter);
-        fit_percent(record.y(), &m).ok()
+        compare(&x.fitted, record.grid(), record.y())
+            .ok()
+            .map(|c| c.fit_percent)
     };
     let (pf, pb) = (percent(f), percent(b));
     let show = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{v:.1} %"));

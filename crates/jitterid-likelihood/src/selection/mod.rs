@@ -38,7 +38,7 @@
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
 use jitterid_signal::forms::TfForm;
-use jitterid_signal::registry::{SignalRegistry, SpecTable};
+use jitterid_signal::registry::{KindReader, SignalRegistry, SpecTable};
 use jitterid_signal::{AnySignal, Input, LtiResponse, Signal, TransferFunction};
 use rayon::prelude::*;
 use serde_json::json;
@@ -456,14 +456,11 @@ const ON_AXIS: f64 = 1e-6;
 fn axis_poles(structure: &Structure, params: &[f64]) -> Option<String> {
     let at = structure.with_params(params).ok()?;
     let spec = at.signal.spec();
-    let coefficients = |key: &str| -> Option<Vec<f64>> {
-        spec.get(key)?
-            .as_array()?
-            .iter()
-            .map(serde_json::Value::as_f64)
-            .collect()
-    };
-    let tf = TfForm::new(&coefficients("num")?, &coefficients("den")?).ok()?;
+    let r = SignalRegistry::builtin()
+        .kind(at.signal.kind())?
+        .reader(&spec)
+        .ok()?;
+    let tf = TfForm::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok()?;
     let on_axis: Vec<String> = tf
         .to_zpk()
         .ok()?
