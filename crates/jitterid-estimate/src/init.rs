@@ -188,13 +188,7 @@ impl InitialModel for TransferFunction {
 }
 
 fn count(roots: &[Root]) -> usize {
-    roots
-        .iter()
-        .map(|r| match r {
-            Root::Real(_) => 1,
-            Root::Pair { .. } => 2,
-        })
-        .sum()
+    roots.iter().map(Root::count).sum()
 }
 
 impl InitialModel for Zpk {
@@ -677,21 +671,30 @@ fn match_kinds(template: &[Root], roots: &[Complex64]) -> Vec<Root> {
         .filter(|r| r.im > 0.0)
         .map(|r| (r.re, r.im))
         .collect();
-    let want_reals = template
-        .iter()
-        .filter(|r| matches!(r, Root::Real(_)))
-        .count();
-    let want_pairs = template.len() - want_reals;
+    let wanted = |kind: fn(&Root) -> bool| template.iter().filter(|r| kind(r)).count();
+    let want_reals = wanted(|r| matches!(r, Root::Real(_)));
+    let want_quadratics = wanted(|r| matches!(r, Root::Quadratic { .. }));
     reals.sort_by(f64::total_cmp);
-    while reals.len() > want_reals && reals.len() >= 2 {
-        // Merge the two closest adjacent reals.
+    // The two closest adjacent reals, taken out of `reals`.
+    let closest = |reals: &mut Vec<f64>| {
         let i = (0..reals.len() - 1)
             .min_by(|&a, &b| (reals[a + 1] - reals[a]).total_cmp(&(reals[b + 1] - reals[b])))
             .unwrap_or(0);
         let (x, y) = (reals[i], reals[i + 1]);
+        reals.drain(i..=i + 1);
+        (x, y)
+    };
+    // Surplus reals go first to the quadratic factors, which take two reals exactly as they
+    // are, then merge into pairs.
+    let mut quadratics: Vec<(f64, f64)> = Vec::new();
+    while reals.len() >= want_reals + 2 && quadratics.len() < want_quadratics {
+        let (x, y) = closest(&mut reals);
+        quadratics.push((-(x + y), x * y));
+    }
+    while reals.len() > want_reals && reals.len() >= 2 {
+        let (x, y) = closest(&mut reals);
         let re = 0.5 * (x + y);
         let im = (0.5 * (y - x)).max(SEPARATION * re.abs().max(f64::MIN_POSITIVE));
-        reals.drain(i..=i + 1);
         pairs.push((re, im));
     }
     while reals.len() < want_reals && !pairs.is_empty() {
@@ -705,18 +708,26 @@ fn match_kinds(template: &[Root], roots: &[Complex64]) -> Vec<Root> {
         reals.push(re - im);
         reals.push(re + im);
     }
-    let _ = want_pairs;
-    // Fill the template in order; reals from the slowest (closest to 0) down, pairs by modulus.
+    // Fill the template in order; reals from the slowest (closest to 0) down, pairs by modulus;
+    // a quadratic factor takes two reals when there were any to spare, otherwise a pair.
     reals.sort_by(|a, b| b.total_cmp(a));
     pairs.sort_by(|a, b| (a.0.hypot(a.1)).total_cmp(&b.0.hypot(b.1)));
-    let (mut ri, mut pi) = (reals.into_iter(), pairs.into_iter());
+    let (mut ri, mut pi, mut qi) = (reals.into_iter(), pairs.into_iter(), quadratics.into_iter());
+    let mut next_pair = || pi.next().unwrap_or((f64::NAN, f64::NAN));
     template
         .iter()
         .map(|r| match r {
             Root::Real(_) => Root::Real(ri.next().unwrap_or(f64::NAN)),
             Root::Pair { .. } => {
-                let (re, im) = pi.next().unwrap_or((f64::NAN, f64::NAN));
+                let (re, im) = next_pair();
                 Root::Pair { re, im }
+            }
+            Root::Quadratic { .. } => {
+                let (a1, a0) = qi.next().unwrap_or_else(|| {
+                    let (re, im) = next_pair();
+                    (-2.0 * re, re * re + im * im)
+                });
+                Root::Quadratic { a1, a0 }
             }
         })
         .collect()

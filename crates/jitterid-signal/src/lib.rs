@@ -55,6 +55,7 @@ mod pulse;
 mod rational;
 mod reach;
 pub mod registry;
+mod root;
 mod signal;
 mod simulate;
 mod sinusoid;

@@ -10,6 +10,8 @@ use crate::coefficients::Coefficients;
 use crate::confluent::Confluent;
 use crate::error::{all_finite, finite, tf_coefficients, SignalError};
 use crate::poly;
+use crate::root::group_repeated;
+pub use crate::root::Root;
 use num_complex::Complex64;
 use std::fmt;
 
@@ -580,67 +582,13 @@ impl RationalModel for TransferFunction {
     }
 }
 
-/// A real root of a polynomial, or a complex-conjugate pair `re ± i·im` with `im > 0`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum Root {
-    /// A real root.
-    Real(f64),
-    /// The pair `re ± i·im`.
-    Pair {
-        /// Real part.
-        re: f64,
-        /// Imaginary part (> 0).
-        im: f64,
-    },
-}
-
-impl Root {
-    fn validate(&self, name: &'static str) -> Result<(), SignalError> {
-        match *self {
-            Root::Real(x) => finite(name, x).map(|_| ()),
-            Root::Pair { re, im } => {
-                finite(name, re)?;
-                finite(name, im)?;
-                if im > 0.0 {
-                    Ok(())
-                } else {
-                    Err(SignalError::BadPair { name, value: im })
-                }
-            }
-        }
-    }
-
-    fn num_params(&self) -> usize {
-        match self {
-            Root::Real(_) => 1,
-            Root::Pair { .. } => 2,
-        }
-    }
-
-    /// Monic factor `(s − x)` or `(s² − 2re·s + re² + im²)` and its derivatives with respect
-    /// to the root's parameters.
-    fn factor(&self) -> (Vec<f64>, Vec<Vec<f64>>) {
-        match *self {
-            Root::Real(x) => (vec![1.0, -x], vec![vec![0.0, -1.0]]),
-            Root::Pair { re, im } => (
-                vec![1.0, -2.0 * re, re * re + im * im],
-                vec![vec![0.0, -2.0, 2.0 * re], vec![0.0, 0.0, 2.0 * im]],
-            ),
-        }
-    }
-
-    fn values(&self) -> Vec<Complex64> {
-        match *self {
-            Root::Real(x) => vec![Complex64::new(x, 0.0)],
-            Root::Pair { re, im } => vec![Complex64::new(re, im), Complex64::new(re, -im)],
-        }
-    }
-}
-
-/// `G(s) = k · Π (s − z_i) / Π (s − p_i)` with real roots and complex pairs.
+/// `G(s) = k · Π (s − z_i) / Π (s − p_i)` with real roots, complex pairs and quadratic factors.
 ///
 /// Parameters: the gain, then each zero, then each pole; a real root is one parameter, a pair
-/// two (real part, then imaginary part). The paper's eq. (17),
+/// two (real part, then imaginary part), a quadratic factor two (`a1`, `a0`). A real root given
+/// twice (a double pole `(s + 0.5)²` written as two poles `-0.5`) is one quadratic factor from
+/// construction on, so that the estimate may pass through the coincidence into a complex pair,
+/// with a covariance there (see [`Root::Quadratic`]). The paper's eq. (17),
 /// `G(s) = k0 (s + z) / ((s − pr − i·pi)(s − pr + i·pi))`, is
 /// `Zpk::new(k0, vec![Root::Real(-z)], vec![Root::Pair { re: pr, im: pi }])`.
 ///
@@ -682,9 +630,17 @@ fn expand(roots: &[Root], held: &[bool]) -> (Vec<f64>, Vec<Vec<f64>>) {
 
 impl Zpk {
     /// Validates finite values, pairs with `im > 0`, at most as many zeros as poles, at least
-    /// one pole, poles with real part `≤ 0` (repeated poles and integrators are accepted).
+    /// one pole, poles with real part `≤ 0` (repeated poles and integrators are accepted). Each
+    /// nonzero real root that occurs twice in `zeros` or in `poles` becomes one
+    /// [`Root::Quadratic`] at the first one's place (the second leaves the list).
     pub fn new(gain: f64, zeros: Vec<Root>, poles: Vec<Root>) -> Result<Self, SignalError> {
-        Self::build(gain, zeros, poles, false, &[])
+        Self::build(
+            gain,
+            group_repeated(zeros),
+            group_repeated(poles),
+            false,
+            &[],
+        )
     }
 
     /// The same model with `n` of its real poles at exactly 0 (the first `n` in the list)
@@ -695,7 +651,7 @@ impl Zpk {
             SignalError::Integrators {
                 integrators: n,
                 at_origin: crate::integrators::at_origin(&self.poles),
-                poles: self.poles.iter().map(Root::num_params).sum(),
+                poles: self.poles.iter().map(Root::count).sum(),
             }
         })?;
         Self::build(
@@ -719,7 +675,13 @@ impl Zpk {
         zeros: Vec<Root>,
         poles: Vec<Root>,
     ) -> Result<Self, SignalError> {
-        Self::build(gain, zeros, poles, true, &[])
+        Self::build(
+            gain,
+            group_repeated(zeros),
+            group_repeated(poles),
+            true,
+            &[],
+        )
     }
 
     /// `held[i]`: pole `i` is an integrator held at 0 (checked by the callers; missing
@@ -734,8 +696,8 @@ impl Zpk {
         finite("gain", gain)?;
         zeros.iter().try_for_each(|z| z.validate("zero"))?;
         poles.iter().try_for_each(|p| p.validate("pole"))?;
-        let nz: usize = zeros.iter().map(Root::num_params).sum();
-        let np: usize = poles.iter().map(Root::num_params).sum();
+        let nz: usize = zeros.iter().map(Root::count).sum();
+        let np: usize = poles.iter().map(Root::count).sum();
         if np == 0 {
             return Err(SignalError::TooFew {
                 name: "poles",
@@ -788,7 +750,7 @@ impl Zpk {
         &self.zeros
     }
 
-    /// The poles.
+    /// The poles (a repeated real pole given at construction is one [`Root::Quadratic`]).
     pub fn poles(&self) -> &[Root] {
         &self.poles
     }
@@ -806,6 +768,10 @@ fn root_names(prefix: &str, roots: &[Root], held: &[bool], out: &mut Vec<String>
                 out.push(format!("{prefix}{i}.re"));
                 out.push(format!("{prefix}{i}.im"));
             }
+            Root::Quadratic { .. } => {
+                out.push(format!("{prefix}{i}.a1"));
+                out.push(format!("{prefix}{i}.a0"));
+            }
         }
     }
 }
@@ -818,6 +784,7 @@ fn push_root_params(roots: &[Root], held: &[bool], out: &mut Vec<f64>) {
         match *r {
             Root::Real(x) => out.push(x),
             Root::Pair { re, im } => out.extend([re, im]),
+            Root::Quadratic { a1, a0 } => out.extend([a1, a0]),
         }
     }
 }
@@ -837,6 +804,10 @@ fn roots_from(
             Root::Pair { .. } => Root::Pair {
                 re: params.next().unwrap_or(f64::NAN),
                 im: params.next().unwrap_or(f64::NAN),
+            },
+            Root::Quadratic { .. } => Root::Quadratic {
+                a1: params.next().unwrap_or(f64::NAN),
+                a0: params.next().unwrap_or(f64::NAN),
             },
         })
         .collect()
@@ -926,7 +897,13 @@ struct ZpkFields {
 impl TryFrom<ZpkFields> for Zpk {
     type Error = SignalError;
     fn try_from(z: ZpkFields) -> Result<Self, SignalError> {
-        let g = Self::build(z.gain, z.zeros, z.poles, z.unstable, &[])?;
+        let g = Self::build(
+            z.gain,
+            group_repeated(z.zeros),
+            group_repeated(z.poles),
+            z.unstable,
+            &[],
+        )?;
         if z.integrators == 0 {
             Ok(g)
         } else {

@@ -197,13 +197,18 @@ fn responses_are_continuous_through_coincidence() {
     let u = binary(11, 2.0, -3.0, 40.0).unwrap();
     let grid = SampleGrid::new(0.0, 0.5, 80).unwrap();
     let jitter = UniformSum::new(1, 0.2).unwrap();
+    // Two real poles as two parameters (a template with distinct poles, moved by
+    // `with_params`): two equal poles given to `Zpk::new` would be one quadratic factor.
+    let template = Zpk::new(
+        1.5,
+        vec![Root::Real(-0.4)],
+        vec![Root::Real(-1.0), Root::Real(-1.5)],
+    )
+    .unwrap();
     let at = |delta: f64| {
-        let g = Zpk::new(
-            1.5,
-            vec![Root::Real(-0.4)],
-            vec![Root::Real(-1.0), Root::Real(-1.0 - delta)],
-        )
-        .unwrap();
+        let g = template
+            .with_params(&[1.5, -0.4, -1.0, -1.0 - delta])
+            .unwrap();
         assert_eq!(g.modal().is_some(), delta > 1e-4, "δ = {delta}");
         LtiResponse::new(g, u.clone()).expected_values_and_gradient(&grid, &jitter)
     };

@@ -208,16 +208,7 @@ fn roots_of(spec: &SpecTable, key: &str) -> Option<Vec<Root>> {
     };
     v.as_array()?
         .iter()
-        .map(|r| match r {
-            Value::Array(p) => match p.as_slice() {
-                [re, im] => Some(Root::Pair {
-                    re: re.as_f64()?,
-                    im: im.as_f64()?,
-                }),
-                _ => None,
-            },
-            x => x.as_f64().map(Root::Real),
-        })
+        .map(|r| Root::from_json(r).ok())
         .collect()
 }
 

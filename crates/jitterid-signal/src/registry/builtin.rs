@@ -40,16 +40,10 @@ fn input_of(input: Option<&Input>) -> Result<Input, SignalError> {
     })
 }
 
-/// Roots as a spec table writes them: a number for a real root, `[re, im]` for a pair
-/// (what [`KindReader::roots`] reads back).
+/// Roots as a spec table writes them ([`Root::to_json`]: a number for a real root, `[re, im]`
+/// for a pair, `{a1, a0}` for a quadratic factor; what [`KindReader::roots`] reads back).
 pub fn roots_json(roots: &[Root]) -> Value {
-    roots
-        .iter()
-        .map(|r| match *r {
-            Root::Real(x) => json!(x),
-            Root::Pair { re, im } => json!([re, im]),
-        })
-        .collect()
+    roots.iter().map(Root::to_json).collect()
 }
 
 fn zpk() -> SignalKind {
@@ -60,13 +54,13 @@ fn zpk() -> SignalKind {
             ParamSpec::new("gain", "gain k", "", "finite"),
             ParamSpec::new(
                 "zeros",
-                "zeros: a number (real) or [re, im] (the pair re ± i·im)",
+                "zeros: a number (real), [re, im] (the pair re ± i·im) or {a1, a0} (the two roots of s² + a1·s + a0)",
                 "rad/s",
                 "optional; finite, im > 0, no more zeros than poles",
             ),
             ParamSpec::new(
                 "poles",
-                "poles: a number (real) or [re, im] (the pair re ± i·im)",
+                "poles: a number (real), [re, im] (the pair re ± i·im) or {a1, a0} (the two roots of s² + a1·s + a0); a real pole given twice is estimated as its quadratic factor",
                 "rad/s",
                 "at least one; real part ≤ 0 (unless `unstable`), im > 0",
             ),

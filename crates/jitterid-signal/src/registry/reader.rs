@@ -37,19 +37,13 @@ impl KindReader for SpecReader<'_> {
     }
 
     fn roots(&self, key: &str) -> Result<Vec<Root>, SignalError> {
-        let root = |v: &Value| match v {
-            Value::Array(a) if a.len() == 2 => Ok(Root::Pair {
-                re: number(self, key, &a[0])?,
-                im: number(self, key, &a[1])?,
-            }),
-            other => number(self, key, other).map(Root::Real),
-        };
+        let root = |v: &Value| Root::from_json(v).map_err(|m| self.invalid(key, m));
         match self.get(key) {
             None => Ok(Vec::new()),
             Some(Value::Array(a)) => a.iter().map(root).collect(),
             Some(v) => Err(self.invalid(
                 key,
-                format!("expected a list of roots (numbers or [re, im]), found {v}"),
+                format!("expected a list of roots (numbers, [re, im] or {{a1, a0}}), found {v}"),
             )),
         }
     }

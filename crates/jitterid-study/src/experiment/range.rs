@@ -90,22 +90,14 @@ pub(super) fn frequency(f: f64, grid: &SampleGrid) -> Result<f64, String> {
     }
 }
 
-/// The magnitude of a root, `|re + i·im|`.
-fn modulus(r: &Root) -> f64 {
-    match *r {
-        Root::Real(x) => x.abs(),
-        Root::Pair { re, im } => re.hypot(im),
-    }
-}
-
 /// Zeros: `|z|·T` at most [`MAX_ROOT_T`] (a zero at 0 is exact and allowed).
 pub(super) fn zeros(roots: &[Root], grid: &SampleGrid) -> Result<(), String> {
     let hi = MAX_ROOT_T / grid.interval();
-    match roots.iter().position(|r| modulus(r) > hi) {
+    match roots.iter().position(|r| r.modulus() > hi) {
         Some(i) => Err(format!(
             "element {}: expected a magnitude of at most {hi:e} rad/s ({MAX_ROOT_T:e}/T), found {:e}",
             i + 1,
-            modulus(&roots[i])
+            roots[i].modulus()
         )),
         None => Ok(()),
     }
@@ -132,7 +124,14 @@ pub(super) fn poles(
 
 /// The pole moduli of a zpk model's roots.
 pub(super) fn root_moduli(roots: &[Root]) -> Vec<f64> {
-    roots.iter().map(modulus).collect()
+    // A quadratic factor's two roots each (a pair's two have one modulus).
+    roots
+        .iter()
+        .flat_map(|r| match r {
+            Root::Quadratic { .. } => r.values().iter().map(|v| v.norm()).collect(),
+            _ => vec![r.modulus()],
+        })
+        .collect()
 }
 
 /// A rational system's poles in range and its step response representable: every mode's

@@ -128,11 +128,7 @@ fn zpk(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> 
     };
     let zpk = zpk.map_err(|e| cx.err(S, "poles", &p.span(), e))?;
     range::response(&zpk, grid).map_err(|m| cx.err(S, "gain", &g.span(), m))?;
-    let order = zpk
-        .poles()
-        .iter()
-        .map(|p| if matches!(p, Root::Pair { .. }) { 2 } else { 1 })
-        .sum();
+    let order = zpk.poles().iter().map(Root::count).sum();
     let n = integrators(cx, r, order, |n| zpk.with_integrators(n).map(|_| ()))?;
     Ok(with_integrators(
         with_unstable(
@@ -301,7 +297,7 @@ fn parse_roots(cx: &Source, key: &str, v: &Spanned<Vec<toml::Value>>) -> StudyRe
     for (i, e) in v.get_ref().iter().enumerate() {
         let bad = |what: String| {
             cx.err("system", key, &v.span(), format!(
-                "element {}: expected a number (a real root) or [re, im] with im > 0 (a complex pair), found {what}",
+                "element {}: expected a number (a real root), [re, im] with im > 0 (a complex pair) or {{a1 = …, a0 = …}} (the two roots of s² + a1·s + a0), found {what}",
                 i + 1
             ))
         };
@@ -313,6 +309,13 @@ fn parse_roots(cx: &Source, key: &str, v: &Spanned<Vec<toml::Value>>) -> StudyRe
                 (Some(re), Some(im)) => return Err(bad(format!("[{re}, {im}]"))),
                 _ => return Err(bad(describe(e))),
             },
+            toml::Value::Table(t) => {
+                let coefficient = |k: &str| t.get(k).and_then(number).filter(|x| x.is_finite());
+                match (coefficient("a1"), coefficient("a0"), t.len()) {
+                    (Some(a1), Some(a0), 2) => Root::Quadratic { a1, a0 },
+                    _ => return Err(bad(describe(e))),
+                }
+            }
             other => match number(other) {
                 Some(x) if x.is_finite() => Root::Real(x),
                 Some(x) => return Err(bad(format!("{x}"))),
