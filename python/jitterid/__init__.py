@@ -8,9 +8,14 @@ The command line's experiments, from Python, with NumPy arrays in and out::
     fit = exp.fit(record, method="bcls")           # FitResult: names, params, std_errors, ...
     study = jitterid.montecarlo(exp, runs=128, seed=1)
     study.mean, study.std
+    fit.bode(), fit.step(), fit.system.to_control()   # responses with ±2σ bands; the System
+    checked = jitterid.validate(exp, record, validation=exp.simulate(seed=1, run=1))
+    checked.fit_percent, checked.whiteness["p_value"]
+    jitterid.select(exp_with_a_select_section, record).best
 
-Every number equals the command line's (``jitterid simulate / fit / montecarlo --json``) for
-the same seed and run. Jitter models by name or class are in ``jitterid.jitter``. Studies split
+Records may also be pandas DataFrames or Series and xarray objects (``t`` a column or the
+index). Every number equals the command line's (``jitterid simulate / fit / validate / select /
+montecarlo --json``) for the same seed and run. Jitter models by name or class are in ``jitterid.jitter``. Studies split
 into shards (``shard=(i, n)``) run anywhere, for example on Dask, and ``merge`` joins them.
 """
 

@@ -79,6 +79,10 @@ def test_xarray_records(table2, record, reference):
     r = jitterid._records.as_record(da)
     np.testing.assert_array_equal(r["t"], record["t"])
     assert table2.fit({**r, "input_t": record["input_t"], "input_u": record["input_u"]}).to_dict(full=True) == reference
+    ds = xr.Dataset({"y": ("time", record["y"])}, coords={"time": record["t"]})
+    r = jitterid._records.as_record(ds)
+    np.testing.assert_array_equal(r["t"], record["t"])
+    np.testing.assert_array_equal(r["y"], record["y"])
 
 
 @pytest.mark.parametrize(
