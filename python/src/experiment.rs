@@ -2,7 +2,7 @@
 //! writes it, and a record fitted as `jitterid fit --json` reports it.
 
 use crate::arrays::finite_samples;
-use crate::errors::{json_text, spec_table, value_error};
+use crate::errors::{json_text, spec_table, study_error, value_error};
 use crate::toml_text;
 use crate::watching::{run_watched, Reporter, Stopped};
 use jitterid::estimate::solver::{ProgressHook, Termination};
@@ -14,7 +14,7 @@ use jitterid_study::fingerprint::experiment_fingerprint;
 use jitterid_study::inputs;
 use jitterid_study::montecarlo::DEFAULT_SEED;
 use jitterid_study::select::{auto_start, InitChoice};
-use jitterid_study::{fit as fitting, records, simulate, Registries, StudyError};
+use jitterid_study::{fit as fitting, records, simulate, Registries};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError};
 use pyo3::prelude::*;
@@ -48,7 +48,7 @@ impl Experiment {
                 .for_own_method
                 .as_ref()
                 .map(Cow::Borrowed)
-                .map_err(value_error);
+                .map_err(study_error);
         }
         let chosen = method
             .map(|m| {
@@ -69,7 +69,7 @@ impl Experiment {
             self.paths,
         )
         .map(Cow::Owned)
-        .map_err(value_error)
+        .map_err(study_error)
     }
 }
 
@@ -297,8 +297,7 @@ impl Experiment {
             };
             let mut signal = fitting::signal_of(&exp, input.as_ref())?;
             if init == InitChoice::Auto {
-                signal = auto_start(&exp, &signal, input.as_ref(), &y, "y")
-                    .map_err(|e| StudyError::new(argument_words(&e.to_string())))?;
+                signal = auto_start(&exp, &signal, input.as_ref(), &y, "y")?;
             }
             fitting::fit_values(&exp, signal, y, "y", &watch)
         };
@@ -314,7 +313,7 @@ impl Experiment {
                     fit,
                     grid: exp.grid,
                 })
-                .map_err(value_error),
+                .map_err(study_error),
             Ok(None) => Err(PyRuntimeError::new_err("the fit's thread panicked")),
             Err(Stopped { error, outcome }) => {
                 let report = match outcome {
@@ -386,15 +385,6 @@ pub fn record_input(
             Some(Input::Piecewise(realisation(t, u, grid, prefix)?))
         }
     })
-}
-
-/// The study layer's words for the command line's options, said as the Python arguments they
-/// are here: its selection module's data-driven start names `--init auto` and its time limit
-/// `--time-limit`.
-pub fn argument_words(message: &str) -> String {
-    message
-        .replace("--init auto", "init=\"auto\"")
-        .replace("--time-limit", "time_limit")
 }
 
 /// The random input's realisation from its switch times `t` and levels `u` (the side file's

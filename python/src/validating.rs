@@ -3,8 +3,8 @@
 //! numbers are those of `jitterid validate --json`, `validate --bode` and `select --json`.
 
 use crate::arrays::finite_samples;
-use crate::errors::{json_text, value_error};
-use crate::experiment::{argument_words, record_input, Experiment, Fit};
+use crate::errors::{json_text, study_error, value_error};
+use crate::experiment::{record_input, Experiment, Fit};
 use jitterid::estimate::validation::{BodePoint, StepPoint, DEFAULT_LEVEL};
 use jitterid::signal::SampleGrid;
 use jitterid_study::fit::Structure;
@@ -236,7 +236,7 @@ pub fn validate(
     });
     let validation = py
         .detach(|| validate_records(&exp, estimation, validation, model, level, &Watch::none()))
-        .map_err(value_error)?;
+        .map_err(study_error)?;
     Ok(Validated { validation })
 }
 
@@ -266,7 +266,7 @@ pub fn select(
     }
     let selection = py
         .detach(|| run_selection(&exp, &data, validation.as_deref()))
-        .map_err(|e| value_error(argument_words(&e.to_string())))?;
+        .map_err(study_error)?;
     json_text(&selection.to_json())
 }
 

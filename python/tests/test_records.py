@@ -165,6 +165,11 @@ def test_every_family_class_is_in_the_stub():
         (lambda t2, r: jitterid.montecarlo(t2, runs=0), ValueError, "runs: expected at least 1"),
         (lambda t2, r: jitterid.fit({"y": r["y"], "T": 1.0}, G, J, estimate=3), TypeError, "estimate: expected"),
         (lambda t2, r: t2.fit(r, method=3), TypeError, "method: expected the name of a method"),
+        # The study layer's own messages, which name the command line's flags there.
+        (lambda t2, r: jitterid.montecarlo(t2, runs=10**8), ValueError, "runs: expected a number of realisations"),
+        (lambda t2, r: jitterid.montecarlo(t2, runs=2, threads=5000), ValueError, "threads: expected 1 to 1024"),
+        (lambda t2, r: jitterid.Experiment(t2.text.replace("1/(2√3) s\nestimate = false", "1/(2√3) s\nestimate = true"))
+         .fit(r, method="ls"), ValueError, "method ls: naive least squares ignores the jitter"),
     ],
 )
 def test_errors_name_the_argument(table2, record, call, error, message):
