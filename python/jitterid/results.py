@@ -18,6 +18,17 @@ def _table(data: Any, what: str) -> None:
     if not isinstance(data, Mapping):
         raise TypeError(f"data: expected the mapping of {what} (as to_dict() gives it), found {type(data).__name__}")
 
+def _system_of(signal_spec: str) -> Any:
+    """The system of a fitted signal's spec table: the signal without its free response (the
+    keys ``initial`` and ``origin``, the state at the record's first instant)."""
+    from .system import System
+
+    spec = json.loads(signal_spec)
+    for key in ("initial", "origin"):
+        spec.pop(key, None)
+    return System(json.dumps(spec))
+
+
 __all__ = ["FitResult", "MonteCarloResult", "SelectionResult", "ValidationResult"]
 
 
@@ -93,13 +104,11 @@ class FitResult:
 
     @property
     def system(self):
-        """The fitted system, a ``System`` (with ``frequency_response``, ``step``,
-        ``to_control()``, ``to_scipy()``)."""
-        from .system import System
-
-        if self._fit is not None:
-            return System(self._fit.system_spec_json)
-        return System(json.dumps(self.fitted_model["signal"]))
+        """The fitted system ``G(s) e^{−sD}``, a ``System`` (with ``frequency_response``,
+        ``step``, ``to_control()``, ``to_scipy()``); a free response estimated from the record's
+        initial state is the record's, not the system's, and is left out."""
+        spec = self._fit.system_spec_json if self._fit is not None else json.dumps(self.fitted_model["signal"])
+        return _system_of(spec)
 
     @property
     def jitter(self):
@@ -251,10 +260,8 @@ class ValidationResult:
 
     @property
     def system(self):
-        """The validated (fitted) system, a ``System``."""
-        from .system import System
-
-        return System(self._validated.system_spec_json)
+        """The validated (fitted) system, a ``System`` (see ``FitResult.system``)."""
+        return _system_of(self._validated.system_spec_json)
 
     def bode(self) -> Optional[Dict[str, np.ndarray]]:
         """The system's Bode diagram with ±2σ bands (see ``FitResult.bode``); the numbers of

@@ -181,6 +181,11 @@ def test_walkthrough_fit_equals_the_command_line(cli, model_exp, estimation):
     assert fit.model == expected["model"]
     assert fit.system.delay == expected["model"]["delay"]
     assert set(fit.fitted_model) == {"signal", "jitter", "noise", "noise_std"}
+    # The system is G(s) e^{-sD}: the record's free response (initial state) is not part of it,
+    # so its exact step response is the study layer's, delay included.
+    assert "initial" in fit.fitted_model["signal"] and "initial" not in fit.system.spec
+    step = fit.step()
+    np.testing.assert_allclose(fit.system.step(step["t"]), step["value"], rtol=1e-9, atol=1e-12)
 
 
 def test_the_fitted_system_converts_to_python_control_and_scipy(small):
