@@ -223,6 +223,12 @@ def test_a_delayed_system_is_not_converted_without_its_delay(model_exp, estimati
     assert system.delay is not None
     with pytest.raises(ValueError, match="pade_order"):
         system.to_control()
+    control = pytest.importorskip("control")
+    # With the delay's Padé approximation: the exact response where the approximation holds
+    # (ω·D well below the order).
+    f = np.array([0.001, 0.01, 0.05])
+    approx = np.array([control.evalfr(system.to_control(pade_order=6), 2j * np.pi * x) for x in f])
+    np.testing.assert_allclose(approx, system.frequency_response(f), rtol=1e-6)
     pytest.importorskip("scipy")
     with pytest.raises(ValueError, match="input delay"):
         system.to_scipy()
