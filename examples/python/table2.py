@@ -21,20 +21,6 @@ PAPER_MEAN = {"gain": 0.2000, "zero0": -0.5012, "pole0.re": -0.2504, "pole0.im":
 PAPER_STD = {"gain": 0.0025, "zero0": 0.0135, "pole0.re": 0.0019, "pole0.im": 0.0029}
 
 
-def zpk_response(model: dict, f: np.ndarray) -> np.ndarray:
-    """G(i2πf) of a zpk spec table (gain, real zeros, pole pairs [re, im])."""
-    s = 2j * np.pi * f
-    g = model["gain"] * np.ones_like(s)
-    for z in model["zeros"]:
-        g = g * (s - (complex(*z) if isinstance(z, list) else z))
-    for p in model["poles"]:
-        if isinstance(p, list):
-            g = g / ((s - complex(p[0], p[1])) * (s - complex(p[0], -p[1])))
-        else:
-            g = g / (s - p)
-    return g
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=128)
@@ -70,15 +56,17 @@ def main() -> None:
     record = exp.simulate(seed=args.seed, run=0)
     fit = exp.fit(record)
     f = np.logspace(-3, np.log10(0.5), 200)
+    truth = jitterid.System.zpk(zeros=[-0.5], poles=[-0.25 + 0.3j, -0.25 - 0.3j], gain=0.2).frequency_response(f)
+    fitted = fit.system.frequency_response(f)
     ax = axes.flat[4]
-    ax.loglog(f, np.abs(zpk_response(dict(gain=0.2, zeros=[-0.5], poles=[[-0.25, 0.3]]), f)), "k", label="true")
-    ax.loglog(f, np.abs(zpk_response(fit.model["signal"], f)), "--", label="BCLS, run 0")
+    ax.loglog(f, np.abs(truth), "k", label="true")
+    ax.loglog(f, np.abs(fitted), "--", label="BCLS, run 0")
     ax.set_xlabel("f (Hz)")
     ax.set_title("|G(i2πf)|")
     ax.legend()
     ax = axes.flat[5]
-    ax.semilogx(f, np.angle(zpk_response(dict(gain=0.2, zeros=[-0.5], poles=[[-0.25, 0.3]]), f), deg=True), "k")
-    ax.semilogx(f, np.angle(zpk_response(fit.model["signal"], f), deg=True), "--")
+    ax.semilogx(f, np.angle(truth, deg=True), "k")
+    ax.semilogx(f, np.angle(fitted, deg=True), "--")
     ax.set_xlabel("f (Hz)")
     ax.set_title("arg G (degrees)")
     fig.tight_layout()

@@ -8,9 +8,14 @@ The command line's experiments, from Python, with NumPy arrays in and out::
     fit = exp.fit(record, method="bcls")           # FitResult: names, params, std_errors, ...
     study = jitterid.montecarlo(exp, runs=128, seed=1)
     study.mean, study.std
+    fit.bode(), fit.step(), fit.system.to_control()   # responses with ±2σ bands; the System
+    checked = jitterid.validate(exp, record, validation=exp.simulate(seed=1, run=1))
+    checked.fit_percent, checked.whiteness["p_value"]
+    jitterid.select(exp_with_a_select_section, record).best
 
-Every number equals the command line's (``jitterid simulate / fit / montecarlo --json``) for
-the same seed and run. Jitter models by name or class are in ``jitterid.jitter``. Studies split
+Records may also be pandas DataFrames or Series and xarray objects (``t`` a column or the
+index). Every number equals the command line's (``jitterid simulate / fit / validate / select /
+montecarlo --json``) for the same seed and run. Jitter models by name or class are in ``jitterid.jitter``. Studies split
 into shards (``shard=(i, n)``) run anywhere, for example on Dask, and ``merge`` joins them.
 """
 
@@ -18,7 +23,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Callable, Iterable, Mapping, Optional, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -26,7 +31,12 @@ from . import _jitterid, inputs, jitter, system
 from ._spec import integer, real_array, real_number
 from .inputs import Input
 from .system import System
-from .results import FitResult, MonteCarloResult
+from ._records import as_record
+from .results import FitResult, MonteCarloResult, SelectionResult, ValidationResult
+
+#: What the functions take as a record: a mapping of arrays (as ``simulate`` returns), a pandas
+#: DataFrame or Series, or an xarray Dataset or DataArray.
+Record = Any
 
 __version__: str = _jitterid.__version__
 DEFAULT_SEED = 20_051_205
@@ -35,6 +45,8 @@ __all__ = [
     "Experiment",
     "FitResult",
     "MonteCarloResult",
+    "SelectionResult",
+    "ValidationResult",
     "DEFAULT_SEED",
     "Input",
     "System",
@@ -48,6 +60,8 @@ __all__ = [
     "merge",
     "montecarlo",
     "read_record",
+    "select",
+    "validate",
 ]
 
 
@@ -64,13 +78,22 @@ class Experiment(_jitterid.Experiment):
     in both constructors; kept when pickled).
     """
 
-    def fit(self, record: Mapping[str, Any], method: Optional[str] = None, *,
+    def fit(self, record: Record, method: Optional[str] = None, *, init: str = "experiment",
             progress: Optional[Callable[[int, float], Any]] = None) -> FitResult:
-        """Fits ``record`` (a mapping with ``y``, and for a random-binary input the
-        ``input_t``, ``input_u`` that ``simulate`` and ``read_record`` give) with ``method``
-        (``"ls"``, ``"bcls"``, ``"bj"``, ``"ml"``, …; the file's by default). The same
-        result as ``jitterid fit --json``. A ``t`` in the record must be the experiment's grid
-        ``start + k·interval``, as a data file's ``t`` column must.
+        """Fits ``record`` with ``method`` (``"ls"``, ``"bcls"``, ``"bj"``, ``"ml"``, …; the
+        file's by default). The same result as ``jitterid fit --json [--init]``.
+
+        ``record`` is a mapping with ``y`` (and for a random-binary input the ``input_t``,
+        ``input_u`` that ``simulate`` and ``read_record`` give), a pandas DataFrame with a
+        column ``y`` or a Series of the samples, or an xarray Dataset or DataArray; its sample
+        times (a column ``t``, else a pandas index or an xarray coordinate that is not the
+        default row numbers) must be the experiment's grid ``start + k·interval``, as a data
+        file's ``t`` column must.
+
+        ``init`` is where the search starts: ``"experiment"`` (the file's values),
+        ``"auto"`` (the data-driven initializer's rational model, as ``--init auto``; the
+        experiment's jitter, noise, delay and initial state kept) or ``"experiment-only"``
+        (the file's values, also as a likelihood fit's only start).
 
         The fit runs without the GIL. ``progress``, if given, is called as
         ``progress(iteration, cost)`` after the solver's start and each of its iterations, on
@@ -78,10 +101,125 @@ class Experiment(_jitterid.Experiment):
         before its next iteration (Levenberg–Marquardt and BFGS; other solvers run to their
         end) and is raised; a ``KeyboardInterrupt``'s ``__cause__`` says where the fit stopped.
         """
-        if not isinstance(record, Mapping) or "y" not in record:
-            raise TypeError("record: expected a mapping with at least `y` (as simulate returns)")
-        return FitResult._of(self.fit_record(record["y"], record.get("input_t"), record.get("input_u"), method,
-                                             record.get("t"), progress))
+        r = as_record(record)
+        return FitResult._of(self.fit_record(r["y"], r.get("input_t"), r.get("input_u"), _method(method),
+                                             r.get("t"), progress, _init(init)))
+
+
+def _method(method: Any) -> Optional[str]:
+    if method is not None and not isinstance(method, str):
+        raise TypeError(f"method: expected the name of a method such as 'bcls', found {type(method).__name__}")
+    return method
+
+
+def _init(init: Any) -> str:
+    if not isinstance(init, str):
+        raise TypeError(f"init: expected 'experiment', 'auto' or 'experiment-only', found {type(init).__name__}")
+    return init
+
+
+def _experiment(experiment: Any) -> None:
+    if not isinstance(experiment, _jitterid.Experiment):
+        raise TypeError(f"experiment: expected an Experiment (Experiment.from_toml(path)), found "
+                        f"{type(experiment).__name__}")
+
+
+def validate(experiment: Experiment, record: Record, *, validation: Optional[Record] = None,
+             fit: Optional[FitResult] = None, level: float = 0.01,
+             method: Optional[str] = None) -> ValidationResult:
+    """Validates ``experiment``'s model on ``record`` and, when given, on the ``validation``
+    record, as ``jitterid validate --json [--validation] [--model] [--level]``.
+
+    * ``record``, ``validation``: records as ``Experiment.fit`` takes them (a mapping, a
+      pandas DataFrame or Series, an xarray Dataset or DataArray; with the input realisation
+      ``input_t``, ``input_u`` for a random-binary experiment). The validation record has the
+      experiment's interval, its own length (at least 16 samples) and start (its first ``t``;
+      the experiment's start without ``t``).
+    * ``fit``: the model to validate, a ``FitResult`` (as ``--model`` reads a ``fit --json``
+      output, with ``--method`` its method); without it, the experiment's model is fitted to
+      ``record`` with ``method`` (the file's by default).
+    * ``level``: the level of the residual tests' verdicts, strictly between 0 and 1.
+
+    Returns a ``ValidationResult``: fit percents, the residual tests (statistics, p-values,
+    verdicts at ``level``), flatness, and the system's Bode and step responses with ±2σ bands.
+    """
+    _experiment(experiment)
+    r = as_record(record)
+    v = None if validation is None else as_record(validation, "validation")
+    if fit is not None and not isinstance(fit, FitResult):
+        raise TypeError(f"fit: expected a FitResult (the result of a fit) or None, found {type(fit).__name__}")
+    validated = _jitterid.validate(
+        experiment, r["y"], r.get("input_t"), r.get("input_u"), r.get("t"),
+        None if v is None else v["y"], None if v is None else v.get("t"),
+        None if v is None else v.get("input_t"), None if v is None else v.get("input_u"),
+        None if fit is None else json.dumps(fit.to_dict()), real_number(level, "level"),
+        # A given fit is read as the structure of its own method.
+        _method(fit.method if method is None and fit is not None else method))
+    return ValidationResult(validated)
+
+
+def _write_record(path: str, record: Dict[str, Any], name: str) -> None:
+    """Writes ``record``'s samples as a data file (column ``y``) and, when it has one, its input
+    realisation as the side file ``<name>.input.csv``, as ``jitterid simulate`` writes them:
+    floats in their shortest round-trip form, which the reader reads back exactly."""
+    y = real_array(record["y"], f"{name}['y']")
+    if y.ndim != 1:
+        raise ValueError(f"{name}['y']: expected a one-dimensional array, found shape {y.shape}")
+    rows = [y.tolist()]
+    if record.get("t") is not None:
+        # Checked by the reader against the experiment's grid, as a data file's `t` is.
+        t = real_array(record["t"], f"{name}['t']")
+        if t.shape != y.shape:
+            raise ValueError(f"{name}['t']: has shape {t.shape}, expected {y.shape} (one time per sample of y)")
+        rows.insert(0, t.tolist())
+    with open(path, "w") as out:
+        out.write(("t,y" if len(rows) == 2 else "y") + "\n")
+        out.write("".join(",".join(repr(v) for v in row) + "\n" for row in zip(*rows)))
+    if record.get("input_t") is not None:
+        t = real_array(record["input_t"], f"{name}['input_t']").ravel()
+        u = real_array(record.get("input_u"), f"{name}['input_u']").ravel()
+        if t.size != u.size:
+            raise ValueError(f"{name}['input_t'] and {name}['input_u']: expected equal lengths, found {t.size} and "
+                             f"{u.size}")
+        with open(path[: -len(".csv")] + ".input.csv", "w") as out:
+            out.write("t,u\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), u.tolist())))
+
+
+def select(experiment: Experiment, record: Record, *, validation: Optional[Record] = None,
+           time_limit: Optional[float] = None) -> SelectionResult:
+    """Selects among ``experiment``'s ``[select]`` grid of model orders and jitter families on
+    ``record`` (as ``Experiment.fit`` takes it), with each candidate's fit percent on the
+    ``validation`` record when given, within ``time_limit`` seconds (the experiment's
+    ``[estimate] max_seconds`` by default, else 600): ``jitterid select --json
+    [--validation] [--time-limit]``. Returns a ``SelectionResult`` (candidates ranked best
+    first).
+    """
+    import tempfile
+
+    _experiment(experiment)
+    r = as_record(record)
+    v = None if validation is None else as_record(validation, "validation")
+    limit = None if time_limit is None else real_number(time_limit, "time_limit")
+    for name, rec in (("record", r), ("validation", v)):
+        if rec is not None and experiment.random_input and rec.get("input_t") is None:
+            raise ValueError(f"{name}: the experiment's input is random-binary, so the {name} record needs its input "
+                             "realisation (input_t and input_u, as simulate and read_record return them)")
+    # The study layer's selection reads its records from files, as the command line gives them.
+    with tempfile.TemporaryDirectory(prefix="jitterid-select-") as tmp:
+        paths = {name: os.path.join(tmp, f"{name}.csv") for name in ("record", "validation")}
+        _write_record(paths["record"], r, "record")
+        if v is not None:
+            _write_record(paths["validation"], v, "validation")
+        try:
+            text = _jitterid.select(experiment, paths["record"], None if v is None else paths["validation"], limit)
+        except ValueError as e:
+            # The files are this call's own: name the arguments they hold, not the files.
+            message = str(e)
+            for name, path in paths.items():
+                message = message.replace(path[: -len(".csv")] + ".input.csv", f"{name}['input_t', 'input_u']")
+                message = message.replace(path, name)
+            raise ValueError(message) from None
+    return SelectionResult(json.loads(text))
 
 
 def montecarlo(
@@ -104,9 +242,10 @@ def montecarlo(
     exception raised by ``progress``, stops the study before its next realisations and is
     raised once the running ones end (a study has no partial result); a
     ``KeyboardInterrupt``'s ``__cause__`` says how many realisations ran."""
-    if not isinstance(experiment, _jitterid.Experiment):
-        raise TypeError(f"experiment: expected an Experiment, found {type(experiment).__name__}")
-    text = _jitterid.montecarlo(experiment, runs, seed, shard, method, threads, progress)
+    _experiment(experiment)
+    if integer(runs, "runs") < 1:
+        raise ValueError(f"runs: expected at least 1 realisation, found {runs}")
+    text = _jitterid.montecarlo(experiment, runs, integer(seed, "seed"), shard, _method(method), threads, progress)
     return MonteCarloResult(json.loads(text))
 
 
@@ -190,7 +329,7 @@ def second_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] 
 def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method: str = "bcls", *,
         estimate: Iterable[str] = ("system",), interval: Optional[float] = None,
         start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
-        options: Optional[Mapping[str, Any]] = None,
+        options: Optional[Mapping[str, Any]] = None, init: str = "experiment",
         progress: Optional[Callable[[int, float], Any]] = None) -> FitResult:
     """Fits a record's samples with ``method``, starting from ``system`` and ``jitter``.
 
@@ -198,18 +337,24 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
 
     * ``record``: a mapping with the samples ``y`` (real, finite) and optionally ``T`` and
       ``t0`` or the sample times ``t``, and the input (``input``, or ``input_t`` and ``input_u``
-      as ``simulate`` gives them). A ``t`` must have one finite time per sample, on the grid
+      as ``simulate`` gives them); or a pandas DataFrame (columns ``y`` and ``t``, or the
+      times as its index) or Series (the samples, the times as its index), or an xarray
+      Dataset or DataArray (the times as its coordinate). A ``t`` must have one finite time per sample, on the grid
       ``start + k·interval`` (within the command line's tolerance for a data file's ``t``
       column, ``1e-6·interval``); it gives the grid when ``interval``/``start`` and ``T``/``t0``
       do not.
     * ``system``, ``jitter``: the model, and the start of the estimated parts.
     * ``method``: ``"ls"``, ``"bcls"``, ``"bj"``, ``"ml"``, … (the command line's methods).
-    * ``estimate``: the estimated parts among ``"system"``, ``"jitter"`` and ``"noise"``.
+    * ``estimate``: the estimated parts among ``"system"``, ``"jitter"`` and ``"noise"`` (one
+      part alone may be given as its name).
     * ``interval``, ``start``: the grid (default: the record's ``T``/``t0``, else its ``t``).
     * ``input``: the known input (default: the record's).
     * ``noise_std``: the measurement-noise level (known, or the start when estimated).
     * ``options``: further keys of the experiment file's ``[estimate]`` section
       (``solver``, ``frequencies``, ``max_iterations``, …).
+    * ``init``: where the search starts: ``"experiment"`` (``system`` as given), ``"auto"``
+      (the data-driven initializer's model, as ``jitterid fit --init auto``) or
+      ``"experiment-only"``.
     * ``progress``: called as ``progress(iteration, cost)`` after the solver's start and each
       of its iterations, on the calling thread (see ``Experiment.fit`` for Ctrl-C and for an
       exception it raises).
@@ -229,13 +374,17 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         fit = jitterid.fit(dict(record, input=u), G, J, "bcls", noise_std=0.01)
         fit.params, fit.std_errors
     """
-    if not isinstance(record, Mapping) or "y" not in record:
-        raise TypeError("record: expected a mapping with at least `y`")
+    record = as_record(record)
     _model(system, jitter, input)
+    _method(method)
     if isinstance(estimate, str):
-        raise TypeError(f"estimate: expected a collection of parts such as ('system', 'jitter'), found the text "
-                        f"{estimate!r}")
-    parts = set(estimate)
+        # One part named alone, as `estimate="jitter"`, is that part.
+        estimate = (estimate,)
+    try:
+        parts = set(estimate)
+    except TypeError:
+        raise TypeError(f"estimate: expected the estimated parts, such as ('system', 'jitter'), found "
+                        f"{type(estimate).__name__}") from None
     unknown = parts - {"system", "jitter", "noise"}
     if unknown:
         raise ValueError(f"estimate: unknown part(s) {sorted(map(str, unknown))}; expected 'system', 'jitter' or "
@@ -282,4 +431,4 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
     from ._spec import spec_json
 
     exp = Experiment.from_sections(spec_json(sections), "fit arguments")
-    return exp.fit({"y": y} if t is None else {"y": y, "t": t}, progress=progress)
+    return exp.fit({"y": y} if t is None else {"y": y, "t": t}, init=init, progress=progress)

@@ -79,10 +79,11 @@ class Experiment:
         method: Optional[str] = None,
         t: Optional[npt.ArrayLike] = None,
         progress: Optional[Callable[[int, float], Any]] = None,
+        init: Optional[str] = None,
     ) -> Fit:
         """Fits the samples ``y`` (with the random input's realisation; ``t``, if given, on the
-        experiment's grid) as ``jitterid fit``; ``progress(iteration, cost)`` follows the solver,
-        and Ctrl-C or an exception it raises stops it."""
+        experiment's grid) as ``jitterid fit [--init]``; ``progress(iteration, cost)`` follows
+        the solver, and Ctrl-C or an exception it raises stops it."""
 
 class Fit:
     """One fit as the library returns it (``jitterid.FitResult`` reads it)."""
@@ -97,6 +98,44 @@ class Fit:
         covariance_names, covariance)``."""
     def json(self) -> str:
         """``jitterid fit --json`` with ``fitted_model``, ``estimated``, ``estimator_covariance``."""
+    def bode(self) -> Optional[dict[str, npt.NDArray[np.float64]]]:
+        """The fitted system's Bode diagram with ±2σ bands (``validate --bode``)."""
+    def step_response(self) -> Optional[dict[str, npt.NDArray[np.float64]]]:
+        """The fitted system's step response with its ±2σ band."""
+    @property
+    def system_spec_json(self) -> str:
+        """The fitted system's spec table, as JSON text."""
+
+class Validated:
+    """A validated model (``jitterid.ValidationResult`` reads it)."""
+
+    def json(self) -> str:
+        """``jitterid validate --json``."""
+    def bode(self) -> Optional[dict[str, npt.NDArray[np.float64]]]: ...
+    def step(self) -> Optional[dict[str, npt.NDArray[np.float64]]]: ...
+    def records(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def system_spec_json(self) -> str: ...
+    @property
+    def noise_std(self) -> float: ...
+
+def validate(
+    experiment: Experiment,
+    y: npt.ArrayLike,
+    input_t: Optional[npt.ArrayLike] = None,
+    input_u: Optional[npt.ArrayLike] = None,
+    t: Optional[npt.ArrayLike] = None,
+    validation_y: Optional[npt.ArrayLike] = None,
+    validation_t: Optional[npt.ArrayLike] = None,
+    validation_input_t: Optional[npt.ArrayLike] = None,
+    validation_input_u: Optional[npt.ArrayLike] = None,
+    fit_json: Optional[str] = None,
+    level: float = 0.01,
+    method: Optional[str] = None,
+) -> Validated:
+    """``jitterid validate [--validation] [--model] [--level]`` on records in memory."""
+def select(experiment: Experiment, data: str, validation: Optional[str] = None, time_limit: Optional[float] = None) -> str:
+    """``jitterid select --json`` on the data files ``data`` (and ``validation``)."""
 
 def jitter_families() -> str: ...
 def montecarlo(

@@ -5,17 +5,18 @@ signal registry, with ``frequency_response(f)``, ``step(t)`` and conversions::
     g = System.zpk(zeros=[-0.5], poles=[-0.25 + 0.3j, -0.25 - 0.3j], gain=0.2)
     h = System.tf(num=[0.2, 0.1], den=[1.0, 0.5, 0.1525])
     g.frequency_response([0.0, 0.1]), g.step([0.0, 1.0]), g.to_tf(), g.to_ss()
+    g.to_control(), g.to_scipy()       # python-control and SciPy objects (optional packages)
 """
 
 from __future__ import annotations
 
 import json
-from typing import Any, Dict, List, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from . import _jitterid
-from ._spec import SpecTable, real_array, real_number, spec_json
+from ._spec import SpecTable, integer, real_array, real_number, spec_json
 
 __all__ = ["System", "from_name", "kinds"]
 
@@ -51,6 +52,40 @@ class System(SpecTable, _jitterid.System):
     def to_ss(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The controllable canonical realisation ``(A, B, C, D)``."""
         return self.state_space()
+
+    def to_control(self, pade_order: Optional[int] = None) -> Any:
+        """The system as a python-control ``TransferFunction`` (``control.tf(num, den)``, in
+        ``s``, rad/s). python-control's transfer functions have no input delay: a delayed system
+        needs ``pade_order``, the order of the Padé approximation of ``e^{−sD}`` multiplied in.
+        Needs the optional package ``control`` (``pip install control``)."""
+        try:
+            import control
+        except ImportError:
+            raise ImportError("System.to_control() needs python-control, which is not installed: "
+                              "pip install control") from None
+        num, den = self.tf_coefficients()
+        g = control.tf(num, den)
+        if self.delay is None:
+            return g
+        if pade_order is None:
+            raise ValueError(f"pade_order: the system has an input delay of {self.delay} s, which a python-control "
+                             "TransferFunction cannot hold; give pade_order (say 5) to multiply in its Padé "
+                             "approximation")
+        return g * control.tf(*control.pade(self.delay, integer(pade_order, "pade_order")))
+
+    def to_scipy(self) -> Any:
+        """The system as a ``scipy.signal.lti`` (transfer-function form, in ``s``, rad/s).
+        SciPy's linear systems have no input delay, so a delayed system raises ``ValueError``.
+        Needs the optional package ``scipy`` (``pip install scipy``)."""
+        try:
+            from scipy import signal
+        except ImportError:
+            raise ImportError("System.to_scipy() needs SciPy, which is not installed: pip install scipy") from None
+        if self.delay is not None:
+            raise ValueError(f"the system has an input delay of {self.delay} s, which scipy.signal.lti cannot hold "
+                             "(System.to_control(pade_order=…) approximates it)")
+        num, den = self.tf_coefficients()
+        return signal.lti(num, den)
 
     def __reduce__(self) -> Any:
         return (System, (self.spec_json,))

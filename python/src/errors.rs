@@ -11,6 +11,29 @@ pub fn value_error(e: impl Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// A study-layer error as a `ValueError`, with the study layer's words for the command line's
+/// options said as the Python arguments they are here: the study layer is the command line's
+/// too, and a few of its messages name its flags (`--runs`, `--method bcls`, `--init auto`).
+pub fn study_error(e: impl Display) -> PyErr {
+    value_error(argument_words(&e.to_string()))
+}
+
+/// `message` with the command line's options named as the Python arguments.
+fn argument_words(message: &str) -> String {
+    [
+        ("--init auto", "init=\"auto\""),
+        ("--init experiment-only", "init=\"experiment-only\""),
+        ("--time-limit", "time_limit"),
+        ("--runs", "runs"),
+        ("--threads", "threads"),
+        ("--method ", "method "),
+    ]
+    .iter()
+    .fold(message.to_string(), |m, (flag, argument)| {
+        m.replace(flag, argument)
+    })
+}
+
 /// The spec table in `json` (an object), as the registries take it.
 pub fn spec_table(json: &str) -> Result<Map<String, Value>, PyErr> {
     match serde_json::from_str(json) {

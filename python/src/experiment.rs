@@ -2,7 +2,7 @@
 //! writes it, and a record fitted as `jitterid fit --json` reports it.
 
 use crate::arrays::finite_samples;
-use crate::errors::{json_text, spec_table, value_error};
+use crate::errors::{json_text, spec_table, study_error, value_error};
 use crate::toml_text;
 use crate::watching::{run_watched, Reporter, Stopped};
 use jitterid::estimate::solver::{ProgressHook, Termination};
@@ -13,6 +13,7 @@ use jitterid_study::experiment::{self, InputSpec, Method, Paths, Purpose};
 use jitterid_study::fingerprint::experiment_fingerprint;
 use jitterid_study::inputs;
 use jitterid_study::montecarlo::DEFAULT_SEED;
+use jitterid_study::select::{auto_start, InitChoice};
 use jitterid_study::{fit as fitting, records, simulate, Registries};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError};
@@ -47,7 +48,7 @@ impl Experiment {
                 .for_own_method
                 .as_ref()
                 .map(Cow::Borrowed)
-                .map_err(value_error);
+                .map_err(study_error);
         }
         let chosen = method
             .map(|m| {
@@ -68,7 +69,7 @@ impl Experiment {
             self.paths,
         )
         .map(Cow::Owned)
-        .map_err(value_error)
+        .map_err(study_error)
     }
 }
 
@@ -238,7 +239,11 @@ impl Experiment {
     /// raised by `progress`, stops the solver before its next iteration (the
     /// Levenberg–Marquardt and BFGS solvers; the others run to their end) and is raised then; a
     /// `KeyboardInterrupt`'s `__cause__` says where the fit stopped.
-    #[pyo3(signature = (y, input_t = None, input_u = None, method = None, t = None, progress = None))]
+    ///
+    /// `init` is where the search starts: `"experiment"` (the file's values, the default),
+    /// `"auto"` (the data-driven initializer's model, as `jitterid fit --init auto`) or
+    /// `"experiment-only"`.
+    #[pyo3(signature = (y, input_t = None, input_u = None, method = None, t = None, progress = None, init = None))]
     #[allow(clippy::too_many_arguments)]
     fn fit_record(
         &self,
@@ -249,8 +254,14 @@ impl Experiment {
         method: Option<&str>,
         t: Option<&Bound<'_, PyAny>>,
         progress: Option<Bound<'_, PyAny>>,
+        init: Option<&str>,
     ) -> PyResult<Fit> {
-        let exp = self.for_method(method)?;
+        let mut exp = self.for_method(method)?;
+        let init = match init {
+            None => InitChoice::default(),
+            Some(s) => InitChoice::parse(s).map_err(|e| value_error(format!("init: {e}")))?,
+        };
+        exp.to_mut().estimate.likelihood_start = init.likelihood_start();
         let y = finite_samples(y, "y")?;
         if y.len() != exp.grid.len() {
             return Err(value_error(format!(
@@ -262,18 +273,7 @@ impl Experiment {
         if let Some(t) = t {
             on_grid(&finite_samples(t, "t")?, &exp.grid)?;
         }
-        let input = match &exp.input {
-            InputSpec::None => None,
-            InputSpec::Known(i) => Some(i.clone()),
-            InputSpec::RandomBinary(_) => {
-                let (Some(t), Some(u)) = (input_t, input_u) else {
-                    return Err(value_error(
-                        "input: the experiment's input is random-binary, so the fit needs the record's input realisation (input_t and input_u, as simulate returns them)",
-                    ));
-                };
-                Some(Input::Piecewise(realisation(t, u, &exp.grid)?))
-            }
-        };
+        let input = record_input(&exp, input_t, input_u, &exp.grid, "")?;
         if let Some(p) = &progress {
             if !p.is_callable() {
                 return Err(PyTypeError::new_err(format!(
@@ -295,7 +295,10 @@ impl Experiment {
                 cancel: Some(Arc::clone(&cancel)),
                 ..jitterid_study::Watch::none()
             };
-            let signal = fitting::signal_of(&exp, input.as_ref())?;
+            let mut signal = fitting::signal_of(&exp, input.as_ref())?;
+            if init == InitChoice::Auto {
+                signal = auto_start(&exp, &signal, input.as_ref(), &y, "y")?;
+            }
             fitting::fit_values(&exp, signal, y, "y", &watch)
         };
         let on_event = |(iteration, cost): (u64, f64)| -> PyResult<()> {
@@ -305,7 +308,12 @@ impl Experiment {
             Ok(())
         };
         match run_watched(py, &cancel, work, on_event) {
-            Ok(Some(fit)) => fit.map(|fit| Fit { fit }).map_err(value_error),
+            Ok(Some(fit)) => fit
+                .map(|fit| Fit {
+                    fit,
+                    grid: exp.grid,
+                })
+                .map_err(study_error),
             Ok(None) => Err(PyRuntimeError::new_err("the fit's thread panicked")),
             Err(Stopped { error, outcome }) => {
                 let report = match outcome {
@@ -354,17 +362,44 @@ impl Experiment {
     }
 }
 
+/// The input of a record on `grid`: the experiment's known input, or for a random-binary
+/// experiment the record's realisation (`input_t`, `input_u`). `prefix` names the record's
+/// arguments in messages (`""` for the fitted record, `"validation "` for a validation
+/// record).
+pub fn record_input(
+    exp: &experiment::Experiment,
+    input_t: Option<&Bound<'_, PyAny>>,
+    input_u: Option<&Bound<'_, PyAny>>,
+    grid: &SampleGrid,
+    prefix: &str,
+) -> PyResult<Option<Input>> {
+    Ok(match &exp.input {
+        InputSpec::None => None,
+        InputSpec::Known(i) => Some(i.clone()),
+        InputSpec::RandomBinary(_) => {
+            let (Some(t), Some(u)) = (input_t, input_u) else {
+                return Err(value_error(format!(
+                    "{prefix}input: the experiment's input is random-binary, so the {prefix}record needs its input realisation (input_t and input_u, as simulate returns them)",
+                )));
+            };
+            Some(Input::Piecewise(realisation(t, u, grid, prefix)?))
+        }
+    })
+}
+
 /// The random input's realisation from its switch times `t` and levels `u` (the side file's
 /// columns, levels closed by a 0), checked as `jitterid fit` checks the side file.
 fn realisation(
     t: &Bound<'_, PyAny>,
     u: &Bound<'_, PyAny>,
     grid: &SampleGrid,
+    prefix: &str,
 ) -> PyResult<PiecewiseConstant> {
-    let values = vec![finite_samples(t, "input_t")?, finite_samples(u, "input_u")?];
+    let (tn, un) = (format!("{prefix}input_t"), format!("{prefix}input_u"));
+    let values = vec![finite_samples(t, &tn)?, finite_samples(u, &un)?];
     if values[0].len() != values[1].len() {
         return Err(value_error(format!(
-            "input_t and input_u: expected equal lengths, found {} and {}",
+            "{tn} and {un}: expected equal lengths, found {} and {}",
             values[0].len(),
             values[1].len()
         )));
@@ -382,7 +417,7 @@ fn realisation(
 /// Refuses sample times `t` that are not the grid's `t0 + kT`, with the tolerance of
 /// `jitterid fit` for a data file's `t` column (`records::read_data`: `1e-6·T` plus
 /// `1e-12·|t|` for the rounding of large times).
-fn on_grid(t: &[f64], grid: &SampleGrid) -> PyResult<()> {
+pub(crate) fn on_grid(t: &[f64], grid: &SampleGrid) -> PyResult<()> {
     if t.len() != grid.len() {
         return Err(value_error(format!(
             "t: has {} times, expected {} (one per sample of y)",
@@ -406,7 +441,9 @@ fn on_grid(t: &[f64], grid: &SampleGrid) -> PyResult<()> {
 /// `model`, pickling): forming it costs more than the rest of the result.
 #[pyclass(module = "jitterid._jitterid", frozen, skip_from_py_object)]
 pub struct Fit {
-    fit: fitting::Fit,
+    pub(crate) fit: fitting::Fit,
+    /// The fitted record's grid: the frequency and step responses' ranges are taken from it.
+    pub(crate) grid: SampleGrid,
 }
 
 #[pymethods]
@@ -459,6 +496,25 @@ impl Fit {
             f.estimated.clone(),
             covariance,
         ))
+    }
+
+    /// The fitted system's Bode diagram with its ±2σ bands, on `validate --bode`'s
+    /// frequencies for the fitted record's grid (a dict of arrays; `None` for a system that is
+    /// not rational).
+    fn bode<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.bode_of(py)
+    }
+
+    /// The fitted system's unit-step response with its ±2σ band, on `validate --plot`'s times
+    /// (a dict of arrays; `None` for a system that is not rational).
+    fn step_response<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.step_of(py)
+    }
+
+    /// The fitted system's spec table (the fitted signal's kind and keys), as JSON text.
+    #[getter]
+    fn system_spec_json(&self) -> PyResult<String> {
+        json_text(&self.fit.fitted.signal.spec())
     }
 
     /// The result as `jitterid fit --json` prints it, with the fitted model's parts as spec

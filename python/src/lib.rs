@@ -16,6 +16,7 @@ mod sampling;
 mod study;
 mod system;
 mod toml_text;
+mod validating;
 mod watching;
 
 use pyo3::prelude::*;
@@ -28,6 +29,7 @@ fn _jitterid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<experiment::Fit>()?;
     m.add_class::<system::System>()?;
     m.add_class::<input::Input>()?;
+    m.add_class::<validating::Validated>()?;
     m.add_function(wrap_pyfunction!(system::system_kinds, m)?)?;
     m.add_function(wrap_pyfunction!(sampling::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sampling::first_moment, m)?)?;
@@ -35,6 +37,8 @@ fn _jitterid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(jitter::jitter_families, m)?)?;
     m.add_function(wrap_pyfunction!(study::montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(study::merge, m)?)?;
+    m.add_function(wrap_pyfunction!(validating::validate, m)?)?;
+    m.add_function(wrap_pyfunction!(validating::select, m)?)?;
     m.add_function(wrap_pyfunction!(experiment::read_record, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

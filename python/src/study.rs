@@ -1,7 +1,7 @@
 //! Monte Carlo studies and the merge of their shards, as `jitterid montecarlo --json` and
 //! `jitterid merge --json` give them.
 
-use crate::errors::{json_text, value_error};
+use crate::errors::{json_text, study_error, value_error};
 use crate::experiment::Experiment;
 use crate::watching::{run_watched, Reporter, Stopped};
 use jitterid_study::merge::merge_values;
@@ -81,7 +81,7 @@ pub fn montecarlo(
         Ok(())
     };
     let j = match run_watched(py, &cancel, work, on_event) {
-        Ok(Some(study)) => study.map_err(value_error)?,
+        Ok(Some(study)) => study.map_err(study_error)?,
         Ok(None) => {
             return Err(PyRuntimeError::new_err(
                 "the Monte Carlo study's thread panicked",

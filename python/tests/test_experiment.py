@@ -57,11 +57,11 @@ def test_table2_montecarlo_equals_the_command_line(cli, table2, table2_path):
 
 def test_fit_takes_lists_float32_and_non_contiguous_samples(table2):
     record = table2.simulate(seed=4)
-    reference = table2.fit(record).to_dict(model=True)
+    reference = table2.fit(record).to_dict(full=True)
     as_list = dict(record, y=list(record["y"]))
-    assert table2.fit(as_list).to_dict(model=True) == reference
+    assert table2.fit(as_list).to_dict(full=True) == reference
     wide = np.repeat(record["y"], 2)
-    assert table2.fit(dict(record, y=wide[::2])).to_dict(model=True) == reference
+    assert table2.fit(dict(record, y=wide[::2])).to_dict(full=True) == reference
     float32 = dict(record, y=record["y"].astype(np.float32))
     assert table2.fit(float32).converged
 
@@ -110,9 +110,9 @@ def test_fit_fields_equal_their_json(table2):
     for method in ["bcls", "ls"]:
         fit = table2.fit(record, method=method)
         assert isinstance(fit.params, np.ndarray) and fit.params.dtype == np.float64
-        via_json = jitterid.FitResult(fit.to_dict(model=True))
+        via_json = jitterid.FitResult(fit.to_dict(full=True))
         for key in ["method", "converged", "cost", "iterations", "termination", "noise_std", "names",
-                    "covariance_names", "model"]:
+                    "covariance_names", "model", "fitted_model"]:
             assert getattr(fit, key) == getattr(via_json, key), (method, key)
         for key in ["params", "std_errors", "covariance"]:
             a, b = getattr(fit, key), getattr(via_json, key)
@@ -130,7 +130,7 @@ def test_pickling_experiments_and_results(table2):
     np.testing.assert_array_equal(again.simulate(seed=9)["y"], record["y"])
     fit = table2.fit(record)
     fit_again = pickle.loads(pickle.dumps(fit))
-    assert fit_again.to_dict(model=True) == fit.to_dict(model=True)
+    assert fit_again.to_dict(full=True) == fit.to_dict(full=True)
     np.testing.assert_array_equal(fit_again.params, fit.params)
     study = jitterid.montecarlo(table2, runs=4, seed=1, shard=(0, 2))
     assert pickle.loads(pickle.dumps(study)).to_dict() == study.to_dict()

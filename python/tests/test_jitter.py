@@ -89,13 +89,28 @@ def test_samples_are_reproducible_by_seed():
         (lambda: jitter.from_name("no-such-family"), ["no-such-family", "uniform-sum"]),
         (lambda: jitter.UniformSum(n=2, a=-1.0), ["`a`", "> 0"]),
         (lambda: jitter.Gaussian(sigma=float("nan")), ["sigma", "finite"]),
-        (lambda: jitter.Gaussian(sigma=0.1, width=2), ["width"]),
-        (lambda: jitter.Gaussian(), ["sigma"]),
         (lambda: jitter.from_std("gaussian", -0.1), ["sigma"]),
+        (lambda: jitter.from_name("gaussian", sigma=0.1, width=2), ["width"]),
+        (lambda: jitter.from_name("gaussian"), ["sigma"]),
     ],
 )
 def test_bad_input_raises_value_error_naming_the_key(make, words):
     with pytest.raises(ValueError) as e:
+        make()
+    for w in words:
+        assert w in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "make, words",
+    [
+        # A class's keys are its parameters: a wrong call is refused as Python refuses one.
+        (lambda: jitter.Gaussian(sigma=0.1, width=2), ["Gaussian", "width", "sigma"]),
+        (lambda: jitter.Gaussian(), ["Gaussian", "missing", "sigma"]),
+    ],
+)
+def test_a_class_called_with_wrong_keys_raises_type_error_naming_them(make, words):
+    with pytest.raises(TypeError) as e:
         make()
     for w in words:
         assert w in str(e.value)

@@ -31,7 +31,7 @@ def test_fit_progress_reports_every_iteration_and_changes_nothing(table2):
     assert iterations == list(range(len(seen))) and iterations[-1] == fit.iterations > 1
     assert np.all(np.isfinite(costs)) and np.all(np.diff(costs) <= 0) and costs[-1] < costs[0]
     # The hook only watches: the fit is the one without it.
-    assert fit.to_dict(model=True) == table2.fit(record).to_dict(model=True)
+    assert fit.to_dict(full=True) == table2.fit(record).to_dict(full=True)
 
 
 def test_fit_on_arrays_takes_a_progress_callback(table2):

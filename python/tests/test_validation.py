@@ -154,7 +154,7 @@ def test_times_and_frequencies_are_real_and_finite(call, error, words):
         (lambda: jitterid.first_moment(G, None, U, samples=5, interval=1.0), TypeError, ["jitter", "NoneType"]),
         (lambda: jitterid.second_moment(G, J, [0.0], samples=5, interval=1.0), TypeError, ["input", "list"]),
         (lambda: jitterid.fit({"y": [1.0, 2.0], "T": 1.0}, G, "J"), TypeError, ["jitter", "str"]),
-        (lambda: jitterid.fit({"y": [1.0, 2.0], "T": 1.0}, G, J, estimate="system"), TypeError, ["estimate"]),
+        (lambda: jitterid.fit({"y": [1.0, 2.0], "T": 1.0}, G, J, estimate=3), TypeError, ["estimate", "int"]),
         (lambda: jitter.from_std("gaussian", "0.1"), TypeError, ["sigma", "str"]),
         (lambda: jitter.from_name("sum", terms=[{"family": "gaussian", "sigma": np.inf}]), ValueError,
          ["terms", "[0]", "sigma", "finite"]),

@@ -82,14 +82,21 @@ struct FitParam {
 /// The fitted structure, its noise level and the covariance of its signal parameters.
 type Model = (Structure, f64, Option<Vec<Vec<f64>>>);
 
-fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> StudyResult<Model> {
-    let name = path.display();
-    let text = csvio::read_text(path, &name.to_string(), "the JSON of `jitterid fit --json`")?;
-    let f: FitFile = serde_json::from_str(&text)
+/// The fitted model in `text`, the JSON of `jitterid fit --json` (`name` names it in
+/// messages, `what` the option or argument that gave it), checked against the experiment's
+/// structure `s`.
+fn model_from_json(
+    exp: &Experiment,
+    s: Structure,
+    text: &str,
+    name: &str,
+    what: &str,
+) -> StudyResult<Model> {
+    let f: FitFile = serde_json::from_str(text)
         .map_err(|e| study_err!("{name}: not the JSON of `jitterid fit --json`: {e}"))?;
     if exp.jitter.estimate && exp.jitter.n_range.is_some() {
         return Err(study_err!(
-            "{name}: --model: a profiled jitter (`[jitter] n_range`) is not supported; validate without --model"
+            "{name}: {what}: a profiled jitter (`[jitter] n_range`) is not supported; validate without {what}"
         ));
     }
     let want = fit::param_names(exp, &s.signal, exp.estimate.method)?;
@@ -233,27 +240,44 @@ fn read_validation(exp: &Experiment, path: &Path) -> StudyResult<(SampleGrid, Ve
     let table = csvio::read(path)?;
     let y = table.column("y")?.to_vec();
     let name = table.name.clone();
-    if y.len() < MIN_VALIDATION_SAMPLES {
+    let grid = validation_grid(exp, y.len(), table.optional("t"), &name, "--validation")?;
+    Ok((grid, y, name))
+}
+
+/// The grid of a validation record of `samples` samples with sample times `t` where known:
+/// the experiment's `T`, the record's own length and start (`t[0]`, else the experiment's
+/// `t0`). `name` names the record in messages, `what` the option or argument that gave it.
+///
+/// # Errors
+///
+/// Fewer than [`MIN_VALIDATION_SAMPLES`] samples, or times whose interval is not the
+/// experiment's.
+pub fn validation_grid(
+    exp: &Experiment,
+    samples: usize,
+    t: Option<&[f64]>,
+    name: &str,
+    what: &str,
+) -> StudyResult<SampleGrid> {
+    if samples < MIN_VALIDATION_SAMPLES {
         return Err(study_err!(
-            "{name}: --validation: {} samples, too short: at least {MIN_VALIDATION_SAMPLES} are needed",
-            y.len()
+            "{name}: {what}: {samples} samples, too short: at least {MIN_VALIDATION_SAMPLES} are needed"
         ));
     }
     let interval = exp.grid.interval();
-    let t0 = match table.optional("t") {
-        Some(t) => {
+    let t0 = match t {
+        Some(t) if t.len() >= 2 => {
             let tv = t[1] - t[0];
             if (tv - interval).abs() > 1e-6 * interval {
                 return Err(study_err!(
-                    "{name}: --validation: column `t` has interval T = {tv}, the experiment's [sampling] interval is {interval}"
+                    "{name}: {what}: column `t` has interval T = {tv}, the experiment's [sampling] interval is {interval}"
                 ));
             }
             t[0]
         }
-        None => exp.grid.time(0),
+        _ => exp.grid.time(0),
     };
-    let grid = SampleGrid::new(t0, interval, y.len()).map_err(|e| study_err!("{name}: {e}"))?;
-    Ok((grid, y, name))
+    SampleGrid::new(t0, interval, samples).map_err(|e| study_err!("{name}: {e}"))
 }
 
 /// The system's part of a signal's parameter covariance, `G`'s parameters then the delay: its
@@ -297,6 +321,16 @@ pub fn step(
     grid: &SampleGrid,
     cov: Option<&[Vec<f64>]>,
 ) -> StudyResult<Option<Vec<StepPoint>>> {
+    step_response(s, grid, cov, "--plot")
+}
+
+/// [`step`], its errors naming `what` (the option or argument that asked for it).
+pub fn step_response(
+    s: &Structure,
+    grid: &SampleGrid,
+    cov: Option<&[Vec<f64>]>,
+    what: &str,
+) -> StudyResult<Option<Vec<StepPoint>>> {
     let cov = system_covariance(s, cov);
     // An export error surfaces from `step_of` below; here it only loses the horizon.
     let slowest = export::tf_of(&s.signal)
@@ -317,7 +351,7 @@ pub fn step(
     let times: Vec<f64> = (0..200).map(|i| horizon * i as f64 / 199.0).collect();
     export::step_of(&s.signal, &times, cov.as_deref())
         .transpose()
-        .map_err(|e| study_err!("--plot: step response: {e}"))
+        .map_err(|e| study_err!("{what}: step response: {e}"))
 }
 
 /// The frequency-response CSV of `points`.
@@ -426,6 +460,37 @@ pub fn check_level(level: f64, flag: &str) -> StudyResult<f64> {
     })
 }
 
+/// The covariance of a fit's signal parameters (the block the frequency and step responses'
+/// bands need), `None` where the fit has none.
+pub fn signal_covariance(f: &fit::Fit) -> Option<Vec<Vec<f64>>> {
+    signal_block(f.covariance.as_deref(), f.fitted.blocks().0)
+}
+
+/// A record held in memory: its samples on its grid, its input, and its name for messages.
+#[derive(Debug, Clone)]
+pub struct RecordSamples {
+    /// The record's name (its file, or the argument that gave it).
+    pub name: String,
+    /// Its grid: the experiment's for the estimation record, [`validation_grid`] for a
+    /// validation record.
+    pub grid: SampleGrid,
+    /// Its samples.
+    pub y: Vec<f64>,
+    /// Its input (the experiment's known input, or the record's realisation).
+    pub input: Option<Input>,
+}
+
+/// A fitted model given as the JSON of `jitterid fit --json`, instead of fitted here.
+#[derive(Debug, Clone, Copy)]
+pub struct FitText<'a> {
+    /// The JSON text.
+    pub text: &'a str,
+    /// What holds it (a file's name), for messages.
+    pub name: &'a str,
+    /// The option or argument that gave it, for messages.
+    pub what: &'a str,
+}
+
 /// Validates the experiment's model on the record in `data` and, when given, on the record in
 /// `o.validation`: the model is read from `o.model` (a `fit --json` output) or fitted here.
 pub fn validate(
@@ -436,18 +501,64 @@ pub fn validate(
 ) -> StudyResult<Validation> {
     let level = check_level(o.level, "--level")?;
     let table = read_data(exp, data)?;
-    let y = table.y;
     let input = read_input_on(exp, data, o.input, &exp.grid)?;
-    let signal = fit::signal_of(exp, input.as_ref())?;
-    let (fitted, noise_std, covariance) = match o.model {
+    let estimation = RecordSamples {
+        name: table.name,
+        grid: exp.grid,
+        y: table.y,
+        input,
+    };
+    let validation = match o.validation {
         Some(path) => {
+            let (grid, y, name) = read_validation(exp, path)?;
+            let input = read_input_on(exp, path, None, &grid)?;
+            Some(RecordSamples {
+                name,
+                grid,
+                y,
+                input,
+            })
+        }
+        None => None,
+    };
+    let text = match o.model {
+        Some(path) => {
+            let name = path.display().to_string();
+            let text = csvio::read_text(path, &name, "the JSON of `jitterid fit --json`")?;
+            Some((name, text))
+        }
+        None => None,
+    };
+    let model = text.as_ref().map(|(name, text)| FitText {
+        text,
+        name,
+        what: "--model",
+    });
+    validate_records(exp, estimation, validation, model, level, watch)
+}
+
+/// [`validate`] on records held in memory: the estimation record (on the experiment's grid)
+/// and, when given, a validation record (on its own grid, [`validation_grid`]); the model is
+/// read from `model` or fitted here. `level` is the correlation tests' level, in `(0, 1)`.
+pub fn validate_records(
+    exp: &Experiment,
+    estimation: RecordSamples,
+    validation: Option<RecordSamples>,
+    model: Option<FitText<'_>>,
+    level: f64,
+    watch: &Watch,
+) -> StudyResult<Validation> {
+    let level = check_level(level, "level")?;
+    let RecordSamples { name, y, input, .. } = estimation;
+    let signal = fit::signal_of(exp, input.as_ref())?;
+    let (fitted, noise_std, covariance) = match model {
+        Some(m) => {
             let s = fit::structure(exp, signal, exp.estimate.method)?;
-            model_from_file(exp, s, path)?
+            model_from_json(exp, s, m.text, m.name, m.what)?
         }
         None => {
-            let f = fit::fit_values(exp, signal, y.clone(), &table.name, watch)?;
-            let ns = f.fitted.blocks().0;
-            let cov = signal_block(f.covariance.as_deref(), ns);
+            let f = fit::fit_values(exp, signal, y.clone(), &name, watch)?;
+            let cov = signal_covariance(&f);
             (f.fitted, f.noise_std, cov)
         }
     };
@@ -458,7 +569,7 @@ pub fn validate(
         noise_std,
         input.as_ref(),
         level,
-        &table.name,
+        &name,
     )?;
     let estimation = ValidatedRecord {
         report,
@@ -466,18 +577,23 @@ pub fn validate(
         y,
         expected,
     };
-    let validation = match o.validation {
-        Some(path) => {
-            let (grid, y, name) = read_validation(exp, path)?;
-            let u = read_input_on(exp, path, None, &grid)?;
-            let s = for_validation_record(&fitted, &grid, &y, u.as_ref(), &name)?;
-            let (mut report, expected) =
-                check_record(&s, &grid, &y, noise_std, u.as_ref(), level, &name)?;
+    let validation = match validation {
+        Some(r) => {
+            let s = for_validation_record(&fitted, &r.grid, &r.y, r.input.as_ref(), &r.name)?;
+            let (mut report, expected) = check_record(
+                &s,
+                &r.grid,
+                &r.y,
+                noise_std,
+                r.input.as_ref(),
+                level,
+                &r.name,
+            )?;
             report.initial_state = initial_state(&s.signal);
             Some(ValidatedRecord {
                 report,
-                grid,
-                y,
+                grid: r.grid,
+                y: r.y,
                 expected,
             })
         }
