@@ -151,7 +151,8 @@ pub fn param_names(
     Ok(report_names(exp, &s))
 }
 
-fn profiled(exp: &Experiment) -> bool {
+/// Whether the experiment profiles the uniform-sum order over `[jitter] n_range`.
+pub(crate) fn profiled(exp: &Experiment) -> bool {
     exp.jitter.estimate && exp.jitter.n_range.is_some()
 }
 
@@ -266,7 +267,7 @@ fn criterion_of(exp: &Experiment, s: &Structure, method: Method) -> AnyCriterion
 }
 
 /// `j`, a uniform sum, with its whole number `n` replaced (rebuilt through the registry).
-fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
+pub(crate) fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
     let mut spec = j.spec();
     spec.insert("n".into(), n.into());
     JitterRegistry::builtin().build(&spec)
@@ -535,6 +536,9 @@ pub struct FitJson<'a> {
     /// that is not rational): an export never goes missing without a word.
     #[serde(skip_serializing_if = "Option::is_none")]
     model_error: Option<String>,
+    /// What the record suggests the model misses ([`crate::notes`]); absent without a note.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    notes: Vec<String>,
 }
 
 /// Fits the experiment's model with its method to the samples `y` of a record whose input
@@ -571,6 +575,14 @@ pub fn fit_record(
     })
 }
 
+/// The JSON of `jitterid fit --json`, with the notes of the fit's record.
+pub fn fit_json_noted<'a>(f: &'a Fit, notes: &crate::notes::Notes) -> FitJson<'a> {
+    FitJson {
+        notes: notes.lines(),
+        ..fit_json(f)
+    }
+}
+
 /// The JSON of `jitterid fit --json`.
 pub fn fit_json(f: &Fit) -> FitJson<'_> {
     let (model, model_error) = match export::model_forms(&f.fitted.signal) {
@@ -591,5 +603,6 @@ pub fn fit_json(f: &Fit) -> FitJson<'_> {
         covariance: f.covariance.as_deref(),
         model,
         model_error,
+        notes: Vec::new(),
     }
 }

@@ -11,6 +11,8 @@
 //! - [`fit`]: the fit an experiment asks for — the model structure, the solver, profiling an
 //!   integer jitter parameter, the jitter floor of a Box–Jenkins noise model, the likelihood
 //!   branch — and the parameters as reported (names, estimates, standard errors, covariance).
+//! - [`notes`]: a fit's status line and what the record suggests the model misses (an input
+//!   recorded on the sampling clock, an output offset).
 //! - [`simulate`]: records of an experiment's truth, realisation by realisation.
 //! - [`montecarlo`]: studies of many realisations, bit-identical across thread counts and
 //!   shards; [`merge`] combines shards, which carry the experiment's [`fingerprint`].
@@ -32,6 +34,7 @@ pub mod inputs;
 pub mod likelihood_start;
 pub mod merge;
 pub mod montecarlo;
+pub mod notes;
 pub mod records;
 mod registries;
 pub mod residual_tests;

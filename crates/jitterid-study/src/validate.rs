@@ -82,16 +82,11 @@ struct FitParam {
 /// The fitted structure, its noise level and the covariance of its signal parameters.
 type Model = (Structure, f64, Option<Vec<Vec<f64>>>);
 
-fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> StudyResult<Model> {
+fn model_from_file(exp: &Experiment, mut s: Structure, path: &Path) -> StudyResult<Model> {
     let name = path.display();
     let text = csvio::read_text(path, &name.to_string(), "the JSON of `jitterid fit --json`")?;
     let f: FitFile = serde_json::from_str(&text)
         .map_err(|e| study_err!("{name}: not the JSON of `jitterid fit --json`: {e}"))?;
-    if exp.jitter.estimate && exp.jitter.n_range.is_some() {
-        return Err(study_err!(
-            "{name}: --model: a profiled jitter (`[jitter] n_range`) is not supported; validate without --model"
-        ));
-    }
     let want = fit::param_names(exp, &s.signal, exp.estimate.method)?;
     let got: Vec<&str> = f.parameters.iter().map(|p| p.name.as_str()).collect();
     if want != got {
@@ -127,8 +122,30 @@ fn model_from_file(exp: &Experiment, s: Structure, path: &Path) -> StudyResult<M
             p.name
         ));
     }
-    let theta: Vec<f64> = f.parameters[..s.num_params()]
+    // A profiled uniform sum reports its order `jitter.n` and the derived `jitter.sigma` beside
+    // its parameter `a`: the order chooses the family member, the derived value is not a
+    // parameter of the structure.
+    let profiled = fit::profiled(exp) && s.estimate_jitter;
+    if profiled {
+        let n = f
+            .parameters
+            .iter()
+            .find(|p| p.name == "jitter.n")
+            .map(|p| p.estimate)
+            .filter(|n| *n >= 0.0 && n.fract() == 0.0 && *n <= f64::from(u32::MAX))
+            .ok_or_else(|| {
+                study_err!(
+                    "{name}: parameter jitter.n: expected the profiled order, a whole number >= 0"
+                )
+            })?;
+        s.jitter = fit::with_n(&s.jitter, n as u32)
+            .map_err(|e| study_err!("{name}: parameter jitter.n: {e}"))?;
+    }
+    let theta: Vec<f64> = f
+        .parameters
         .iter()
+        .filter(|p| !(profiled && (p.name == "jitter.n" || p.name == "jitter.sigma")))
+        .take(s.num_params())
         .map(|p| p.estimate)
         .collect();
     let ns = s.blocks().0;

@@ -9,9 +9,10 @@ use crate::progress::Ticker;
 use jitterid::estimate::Record;
 use jitterid::signal::{AnySignal, Input};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{Experiment, Method, Paths, Purpose};
+use jitterid_study::experiment::{Experiment, Method, Purpose, ReadOptions};
 use jitterid_study::export;
-use jitterid_study::fit::{self, fit_json, fit_record, Fit};
+use jitterid_study::fit::{self, fit_json_noted, fit_record, Fit};
+use jitterid_study::notes::{status, Notes};
 use jitterid_study::records::{read_data, read_data_and_tau, read_experiment, read_input};
 use jitterid_study::select::{auto_start, InitChoice};
 use jitterid_study::study_err;
@@ -24,8 +25,9 @@ use std::path::{Path, PathBuf};
 pub struct FitRequest {
     /// The experiment file.
     pub experiment: PathBuf,
-    /// Where the files the experiment file names may be (`--allow-paths-outside`).
-    pub paths: Paths,
+    /// How the experiment file is read (`--allow-paths-outside`, `--set`, the `[sampling]`
+    /// keys a data file gives).
+    pub read: ReadOptions,
     /// The data file.
     pub data: PathBuf,
     /// The input file (for a random-binary experiment), default `<data>.input.csv`.
@@ -52,7 +54,7 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let mut exp = read_experiment(
         &o.experiment,
         Purpose::Estimate(o.method),
-        o.paths,
+        &o.read,
         o.max_iterations,
         o.time_limit,
     )?;
@@ -79,6 +81,7 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     };
     let f = fit_record(&exp, signal.clone(), &record, &watch)?;
     drop(ticker);
+    let notes = Notes::of(&f, &exp.grid, record.y(), input.as_ref());
 
     let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
@@ -90,14 +93,14 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     }
 
     if o.json {
-        return serde_json::to_string_pretty(&fit_json(&f))
+        return serde_json::to_string_pretty(&fit_json_noted(&f, &notes))
             .map(|text| Outcome {
                 text: text + "\n",
                 status,
             })
             .map_err(|e| study_err!("JSON: {e}"));
     }
-    let out = fit_text(&exp, &f, &name, o.plot.as_deref());
+    let out = fit_text(&exp, &f, &notes, &name, o.plot.as_deref());
     Ok(Outcome { text: out, status })
 }
 
@@ -169,7 +172,7 @@ fn write_fit_figures(
 }
 
 /// The human-readable report of `fit`.
-fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> String {
+fn fit_text(exp: &Experiment, f: &Fit, notes: &Notes, name: &str, plot: Option<&Path>) -> String {
     let method = exp.estimate.method;
     let mut out = String::new();
     let _ = writeln!(
@@ -181,13 +184,8 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
     );
     let _ = writeln!(
         out,
-        "{} ({}) after {} iterations, cost {:.6e}, noise std {} ({})",
-        if f.converged {
-            "converged"
-        } else {
-            "NOT converged"
-        },
-        f.termination,
+        "{} after {} iterations, cost {:.6e}, noise std {} ({})",
+        status(f),
         f.iterations,
         f.cost,
         fmt_num(f.noise_std),
@@ -197,6 +195,9 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
             "known"
         }
     );
+    if let Some(cause) = notes.likely_cause(f) {
+        let _ = writeln!(out, "{cause}");
+    }
     let w = name_width(f.params.iter().map(|p| p.name.as_str()));
     let _ = writeln!(
         out,
@@ -223,6 +224,9 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
             "model: G(s) e^(-sD) with input delay D = {} s (the parameter delay; --json: model.zpk, model.tf, model.ss give G, model.delay gives D)",
             fmt_num(d)
         );
+    }
+    for line in notes.lines() {
+        let _ = writeln!(out, "{line}");
     }
     if let Some(dir) = plot {
         let _ = writeln!(
