@@ -228,13 +228,13 @@ fn statistic(t: &CorrelationTest) -> String {
     )
 }
 
-/// How many lags lie outside the bounds, of how many, and how many the per-lag rule allows.
+/// How many lags lie outside the bounds, of how many tested, and how many the per-lag rule
+/// allows. An autocorrelation's lag 0 is 1 by construction and not tested.
 fn lags(t: &CorrelationTest) -> String {
+    let auto = t.test == "ljung-box";
+    let tested = t.lags.iter().filter(|&&l| !(auto && l == 0)).count();
     format!(
-        "{} of {} (±{:.3}; {} allowed)",
-        t.outside,
-        t.lags.len(),
-        t.bound,
-        t.allowed
+        "{} of {tested} (±{:.3}; {} allowed)",
+        t.outside, t.bound, t.allowed
     )
 }
