@@ -166,9 +166,11 @@ pub struct BudgetArgs {
 pub struct FitArgs {
     /// The experiment file (TOML); its values are the starting point.
     pub experiment: PathBuf,
-    /// The data file (CSV with a column `y`; optional `k`, `t` are checked).
-    #[arg(long)]
-    pub data: PathBuf,
+    /// The data file (CSV with a column `y`; optional `k`, `t` are checked). Repeat it to fit
+    /// several records of one system jointly (each with its own input side file, length and
+    /// start; a first-moment method).
+    #[arg(long, required = true)]
+    pub data: Vec<PathBuf>,
     /// The input realisation (CSV with columns t,u) for a random-binary experiment
     /// [default: <data stem>.input.csv].
     #[arg(long)]
@@ -296,7 +298,9 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
         })
         .map(|s| Outcome::success(s + "\n")),
         Command::Fit(a) => commands::fit(&FitRequest {
-            read: a.experiment_args.read_options(Some(&a.data))?,
+            read: a
+                .experiment_args
+                .read_options(a.data.first().map(PathBuf::as_path))?,
             experiment: a.experiment,
             data: a.data,
             input: a.input,

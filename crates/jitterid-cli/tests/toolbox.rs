@@ -49,15 +49,20 @@ fn edited_example(dir: &Path, name: &str, edits: &[(&str, &str)]) -> PathBuf {
 
 /// A Table 2 record (seed 1) in `dir`: the data file and its input side file.
 fn table2_record(dir: &Path) -> PathBuf {
-    let data = dir.join("d.csv");
-    let o = run(&[
-        "simulate",
-        &example("table2.toml"),
-        "--seed",
-        "1",
-        "--out",
-        s(&data),
-    ]);
+    table2_run(dir, "d.csv", "0", &[])
+}
+
+/// Realisation `run` of Table 2 (seed 1) as `dir/name` with its side file, the experiment
+/// edited by the `--set` arguments `set`.
+fn table2_run(dir: &Path, name: &str, run_index: &str, set: &[&str]) -> PathBuf {
+    let data = dir.join(name);
+    let exp = example("table2.toml");
+    let mut args = vec!["simulate", exp.as_str(), "--seed", "1", "--run", run_index];
+    for x in set {
+        args.extend(["--set", x]);
+    }
+    args.extend(["--out", s(&data)]);
+    let o = run(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     data
 }
@@ -417,19 +422,8 @@ fn notes_and_status_lines_on_measured_data_mistakes() {
 fn validate_prints_a_table_with_the_json_numbers() {
     let dir = scratch_in(GROUP, "validate-table");
     let data = table2_record(&dir);
-    let other = dir.join("v.csv");
+    let other = table2_run(&dir, "v.csv", "1", &[]);
     let exp = example("table2.toml");
-    let o = run(&[
-        "simulate",
-        &exp,
-        "--seed",
-        "1",
-        "--run",
-        "1",
-        "--out",
-        s(&other),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
     let args = [
         "validate",
         exp.as_str(),
@@ -581,4 +575,74 @@ fn validate_takes_a_profiled_uniform_sum_model() {
         &["validate", &exp, "--data", s(&data), "--model", s(&bad)],
         &["parameter jitter.n", "whole number"],
     );
+}
+
+/// Several `--data` files are fitted jointly: a record given twice gives the estimates of the
+/// single fit and standard errors smaller by √2 (twice the information); records of different
+/// lengths, starts and inputs fit together; what belongs to one record is refused.
+#[test]
+fn several_records_are_fitted_jointly() {
+    let dir = scratch_in(GROUP, "joint");
+    let data = table2_record(&dir);
+    let exp = example("table2.toml");
+    let copy = dir.join("copy.csv");
+    std::fs::copy(&data, &copy).unwrap();
+    std::fs::copy(dir.join("d.input.csv"), dir.join("copy.input.csv")).unwrap();
+    let single = json(&["fit", &exp, "--data", s(&data), "--json"]);
+    let twice = json(&[
+        "fit",
+        &exp,
+        "--data",
+        s(&data),
+        "--data",
+        s(&copy),
+        "--json",
+    ]);
+    let params = |v: &Value| v["parameters"].as_array().unwrap().clone();
+    for (a, b) in params(&single).iter().zip(params(&twice).iter()) {
+        let (x, y) = (
+            a["estimate"].as_f64().unwrap(),
+            b["estimate"].as_f64().unwrap(),
+        );
+        assert!((x - y).abs() <= 1e-9 * x.abs(), "{a} {b}");
+        let (sa, sb) = (a["stderr"].as_f64().unwrap(), b["stderr"].as_f64().unwrap());
+        assert!((sa / sb - 2f64.sqrt()).abs() < 1e-6, "{a} {b}");
+    }
+    // A second record of 150 samples from 500 s, with its own input.
+    let other = table2_run(
+        &dir,
+        "other.csv",
+        "1",
+        &["sampling.samples=150", "sampling.start=500"],
+    );
+    let both = ["fit", exp.as_str(), "--data", s(&data), "--data", s(&other)];
+    let joint = json(&[&both[..], &["--json"]].concat());
+    assert!(joint["converged"].as_bool().unwrap(), "{joint}");
+    for (a, b) in params(&single).iter().zip(params(&joint).iter()) {
+        assert!(
+            b["stderr"].as_f64().unwrap() < a["stderr"].as_f64().unwrap(),
+            "{a} {b}"
+        );
+    }
+    // The other record's input is its own: with the first record's instead, the fit differs.
+    std::fs::copy(dir.join("d.input.csv"), dir.join("other.input.csv")).unwrap();
+    let status = run(&both).status.code().unwrap();
+    let wrong = json_with(&[&both[..], &["--json"]].concat(), status);
+    assert_ne!(wrong["parameters"], joint["parameters"]);
+    let text = stdout(&run(&["fit", &exp, "--data", s(&data), "--data", s(&copy)]));
+    let named = format!("fit of {} + {} with bcls", data.display(), copy.display());
+    assert!(text.starts_with(&named), "{text}");
+    let two = ["fit", exp.as_str(), "--data", s(&data), "--data", s(&copy)];
+    refused(
+        &[&two[..], &["--method", "ml"]].concat(),
+        &[
+            "a joint fit of 2 records with method ml",
+            "first-moment method",
+        ],
+    );
+    refused(
+        &[&two[..], &["--plot", "figs"]].concat(),
+        &["--plot: not with several --data"],
+    );
+    assert!(!Path::new("figs").exists());
 }

@@ -12,6 +12,7 @@ use jitterid_study::error::StudyResult;
 use jitterid_study::experiment::{Experiment, Method, Purpose, ReadOptions};
 use jitterid_study::export;
 use jitterid_study::fit::{self, fit_json_noted, fit_record, Fit};
+use jitterid_study::joint::{fit_joint, read_records};
 use jitterid_study::notes::{status, Notes};
 use jitterid_study::records::{read_data, read_data_and_tau, read_experiment, read_input};
 use jitterid_study::select::{auto_start, InitChoice};
@@ -28,8 +29,8 @@ pub struct FitRequest {
     /// How the experiment file is read (`--allow-paths-outside`, `--set`, the `[sampling]`
     /// keys a data file gives).
     pub read: ReadOptions,
-    /// The data file.
-    pub data: PathBuf,
+    /// The data files: one record, or several fitted jointly.
+    pub data: Vec<PathBuf>,
     /// The input file (for a random-binary experiment), default `<data>.input.csv`.
     pub input: Option<PathBuf>,
     /// Method override.
@@ -60,16 +61,20 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     )?;
     exp.estimate.likelihood_start = o.init.likelihood_start();
     let method = exp.estimate.method;
+    let data_file = match o.data.as_slice() {
+        [one] => one,
+        several => return fit_several(o, &exp, several),
+    };
     // The jitter column is kept only for the figures that draw it.
     let data = if o.plot.is_some() {
-        read_data_and_tau(&exp, &o.data)?
+        read_data_and_tau(&exp, data_file)?
     } else {
-        read_data(&exp, &o.data)?
+        read_data(&exp, data_file)?
     };
     let (name, tau) = (data.name, data.tau);
     // The one copy of the samples: the fit, the start and the figures share it.
     let record = fit::record(&exp.grid, data.y).map_err(|e| study_err!("{name}: {e}"))?;
-    let input = read_input(&exp, &o.data, o.input.as_deref())?;
+    let input = read_input(&exp, data_file, o.input.as_deref())?;
     let mut signal = fit::signal_of(&exp, input.as_ref())?;
     if o.init == InitChoice::Auto {
         signal = auto_start(&exp, &signal, input.as_ref(), record.y(), &name)?;
@@ -101,6 +106,48 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
             .map_err(|e| study_err!("JSON: {e}"));
     }
     let out = fit_text(&exp, &f, &notes, &name, o.plot.as_deref());
+    Ok(Outcome { text: out, status })
+}
+
+/// `jitterid fit` of several records at once (`--data` repeated): the joint fit of the study
+/// layer, printed as for one record.
+fn fit_several(o: &FitRequest, exp: &Experiment, data: &[PathBuf]) -> StudyResult<Outcome> {
+    // What belongs to one record: its figures, its input file, its data-driven start.
+    for (given, flag) in [
+        (o.plot.is_some(), "--plot"),
+        (o.input.is_some(), "--input"),
+        (o.init == InitChoice::Auto, "--init auto"),
+    ] {
+        if given {
+            return Err(study_err!(
+                "{flag}: not with several --data files (it belongs to one record; each record's input is its side file or the experiment's)"
+            ));
+        }
+    }
+    let paths: Vec<&Path> = data.iter().map(PathBuf::as_path).collect();
+    let records = read_records(exp, &paths)?;
+    let ticker = Ticker::start(&format!(
+        "fitting {} records with {}",
+        records.len(),
+        exp.estimate.method.as_str()
+    ));
+    let watch = Watch {
+        iterations: crate::progress::active_fit_hook(),
+        ..Watch::none()
+    };
+    let f = fit_joint(exp, &records, &watch)?;
+    drop(ticker);
+    let status = Status::of_convergence(f.converged, o.accept_unconverged);
+    if o.json {
+        return serde_json::to_string_pretty(&fit_json_noted(&f, &Notes::default()))
+            .map(|text| Outcome {
+                text: text + "\n",
+                status,
+            })
+            .map_err(|e| study_err!("JSON: {e}"));
+    }
+    let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
+    let out = fit_text(exp, &f, &Notes::default(), &names.join(" + "), None);
     Ok(Outcome { text: out, status })
 }
 
