@@ -17,6 +17,7 @@
 //!   mean against their standard deviation names it.
 
 use crate::fit::{Fit, Structure};
+use jitterid::estimate::NoiseModel;
 use jitterid::signal::{Input, SampleGrid, Signal};
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
@@ -144,10 +145,11 @@ pub fn switches_on_grid(input: &Input, grid: &SampleGrid) -> Option<usize> {
 /// `∂m_k/∂θ` of the fitted parameters, `t = eᵀr / (s ‖e‖)` for the residuals `r = y − m` of
 /// standard deviation `s`, and `eᵀr / ‖e‖²` the offset a refit with a constant would find to
 /// first order. With no parameter gradient (nothing fitted) it is the plain t-test of the
-/// residuals' mean.
+/// residuals' mean. The test's law holds for independent residuals: with a coloured noise
+/// model (their correlation would make a chance mean look significant) it is not run.
 pub fn residual_offset(fitted: &Structure, grid: &SampleGrid, y: &[f64]) -> Option<Offset> {
     let n = y.len();
-    if grid.len() != n {
+    if grid.len() != n || !fitted.noise.is_white() {
         return None;
     }
     let m = fitted.signal.expected_values(grid, &fitted.jitter);
