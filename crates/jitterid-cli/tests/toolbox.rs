@@ -646,3 +646,40 @@ fn several_records_are_fitted_jointly() {
     );
     assert!(!Path::new("figs").exists());
 }
+
+/// The offset note's evidence on Table 2 records (noise 0.01): no note on eight records as
+/// simulated, a note on each of the same records with an offset of two noise standard
+/// deviations (0.02) added.
+#[test]
+fn the_offset_note_fires_on_an_offset_and_not_without_one() {
+    let dir = scratch_in(GROUP, "offset-evidence");
+    let exp = example("table2.toml");
+    for r in 0..8 {
+        let name = format!("d{r}.csv");
+        let data = table2_run(&dir, &name, &r.to_string(), &[]);
+        let clean = stdout(&run(&["fit", &exp, "--data", s(&data)]));
+        assert!(!clean.contains("note:"), "run {r}: {clean}");
+        let text = std::fs::read_to_string(&data).unwrap();
+        let header = text.lines().next().unwrap();
+        let iy = header.split(',').position(|c| c == "y").unwrap();
+        let mut shifted = vec![header.to_string()];
+        for l in text.lines().skip(1) {
+            let mut c: Vec<String> = l.split(',').map(str::to_string).collect();
+            let y: f64 = c[iy].parse().unwrap();
+            c[iy] = format!("{}", y + 0.02);
+            shifted.push(c.join(","));
+        }
+        let off = dir.join(format!("o{r}.csv"));
+        std::fs::write(&off, shifted.join("\n") + "\n").unwrap();
+        std::fs::copy(
+            dir.join(format!("d{r}.input.csv")),
+            dir.join(format!("o{r}.input.csv")),
+        )
+        .unwrap();
+        let noted = stdout(&run(&["fit", &exp, "--data", s(&off)]));
+        assert!(
+            noted.contains("note: the output probably has an offset"),
+            "run {r}: {noted}"
+        );
+    }
+}
