@@ -88,7 +88,6 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     drop(ticker);
     let notes = Notes::of(&f, &exp.grid, record.y(), input.as_ref());
 
-    let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
         let data = Samples {
             record: &record,
@@ -97,16 +96,26 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
         write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &data)?;
     }
 
-    if o.json {
-        return serde_json::to_string_pretty(&fit_json_noted(&f, &notes))
-            .map(|text| Outcome {
-                text: text + "\n",
-                status,
-            })
-            .map_err(|e| study_err!("JSON: {e}"));
-    }
-    let out = fit_text(&exp, &f, &notes, &name, o.plot.as_deref());
-    Ok(Outcome { text: out, status })
+    report(o, &exp, &f, &notes, &name)
+}
+
+/// The report of a fit, as JSON or as the table, with the exit status of its convergence.
+fn report(
+    o: &FitRequest,
+    exp: &Experiment,
+    f: &Fit,
+    notes: &Notes,
+    name: &str,
+) -> StudyResult<Outcome> {
+    let status = Status::of_convergence(f.converged, o.accept_unconverged);
+    let text = if o.json {
+        serde_json::to_string_pretty(&fit_json_noted(f, notes))
+            .map_err(|e| study_err!("JSON: {e}"))?
+            + "\n"
+    } else {
+        fit_text(exp, f, notes, name, o.plot.as_deref())
+    };
+    Ok(Outcome { text, status })
 }
 
 /// `jitterid fit` of several records at once (`--data` repeated): the joint fit of the study
@@ -137,18 +146,8 @@ fn fit_several(o: &FitRequest, exp: &Experiment, data: &[PathBuf]) -> StudyResul
     };
     let f = fit_joint(exp, &records, &watch)?;
     drop(ticker);
-    let status = Status::of_convergence(f.converged, o.accept_unconverged);
-    if o.json {
-        return serde_json::to_string_pretty(&fit_json_noted(&f, &Notes::default()))
-            .map(|text| Outcome {
-                text: text + "\n",
-                status,
-            })
-            .map_err(|e| study_err!("JSON: {e}"));
-    }
     let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
-    let out = fit_text(exp, &f, &Notes::default(), &names.join(" + "), None);
-    Ok(Outcome { text: out, status })
+    report(o, exp, &f, &Notes::default(), &names.join(" + "))
 }
 
 /// The samples of the fitted file, as the figures draw them.
