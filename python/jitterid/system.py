@@ -58,6 +58,13 @@ class System(SpecTable, _jitterid.System):
         ``s``, rad/s). python-control's transfer functions have no input delay: a delayed system
         needs ``pade_order``, the order of the Padé approximation of ``e^{−sD}`` multiplied in.
         Needs the optional package ``control`` (``pip install control``)."""
+        # The arguments first: a wrong call is the caller's error whether or not the optional
+        # package is there.
+        if self.delay is not None and pade_order is None:
+            raise ValueError(f"pade_order: the system has an input delay of {self.delay} s, which a python-control "
+                             "TransferFunction cannot hold; give pade_order (say 5) to multiply in its Padé "
+                             "approximation")
+        order = None if self.delay is None else integer(pade_order, "pade_order")
         try:
             import control
         except ImportError:
@@ -67,23 +74,19 @@ class System(SpecTable, _jitterid.System):
         g = control.tf(num, den)
         if self.delay is None:
             return g
-        if pade_order is None:
-            raise ValueError(f"pade_order: the system has an input delay of {self.delay} s, which a python-control "
-                             "TransferFunction cannot hold; give pade_order (say 5) to multiply in its Padé "
-                             "approximation")
-        return g * control.tf(*control.pade(self.delay, integer(pade_order, "pade_order")))
+        return g * control.tf(*control.pade(self.delay, order))
 
     def to_scipy(self) -> Any:
         """The system as a ``scipy.signal.lti`` (transfer-function form, in ``s``, rad/s).
         SciPy's linear systems have no input delay, so a delayed system raises ``ValueError``.
         Needs the optional package ``scipy`` (``pip install scipy``)."""
+        if self.delay is not None:
+            raise ValueError(f"the system has an input delay of {self.delay} s, which scipy.signal.lti cannot hold "
+                             "(System.to_control(pade_order=…) approximates it)")
         try:
             from scipy import signal
         except ImportError:
             raise ImportError("System.to_scipy() needs SciPy, which is not installed: pip install scipy") from None
-        if self.delay is not None:
-            raise ValueError(f"the system has an input delay of {self.delay} s, which scipy.signal.lti cannot hold "
-                             "(System.to_control(pade_order=…) approximates it)")
         num, den = self.tf_coefficients()
         return signal.lti(num, den)
 

@@ -5,7 +5,9 @@ past the first argument's check), each call in a fresh interpreter under a memor
 time limit.
 
 A call may return, or raise ``ValueError``, ``TypeError``, ``OverflowError``, ``MemoryError``,
-``KeyError``, ``OSError`` (or the exception of a hostile callback handed to it); anything else
+``KeyError``, ``OSError``, ``ImportError`` (a conversion whose optional package, SciPy or
+python-control, is not installed: the message says what to install) or the exception of a
+hostile callback handed to it; anything else
 is a finding: a Rust panic (``PanicException``), the interpreter's death by a signal (an abort
 on a failed allocation, a segmentation fault), a call that does not return within the time
 limit, or an exception of another type (``AttributeError``, ``IndexError``, ``RuntimeError``…:
@@ -57,8 +59,18 @@ CALL_TIMEOUT = 60.0
 BATCH = 10
 
 #: Exception types that are a clean refusal. ``Hostile`` is raised by the hostile callables of
-#: the pool (a progress callback that raises must have its exception propagate).
-FINE = ("ValueError", "TypeError", "OverflowError", "MemoryError", "KeyError", "OSError", "Hostile")
+#: the pool (a progress callback that raises must have its exception propagate); ``ImportError``
+#: is an optional package's absence, named in the message.
+FINE = (
+    "ValueError",
+    "TypeError",
+    "OverflowError",
+    "MemoryError",
+    "KeyError",
+    "OSError",
+    "ImportError",
+    "Hostile",
+)
 
 #: What every interpreter runs before its calls: the receivers (objects whose methods are
 #: called), made on first use, and the names the pools' expressions use.
