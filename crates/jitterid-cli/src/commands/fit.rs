@@ -152,7 +152,13 @@ fn write_fit_figures(
         method.as_str()
     };
     let cov = signal_covariance(f);
-    let bode = frequency_response(&f.fitted, &exp.grid, cov.as_deref(), "--plot")?;
+    // The response is drawn from 1/(NT) to the Nyquist frequency 1/(2T): a record of one or
+    // two samples has no such band, and its figures go without the Bode diagram.
+    let bode = if exp.grid.len() > 2 {
+        frequency_response(&f.fitted, &exp.grid, cov.as_deref(), "--plot")?
+    } else {
+        None
+    };
     let step = step(&f.fitted, &exp.grid, cov.as_deref())?;
     let figs = plots::fit_figures(&plots::FitPlots {
         exp,
