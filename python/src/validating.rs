@@ -229,11 +229,7 @@ pub fn validate(
         }
         None => None,
     };
-    let model = fit_json.map(|text| FitText {
-        text,
-        name: "fit",
-        what: "fit",
-    });
+    let model = fit_json.map(|text| FitText { text, name: "fit" });
     let validation = py
         .detach(|| validate_records(&exp, estimation, validation, model, level, &Watch::none()))
         .map_err(study_error)?;

@@ -81,7 +81,7 @@ def small(tmp_path_factory, cli):
 def test_validate_equals_the_command_line(cli, small):
     path, data, check = small
     exp = jitterid.Experiment.from_toml(path)
-    expected = cli("validate", path, "--data", data, "--validation", check, "--level", 0.01, parse_json=True)
+    expected = cli("validate", path, "--data", data, "--validation", check, "--level", 0.01, "--json", parse_json=True)
     got = jitterid.validate(exp, jitterid.read_record(data), validation=jitterid.read_record(check), level=0.01)
     d = got.to_dict()
     # The records are named by their files on the command line and by their arguments here.
@@ -98,7 +98,7 @@ def test_validate_of_a_given_fit_equals_validate_model(cli, small, tmp_path):
     exp = jitterid.Experiment.from_toml(path)
     fit_file = tmp_path / "fit.json"
     fit_file.write_text(cli("fit", path, "--data", data, "--json"))
-    expected = cli("validate", path, "--data", data, "--model", fit_file, parse_json=True)
+    expected = cli("validate", path, "--data", data, "--model", fit_file, "--json", parse_json=True)
     record = jitterid.read_record(data)
     got = jitterid.validate(exp, record, fit=exp.fit(record)).to_dict()
     got["estimation"].pop("record"), expected["estimation"].pop("record")

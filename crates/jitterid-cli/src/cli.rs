@@ -8,12 +8,12 @@ use crate::commands::{self, FitRequest, MonteCarloOptions, SimulateOptions};
 use crate::exit::{Outcome, BAD_INPUT};
 use clap::{Args, Parser, Subcommand};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{Method, Paths};
+use jitterid_study::experiment::{Method, Override, Paths, ReadOptions};
 use jitterid_study::montecarlo::{Shard, DEFAULT_SEED};
 use jitterid_study::select::InitChoice;
 use std::ffi::OsString;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// System identification from jittered samples: simulate, fit and Monte Carlo studies of
@@ -66,7 +66,7 @@ pub struct ValidateArgs {
     /// The model to validate, as written by `jitterid fit --json` [default: fit it here].
     #[arg(long, value_name = "FIT.json")]
     pub model: Option<PathBuf>,
-    /// Print JSON (the only output format of validate; accepted for symmetry with fit).
+    /// Print JSON instead of the table (the --out file is JSON either way).
     #[arg(long)]
     pub json: bool,
     /// Write the frequency response with ±2σ bands as CSV to this file.
@@ -80,7 +80,7 @@ pub struct ValidateArgs {
     pub plot: Option<PathBuf>,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub paths: PathArgs,
+    pub experiment_args: ExperimentArgs,
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -108,26 +108,40 @@ pub struct SimulateArgs {
     pub truth: bool,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub paths: PathArgs,
+    pub experiment_args: ExperimentArgs,
 }
 
-/// Where the files an experiment file names may be: shared by every subcommand that reads an
-/// experiment file.
+/// How the experiment file is read: shared by every subcommand that reads one.
 #[derive(Debug, Args)]
-pub struct PathArgs {
+pub struct ExperimentArgs {
     /// Let the experiment file name files outside its own directory (absolute paths, `..`,
     /// symbolic links leading out); by default such a path is refused before it is read.
     #[arg(long)]
     pub allow_paths_outside: bool,
+    /// Override one key of the experiment file (repeatable): a dotted path and a TOML value,
+    /// e.g. `--set jitter.family=gaussian --set jitter.sigma=0.1`, `--set system.den=[1,2,5]`,
+    /// `--set jitter.terms.1.d=0.05`; checked as if written in the file.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
 }
 
-impl PathArgs {
-    fn paths(&self) -> Paths {
-        if self.allow_paths_outside {
-            Paths::Anywhere
-        } else {
-            Paths::Inside
-        }
+impl ExperimentArgs {
+    /// How to read the experiment: for a record in `data`, whose `t` column gives the
+    /// `[sampling]` keys the file leaves out.
+    fn read_options(&self, data: Option<&Path>) -> StudyResult<ReadOptions> {
+        Ok(ReadOptions {
+            paths: if self.allow_paths_outside {
+                Paths::Anywhere
+            } else {
+                Paths::Inside
+            },
+            overrides: self
+                .set
+                .iter()
+                .map(|a| Override::parse(a))
+                .collect::<StudyResult<_>>()?,
+            data: data.map(Path::to_path_buf),
+        })
     }
 }
 
@@ -152,9 +166,11 @@ pub struct BudgetArgs {
 pub struct FitArgs {
     /// The experiment file (TOML); its values are the starting point.
     pub experiment: PathBuf,
-    /// The data file (CSV with a column `y`; optional `k`, `t` are checked).
-    #[arg(long)]
-    pub data: PathBuf,
+    /// The data file (CSV with a column `y`; optional `k`, `t` are checked). Repeat it to fit
+    /// several records of one system jointly (each with its own input side file, length and
+    /// start; a first-moment method).
+    #[arg(long, required = true)]
+    pub data: Vec<PathBuf>,
     /// The input realisation (CSV with columns t,u) for a random-binary experiment
     /// [default: <data stem>.input.csv].
     #[arg(long)]
@@ -179,7 +195,7 @@ pub struct FitArgs {
     pub budget: BudgetArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub paths: PathArgs,
+    pub experiment_args: ExperimentArgs,
 }
 
 /// Arguments of `montecarlo`.
@@ -221,7 +237,7 @@ pub struct MonteCarloArgs {
     pub budget: BudgetArgs,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub paths: PathArgs,
+    pub experiment_args: ExperimentArgs,
 }
 
 /// Arguments of `select`.
@@ -247,7 +263,7 @@ pub struct SelectArgs {
     pub time_limit: Option<f64>,
     #[command(flatten)]
     #[allow(missing_docs)]
-    pub paths: PathArgs,
+    pub experiment_args: ExperimentArgs,
 }
 
 /// Arguments of `merge`.
@@ -273,8 +289,8 @@ pub struct MergeArgs {
 fn dispatch(cli: Cli) -> StudyResult<Outcome> {
     match cli.command {
         Command::Simulate(a) => commands::simulate(&SimulateOptions {
+            read: a.experiment_args.read_options(None)?,
             experiment: a.experiment,
-            paths: a.paths.paths(),
             seed: a.seed,
             run: a.run,
             out: a.out,
@@ -282,8 +298,10 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
         })
         .map(|s| Outcome::success(s + "\n")),
         Command::Fit(a) => commands::fit(&FitRequest {
+            read: a
+                .experiment_args
+                .read_options(a.data.first().map(PathBuf::as_path))?,
             experiment: a.experiment,
-            paths: a.paths.paths(),
             data: a.data,
             input: a.input,
             method: a.method,
@@ -295,8 +313,8 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             time_limit: a.budget.time_limit,
         }),
         Command::Montecarlo(a) => commands::montecarlo(&MonteCarloOptions {
+            read: a.experiment_args.read_options(None)?,
             experiment: a.experiment,
-            paths: a.paths.paths(),
             runs: a.runs,
             seed: a.seed,
             threads: a.threads,
@@ -311,8 +329,8 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             timing: !a.no_timing,
         }),
         Command::Validate(a) => commands::validate(&commands::ValidateOptions {
+            read: a.experiment_args.read_options(Some(&a.data))?,
             experiment: a.experiment,
-            paths: a.paths.paths(),
             data: a.data,
             input: a.input,
             level: a.level,
@@ -321,10 +339,11 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             bode: a.bode,
             out: a.out,
             plot: a.plot,
+            json: a.json,
         }),
         Command::Select(a) => commands::select(&commands::SelectOptions {
+            read: a.experiment_args.read_options(Some(&a.data))?,
             experiment: a.experiment,
-            paths: a.paths.paths(),
             data: a.data,
             validation: a.validation,
             json: a.json,

@@ -397,7 +397,23 @@ fn validate_input_file_level_and_portmanteau_fields() {
     let o = run(&["validate", &exp, "--data", s(&data)]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("d.input.csv"), "{}", stderr(&o));
-    let o = run(&["validate", &exp, "--data", s(&data), "--input", s(&moved)]);
+    // With the input file given, at the default level and at a chosen one.
+    let at_level = |level: Option<&str>| {
+        let mut args = vec![
+            "validate",
+            exp.as_str(),
+            "--data",
+            s(&data),
+            "--input",
+            s(&moved),
+            "--json",
+        ];
+        if let Some(l) = level {
+            args.extend(["--level", l]);
+        }
+        run(&args)
+    };
+    let o = at_level(None);
     assert!(o.status.success(), "{}", stderr(&o));
     let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(j["level"], 0.01);
@@ -414,24 +430,12 @@ fn validate_input_file_level_and_portmanteau_fields() {
     assert_eq!(w["dof"], 25);
     assert!(w["statistic"].as_f64().unwrap() > 0.0);
     // The verdict is the p-value against the level: a level below the p-value passes.
-    let at_level = |level: &str| {
-        run(&[
-            "validate",
-            &exp,
-            "--data",
-            s(&data),
-            "--input",
-            s(&moved),
-            "--level",
-            level,
-        ])
-    };
-    let o = at_level(&format!("{:e}", p / 2.0));
+    let o = at_level(Some(&format!("{:e}", p / 2.0)));
     assert!(o.status.success(), "{}", stderr(&o));
     let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(j["cross_correlation"]["passed"], true, "{j}");
     for bad in ["0", "1", "1.5", "-0.2", "NaN"] {
-        let o = at_level(bad);
+        let o = at_level(Some(bad));
         assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
         let e = stderr(&o);
         assert!(e.contains("--level") && e.contains(bad), "{bad}: {e}");

@@ -204,6 +204,7 @@ fn validate_passes_on_both_records() {
         s(&val),
         "--model",
         s(&model),
+        "--json",
     ]);
     for record in ["estimation", "validation"] {
         let r = &v[record];

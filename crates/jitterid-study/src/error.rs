@@ -36,6 +36,9 @@ pub enum StudyErrorKind {
     /// A path written in an experiment file leads outside the experiment's directory and the
     /// caller did not allow that ([`crate::experiment::Paths`]).
     PathOutside,
+    /// The instants of a data file's `t` column, read for an experiment's `[sampling]`, are not
+    /// a uniform grid `t0 + kT` (the message names the row that breaks it).
+    NotUniformGrid,
 }
 
 /// An error reported to the user as one line (`error: …` on the command line's stderr).

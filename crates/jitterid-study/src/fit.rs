@@ -151,7 +151,8 @@ pub fn param_names(
     Ok(report_names(exp, &s))
 }
 
-fn profiled(exp: &Experiment) -> bool {
+/// Whether the experiment profiles the uniform-sum order over `[jitter] n_range`.
+pub(crate) fn profiled(exp: &Experiment) -> bool {
     exp.jitter.estimate && exp.jitter.n_range.is_some()
 }
 
@@ -229,7 +230,7 @@ pub fn truth_values(
 /// solver on its frequency set. A likelihood runs the likelihood's default solver (Brent's
 /// method for one parameter, BFGS otherwise), with the wall-clock budget given to BFGS
 /// (Brent's method is bounded by its iteration limit).
-fn options(
+pub(crate) fn options(
     exp: &Experiment,
     criterion: &AnyCriterion,
     seed: u64,
@@ -256,7 +257,7 @@ fn options(
 /// The criterion `method` names, as the experiment fits it: `"ml"`, the exact likelihood of
 /// white noise, is the Gaussian (quasi) likelihood of the first two moments for an ARMA noise
 /// model.
-fn criterion_of(exp: &Experiment, s: &Structure, method: Method) -> AnyCriterion {
+pub(crate) fn criterion_of(exp: &Experiment, s: &Structure, method: Method) -> AnyCriterion {
     let criterion = method.criterion_in(&exp.registries.criteria);
     if method.as_str() == "ml" && !s.noise.is_white() {
         AnyCriterion::quasi_ml()
@@ -266,7 +267,7 @@ fn criterion_of(exp: &Experiment, s: &Structure, method: Method) -> AnyCriterion
 }
 
 /// `j`, a uniform sum, with its whole number `n` replaced (rebuilt through the registry).
-fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
+pub(crate) fn with_n(j: &AnyJitter, n: u32) -> Result<AnyJitter, JitterError> {
     let mut spec = j.spec();
     spec.insert("n".into(), n.into());
     JitterRegistry::builtin().build(&spec)
@@ -331,7 +332,7 @@ fn fitted_structure(
 }
 
 /// The raw outcome of one estimator, before the parameters are arranged for the report.
-struct Raw {
+pub(crate) struct Raw {
     /// The structure's free parameters, then `σ_v` when a likelihood estimated it.
     params: Vec<f64>,
     std_errors: Option<Vec<f64>>,
@@ -348,7 +349,7 @@ struct Raw {
 
 impl Raw {
     /// The outcome of an estimator with the structure it fitted and the profiled `n`, if any.
-    fn of(e: Estimate, fitted: Structure, n: Option<u32>) -> Self {
+    pub(crate) fn of(e: Estimate, fitted: Structure, n: Option<u32>) -> Self {
         Raw {
             params: e.params,
             std_errors: e.std_errors,
@@ -433,7 +434,18 @@ fn fit_once(call: &FitCall<'_>, s: &Structure) -> Result<Fit, String> {
             Some(stop) => format!("stopped before the search could begin: {stop}"),
             None => e.to_string(),
         })?;
-    let e = Raw::of(e, fitted, n);
+    reported(exp, s, method, Raw::of(e, fitted, n))
+}
+
+/// The fit of `s` with `method` as reported: the estimator's outcome `e` with the reported
+/// parameters (a profiled order and its derived `σ`, a noise level estimated after the fit)
+/// and their covariance.
+pub(crate) fn reported(
+    exp: &Experiment,
+    s: &Structure,
+    method: Method,
+    e: Raw,
+) -> Result<Fit, String> {
     let names = report_names(exp, s);
     let se = |i: usize| {
         e.std_errors
@@ -535,6 +547,9 @@ pub struct FitJson<'a> {
     /// that is not rational): an export never goes missing without a word.
     #[serde(skip_serializing_if = "Option::is_none")]
     model_error: Option<String>,
+    /// What the record suggests the model misses ([`crate::notes`]); absent without a note.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    notes: Vec<String>,
 }
 
 /// Fits the experiment's model with its method to the samples `y` of a record whose input
@@ -571,6 +586,14 @@ pub fn fit_record(
     })
 }
 
+/// The JSON of `jitterid fit --json`, with the notes of the fit's record.
+pub fn fit_json_noted<'a>(f: &'a Fit, notes: &crate::notes::Notes) -> FitJson<'a> {
+    FitJson {
+        notes: notes.lines(),
+        ..fit_json(f)
+    }
+}
+
 /// The JSON of `jitterid fit --json`.
 pub fn fit_json(f: &Fit) -> FitJson<'_> {
     let (model, model_error) = match export::model_forms(&f.fitted.signal) {
@@ -591,5 +614,6 @@ pub fn fit_json(f: &Fit) -> FitJson<'_> {
         covariance: f.covariance.as_deref(),
         model,
         model_error,
+        notes: Vec::new(),
     }
 }

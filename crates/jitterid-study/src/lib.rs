@@ -11,6 +11,10 @@
 //! - [`fit`]: the fit an experiment asks for — the model structure, the solver, profiling an
 //!   integer jitter parameter, the jitter floor of a Box–Jenkins noise model, the likelihood
 //!   branch — and the parameters as reported (names, estimates, standard errors, covariance).
+//! - [`joint`]: joint fits of several records of one system, each with its own input and
+//!   length.
+//! - [`notes`]: a fit's status line and what the record suggests the model misses (an input
+//!   recorded on the sampling clock, an output offset).
 //! - [`simulate`]: records of an experiment's truth, realisation by realisation.
 //! - [`montecarlo`]: studies of many realisations, bit-identical across thread counts and
 //!   shards; [`merge`] combines shards, which carry the experiment's [`fingerprint`].
@@ -29,9 +33,11 @@ pub mod export;
 pub mod fingerprint;
 pub mod fit;
 pub mod inputs;
+pub mod joint;
 pub mod likelihood_start;
 pub mod merge;
 pub mod montecarlo;
+pub mod notes;
 pub mod records;
 mod registries;
 pub mod residual_tests;

@@ -3,7 +3,7 @@
 
 use crate::csvio;
 use crate::error::StudyResult;
-use crate::experiment::{self, Experiment, InputSpec, Paths, Purpose};
+use crate::experiment::{self, Experiment, InputSpec, Purpose, ReadOptions};
 use crate::inputs;
 use crate::study_err;
 use jitterid::signal::{Input, SampleGrid};
@@ -104,16 +104,16 @@ fn read_data_columns(exp: &Experiment, path: &Path, keep_tau: bool) -> StudyResu
     Ok(DataFile { name, y, tau })
 }
 
-/// The experiment of `path` with the command line's iteration and wall-clock budgets, where
-/// given; `paths` says where the files it names may be.
+/// The experiment of `path`, edited and read as `options` says, with the command line's
+/// iteration and wall-clock budgets, where given.
 pub fn read_experiment(
     path: &Path,
     purpose: Purpose,
-    paths: Paths,
+    options: &ReadOptions,
     max_iterations: Option<u64>,
     time_limit: Option<f64>,
 ) -> StudyResult<Experiment> {
-    let mut exp = experiment::read_with(path, purpose, paths)?;
+    let mut exp = experiment::read_edited(path, purpose, options)?;
     if let Some(t) = time_limit {
         if !(t.is_finite() && t >= 0.0) {
             return Err(study_err!(

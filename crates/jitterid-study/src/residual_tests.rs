@@ -63,7 +63,7 @@ fn scaler<'a>(
 /// (the system's and the jitter's; the noise model's do not), by central differences, one
 /// side where the other leaves the parameters' domain. A parameter whose expected samples
 /// cannot be evaluated on either side is left out: nothing is removed for it.
-fn mean_gradients(s: &Structure, grid: &SampleGrid, y: &[f64]) -> Vec<Vec<f64>> {
+pub(crate) fn mean_gradients(s: &Structure, grid: &SampleGrid, y: &[f64]) -> Vec<Vec<f64>> {
     let theta = s.params();
     let (ns, nj, _) = s.blocks();
     let mean_at = |j: usize, h: f64| -> Option<Vec<f64>> {

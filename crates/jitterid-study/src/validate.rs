@@ -83,22 +83,15 @@ struct FitParam {
 type Model = (Structure, f64, Option<Vec<Vec<f64>>>);
 
 /// The fitted model in `text`, the JSON of `jitterid fit --json` (`name` names it in
-/// messages, `what` the option or argument that gave it), checked against the experiment's
-/// structure `s`.
+/// messages), checked against the experiment's structure `s`.
 fn model_from_json(
     exp: &Experiment,
-    s: Structure,
+    mut s: Structure,
     text: &str,
     name: &str,
-    what: &str,
 ) -> StudyResult<Model> {
     let f: FitFile = serde_json::from_str(text)
         .map_err(|e| study_err!("{name}: not the JSON of `jitterid fit --json`: {e}"))?;
-    if exp.jitter.estimate && exp.jitter.n_range.is_some() {
-        return Err(study_err!(
-            "{name}: {what}: a profiled jitter (`[jitter] n_range`) is not supported; validate without {what}"
-        ));
-    }
     let want = fit::param_names(exp, &s.signal, exp.estimate.method)?;
     let got: Vec<&str> = f.parameters.iter().map(|p| p.name.as_str()).collect();
     if want != got {
@@ -134,8 +127,30 @@ fn model_from_json(
             p.name
         ));
     }
-    let theta: Vec<f64> = f.parameters[..s.num_params()]
+    // A profiled uniform sum reports its order `jitter.n` and the derived `jitter.sigma` beside
+    // its parameter `a`: the order chooses the family member, the derived value is not a
+    // parameter of the structure.
+    let profiled = fit::profiled(exp) && s.estimate_jitter;
+    if profiled {
+        let n = f
+            .parameters
+            .iter()
+            .find(|p| p.name == "jitter.n")
+            .map(|p| p.estimate)
+            .filter(|n| *n >= 0.0 && n.fract() == 0.0 && *n <= f64::from(u32::MAX))
+            .ok_or_else(|| {
+                study_err!(
+                    "{name}: parameter jitter.n: expected the profiled order, a whole number >= 0"
+                )
+            })?;
+        s.jitter = fit::with_n(&s.jitter, n as u32)
+            .map_err(|e| study_err!("{name}: parameter jitter.n: {e}"))?;
+    }
+    let theta: Vec<f64> = f
+        .parameters
         .iter()
+        .filter(|p| !(profiled && (p.name == "jitter.n" || p.name == "jitter.sigma")))
+        .take(s.num_params())
         .map(|p| p.estimate)
         .collect();
     let ns = s.blocks().0;
@@ -487,8 +502,6 @@ pub struct FitText<'a> {
     pub text: &'a str,
     /// What holds it (a file's name), for messages.
     pub name: &'a str,
-    /// The option or argument that gave it, for messages.
-    pub what: &'a str,
 }
 
 /// Validates the experiment's model on the record in `data` and, when given, on the record in
@@ -529,11 +542,7 @@ pub fn validate(
         }
         None => None,
     };
-    let model = text.as_ref().map(|(name, text)| FitText {
-        text,
-        name,
-        what: "--model",
-    });
+    let model = text.as_ref().map(|(name, text)| FitText { text, name });
     validate_records(exp, estimation, validation, model, level, watch)
 }
 
@@ -554,7 +563,7 @@ pub fn validate_records(
     let (fitted, noise_std, covariance) = match model {
         Some(m) => {
             let s = fit::structure(exp, signal, exp.estimate.method)?;
-            model_from_json(exp, s, m.text, m.name, m.what)?
+            model_from_json(exp, s, m.text, m.name)?
         }
         None => {
             let f = fit::fit_values(exp, signal, y.clone(), &name, watch)?;

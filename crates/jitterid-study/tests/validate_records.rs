@@ -107,7 +107,6 @@ fn a_model_given_as_fit_json_validates_as_its_file_does() {
     let given = FitText {
         text: &text,
         name: "fit",
-        what: "fit",
     };
     let from_text =
         validate_records(&exp, record, None, Some(given), 0.01, &Watch::none()).unwrap();

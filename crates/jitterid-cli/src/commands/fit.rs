@@ -9,9 +9,11 @@ use crate::progress::Ticker;
 use jitterid::estimate::Record;
 use jitterid::signal::{AnySignal, Input};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{Experiment, Method, Paths, Purpose};
+use jitterid_study::experiment::{Experiment, Method, Purpose, ReadOptions};
 use jitterid_study::export;
-use jitterid_study::fit::{self, fit_json, fit_record, Fit};
+use jitterid_study::fit::{self, fit_json_noted, fit_record, Fit};
+use jitterid_study::joint::{fit_joint, read_records};
+use jitterid_study::notes::{status, Notes};
 use jitterid_study::records::{read_data, read_data_and_tau, read_experiment, read_input};
 use jitterid_study::select::{auto_start, InitChoice};
 use jitterid_study::study_err;
@@ -25,10 +27,11 @@ use std::path::{Path, PathBuf};
 pub struct FitRequest {
     /// The experiment file.
     pub experiment: PathBuf,
-    /// Where the files the experiment file names may be (`--allow-paths-outside`).
-    pub paths: Paths,
-    /// The data file.
-    pub data: PathBuf,
+    /// How the experiment file is read (`--allow-paths-outside`, `--set`, the `[sampling]`
+    /// keys a data file gives).
+    pub read: ReadOptions,
+    /// The data files: one record, or several fitted jointly.
+    pub data: Vec<PathBuf>,
     /// The input file (for a random-binary experiment), default `<data>.input.csv`.
     pub input: Option<PathBuf>,
     /// Method override.
@@ -53,22 +56,26 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let mut exp = read_experiment(
         &o.experiment,
         Purpose::Estimate(o.method),
-        o.paths,
+        &o.read,
         o.max_iterations,
         o.time_limit,
     )?;
     exp.estimate.likelihood_start = o.init.likelihood_start();
     let method = exp.estimate.method;
+    let data_file = match o.data.as_slice() {
+        [one] => one,
+        several => return fit_several(o, &exp, several),
+    };
     // The jitter column is kept only for the figures that draw it.
     let data = if o.plot.is_some() {
-        read_data_and_tau(&exp, &o.data)?
+        read_data_and_tau(&exp, data_file)?
     } else {
-        read_data(&exp, &o.data)?
+        read_data(&exp, data_file)?
     };
     let (name, tau) = (data.name, data.tau);
     // The one copy of the samples: the fit, the start and the figures share it.
     let record = fit::record(&exp.grid, data.y).map_err(|e| study_err!("{name}: {e}"))?;
-    let input = read_input(&exp, &o.data, o.input.as_deref())?;
+    let input = read_input(&exp, data_file, o.input.as_deref())?;
     let mut signal = fit::signal_of(&exp, input.as_ref())?;
     if o.init == InitChoice::Auto {
         signal = auto_start(&exp, &signal, input.as_ref(), record.y(), &name)?;
@@ -80,8 +87,8 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     };
     let f = fit_record(&exp, signal.clone(), &record, &watch)?;
     drop(ticker);
+    let notes = Notes::of(&f, &exp.grid, record.y(), input.as_ref());
 
-    let status = Status::of_convergence(f.converged, o.accept_unconverged);
     if let Some(dir) = &o.plot {
         let data = Samples {
             record: &record,
@@ -90,16 +97,58 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
         write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &data)?;
     }
 
-    if o.json {
-        return serde_json::to_string_pretty(&fit_json(&f))
-            .map(|text| Outcome {
-                text: text + "\n",
-                status,
-            })
-            .map_err(|e| study_err!("JSON: {e}"));
+    report(o, &exp, &f, &notes, &name)
+}
+
+/// The report of a fit, as JSON or as the table, with the exit status of its convergence.
+fn report(
+    o: &FitRequest,
+    exp: &Experiment,
+    f: &Fit,
+    notes: &Notes,
+    name: &str,
+) -> StudyResult<Outcome> {
+    let status = Status::of_convergence(f.converged, o.accept_unconverged);
+    let text = if o.json {
+        serde_json::to_string_pretty(&fit_json_noted(f, notes))
+            .map_err(|e| study_err!("JSON: {e}"))?
+            + "\n"
+    } else {
+        fit_text(exp, f, notes, name, o.plot.as_deref())
+    };
+    Ok(Outcome { text, status })
+}
+
+/// `jitterid fit` of several records at once (`--data` repeated): the joint fit of the study
+/// layer, printed as for one record.
+fn fit_several(o: &FitRequest, exp: &Experiment, data: &[PathBuf]) -> StudyResult<Outcome> {
+    // What belongs to one record: its figures, its input file, its data-driven start.
+    for (given, flag) in [
+        (o.plot.is_some(), "--plot"),
+        (o.input.is_some(), "--input"),
+        (o.init == InitChoice::Auto, "--init auto"),
+    ] {
+        if given {
+            return Err(study_err!(
+                "{flag}: not with several --data files (it belongs to one record; each record's input is its side file or the experiment's)"
+            ));
+        }
     }
-    let out = fit_text(&exp, &f, &name, o.plot.as_deref());
-    Ok(Outcome { text: out, status })
+    let paths: Vec<&Path> = data.iter().map(PathBuf::as_path).collect();
+    let records = read_records(exp, &paths)?;
+    let ticker = Ticker::start(&format!(
+        "fitting {} records with {}",
+        records.len(),
+        exp.estimate.method.as_str()
+    ));
+    let watch = Watch {
+        iterations: crate::progress::active_fit_hook(),
+        ..Watch::none()
+    };
+    let f = fit_joint(exp, &records, &watch)?;
+    drop(ticker);
+    let names: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
+    report(o, exp, &f, &Notes::default(), &names.join(" + "))
 }
 
 /// The samples of the fitted file, as the figures draw them.
@@ -182,7 +231,7 @@ fn write_fit_figures(
 }
 
 /// The human-readable report of `fit`.
-fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> String {
+fn fit_text(exp: &Experiment, f: &Fit, notes: &Notes, name: &str, plot: Option<&Path>) -> String {
     let method = exp.estimate.method;
     let mut out = String::new();
     let _ = writeln!(
@@ -194,13 +243,8 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
     );
     let _ = writeln!(
         out,
-        "{} ({}) after {} iterations, cost {:.6e}, noise std {} ({})",
-        if f.converged {
-            "converged"
-        } else {
-            "NOT converged"
-        },
-        f.termination,
+        "{} after {} iterations, cost {:.6e}, noise std {} ({})",
+        status(f),
         f.iterations,
         f.cost,
         fmt_num(f.noise_std),
@@ -210,6 +254,9 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
             "known"
         }
     );
+    if let Some(cause) = notes.likely_cause(f) {
+        let _ = writeln!(out, "{cause}");
+    }
     let w = name_width(f.params.iter().map(|p| p.name.as_str()));
     let _ = writeln!(
         out,
@@ -236,6 +283,9 @@ fn fit_text(exp: &Experiment, f: &Fit, name: &str, plot: Option<&Path>) -> Strin
             "model: G(s) e^(-sD) with input delay D = {} s (the parameter delay; --json: model.zpk, model.tf, model.ss give G, model.delay gives D)",
             fmt_num(d)
         );
+    }
+    for line in notes.lines() {
+        let _ = writeln!(out, "{line}");
     }
     if let Some(dir) = plot {
         let _ = writeln!(

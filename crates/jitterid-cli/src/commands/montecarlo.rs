@@ -7,7 +7,7 @@ use crate::output::OutputSet;
 use crate::plots;
 use crate::progress::Progress;
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{Method, Paths, Purpose};
+use jitterid_study::experiment::{Method, Purpose, ReadOptions};
 use jitterid_study::fit::Structure;
 use jitterid_study::montecarlo::{run_study, Keep, McJson, Shard};
 use jitterid_study::records::read_experiment;
@@ -22,8 +22,9 @@ use std::sync::{Arc, OnceLock};
 pub struct MonteCarloOptions {
     /// The experiment file.
     pub experiment: PathBuf,
-    /// Where the files the experiment file names may be (`--allow-paths-outside`).
-    pub paths: Paths,
+    /// How the experiment file is read (`--allow-paths-outside`, `--set`, the `[sampling]`
+    /// keys a data file gives).
+    pub read: ReadOptions,
     /// Total number of realisations.
     pub runs: u64,
     /// Master seed.
@@ -104,7 +105,7 @@ pub fn montecarlo(o: &MonteCarloOptions) -> StudyResult<Outcome> {
     let exp = read_experiment(
         &o.experiment,
         Purpose::Estimate(o.method),
-        o.paths,
+        &o.read,
         o.max_iterations,
         o.time_limit,
     )?;

@@ -9,9 +9,9 @@
 use crate::exit::{Outcome, Status};
 use crate::output::OutputSet;
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{Paths, Purpose};
+use jitterid_study::experiment::{Purpose, ReadOptions};
 use jitterid_study::records::read_experiment;
-use jitterid_study::select::{ranked_by, select as run_selection};
+use jitterid_study::select::select as run_selection;
 use jitterid_study::study_err;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -21,8 +21,9 @@ use std::path::PathBuf;
 pub struct SelectOptions {
     /// The experiment file (its `[sampling]`, `[input]` and `[select]` are used).
     pub experiment: PathBuf,
-    /// Where the files the experiment file names may be (`--allow-paths-outside`).
-    pub paths: Paths,
+    /// How the experiment file is read (`--allow-paths-outside`, `--set`, the `[sampling]`
+    /// keys a data file gives).
+    pub read: ReadOptions,
     /// The estimation record.
     pub data: PathBuf,
     /// An optional validation record (same experiment grid; input from its side file).
@@ -41,7 +42,7 @@ pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
     let exp = read_experiment(
         &o.experiment,
         Purpose::Simulate,
-        o.paths,
+        &o.read,
         None,
         o.time_limit,
     )?;
@@ -63,21 +64,32 @@ pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
         return Ok(Outcome { text, status });
     }
     let mut out = format!("selection on {} ({})\n", selection.data, exp.file);
+    // The two criteria are on different scales, so each has its column: the screen's BCLS BIC
+    // (every candidate) and the final exact likelihood's BIC (the finalists, which rank first).
     let _ = writeln!(
         out,
-        "{:>5}  {:>5}  {:<14}  {:>14}  {:<12}  {:>14}  {:>9}  {:>14}",
-        "poles", "zeros", "family", "BIC", "ranked by", "BCLS BIC", "converged", "validation fit"
+        "{:>5}  {:>5}  {:<14}  {:>16}  {:>16}  {:>9}  {:>14}",
+        "poles",
+        "zeros",
+        "family",
+        "screen BCLS BIC",
+        "final ML BIC",
+        "converged",
+        "validation fit"
     );
     for (c, f) in ranked.iter().zip(fits) {
+        let final_bic = c
+            .likelihood_criterion
+            .filter(|_| c.ranked_by_likelihood)
+            .map_or("–".into(), |b| format!("{b:.4}"));
         let _ = writeln!(
             out,
-            "{:>5}  {:>5}  {:<14}  {:>14.4}  {:<12}  {:>14.4}  {:>9}  {:>14}",
+            "{:>5}  {:>5}  {:<14}  {:>16.4}  {:>16}  {:>9}  {:>14}",
             c.poles,
             c.zeros,
             c.family,
-            c.criterion,
-            ranked_by(c),
             c.bcls_criterion,
+            final_bic,
             if c.converged { "yes" } else { "no" },
             f.map_or("–".into(), |v| format!("{v:.2} %"))
         );

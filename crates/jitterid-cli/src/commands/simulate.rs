@@ -5,7 +5,7 @@ use crate::output::{self, OutputSet};
 use jitterid::signal::Input;
 use jitterid_study::csvio::{self, Column};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{self, InputSpec, Paths, Purpose};
+use jitterid_study::experiment::{self, InputSpec, Purpose, ReadOptions};
 use jitterid_study::records::input_side_file;
 use jitterid_study::simulate::{simulate_data, SimulatedData};
 use std::fmt::Write as _;
@@ -16,8 +16,9 @@ use std::path::PathBuf;
 pub struct SimulateOptions {
     /// The experiment file.
     pub experiment: PathBuf,
-    /// Where the files the experiment file names may be (`--allow-paths-outside`).
-    pub paths: Paths,
+    /// How the experiment file is read (`--allow-paths-outside`, `--set`, the `[sampling]`
+    /// keys a data file gives).
+    pub read: ReadOptions,
     /// Master seed.
     pub seed: u64,
     /// Realisation index (the same record as Monte Carlo run `run`).
@@ -30,7 +31,7 @@ pub struct SimulateOptions {
 
 /// `jitterid simulate`: one record of the experiment's truth. Returns the report line.
 pub fn simulate(o: &SimulateOptions) -> StudyResult<String> {
-    let exp = experiment::read_with(&o.experiment, Purpose::Simulate, o.paths)?;
+    let exp = experiment::read_edited(&o.experiment, Purpose::Simulate, &o.read)?;
     let SimulatedData {
         t,
         y,

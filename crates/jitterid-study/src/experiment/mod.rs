@@ -14,6 +14,7 @@ mod input;
 mod jitter;
 mod method;
 mod noise;
+mod overrides;
 mod paths;
 pub mod range;
 mod raw;
@@ -23,6 +24,7 @@ mod spec;
 mod system;
 
 pub use input::MAX_SWITCHES;
+pub use overrides::Override;
 pub use paths::Paths;
 pub use sampling::MAX_SAMPLES;
 pub use spec::{
@@ -59,16 +61,74 @@ pub fn read(path: &Path, purpose: Purpose) -> StudyResult<Experiment> {
 /// Reads and validates an experiment file for `purpose`; `paths` says where the files it names
 /// may be (see [`Paths`]).
 pub fn read_with(path: &Path, purpose: Purpose, paths: Paths) -> StudyResult<Experiment> {
+    read_edited(
+        path,
+        purpose,
+        &ReadOptions {
+            paths,
+            ..ReadOptions::default()
+        },
+    )
+}
+
+/// How an experiment file is read: where the files it names may be, the edits of its document
+/// (the command line's `--set key=value`), and the data file whose `t` column and row count
+/// give the `[sampling]` keys the document lacks.
+#[derive(Debug, Clone, Default)]
+pub struct ReadOptions {
+    /// Where the files the experiment names may be.
+    pub paths: Paths,
+    /// Edits of the document, applied in order before it is read.
+    pub overrides: Vec<Override>,
+    /// The record the experiment is read for: `[sampling] samples`, `start` and `interval`,
+    /// when the document does not give them, are its row count, its first instant and the
+    /// step of its uniform `t` column.
+    pub data: Option<PathBuf>,
+}
+
+/// Reads and validates the experiment file at `path` for `purpose`, edited as `options` says
+/// before it is read (see [`parse_edited`]).
+pub fn read_edited(
+    path: &Path,
+    purpose: Purpose,
+    options: &ReadOptions,
+) -> StudyResult<Experiment> {
     let file = path.display().to_string();
     let text = read_text(path)?;
-    parse_with(
+    parse_edited(
         &Registries::builtin(),
         &file,
         &text,
         &directory_of(path),
         purpose,
-        paths,
+        options,
     )
+}
+
+/// [`parse_with`] of `text` after the edits of `options`: the edited document is validated as a
+/// file would be, and messages locate a key in the file as written, or name the edit that
+/// wrote it (`exp.toml (--set jitter.sigma=-1): [jitter] sigma: …`).
+pub fn parse_edited(
+    registries: &Arc<Registries>,
+    file: &str,
+    text: &str,
+    dir: &Path,
+    purpose: Purpose,
+    options: &ReadOptions,
+) -> StudyResult<Experiment> {
+    let read = |text: &str| parse_with(registries, file, text, dir, purpose, options.paths);
+    if options.overrides.is_empty() && options.data.is_none() {
+        return read(text);
+    }
+    match overrides::apply(text, &options.overrides, options.data.as_deref())? {
+        Some(edited) => read(&edited.text).map_err(|e| edited.relocate(file, e)),
+        // Not a TOML document: read unedited, it is reported as any such file is.
+        None => read(text).and_then(|_| {
+            Err(study_err!(
+                "{file}: the document cannot be edited (it is read as TOML, but not by the editor)"
+            ))
+        }),
+    }
 }
 
 /// The text of the experiment file at `path`, read as every front end reads it: only a regular
