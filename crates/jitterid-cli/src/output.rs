@@ -117,6 +117,8 @@ fn dir_of(path: &Path) -> &Path {
 pub struct OutputSet {
     files: Vec<(PathBuf, Vec<u8>)>,
     dirs: Vec<PathBuf>,
+    /// Figures of an earlier run that this set does not redraw, removed once it is written.
+    stale: Vec<PathBuf>,
 }
 
 impl OutputSet {
@@ -136,8 +138,16 @@ impl OutputSet {
     }
 
     /// Adds the figures `figures` (file name, SVG) in the directory `dir`, created if needed.
-    pub fn figures(&mut self, dir: &Path, figures: Vec<(String, String)>) {
+    /// Of the names a command may draw (`may_draw`), those it did not draw this time are
+    /// removed from `dir` once the set is written (a figure of an earlier run whose model had
+    /// it, such as a Bode diagram, would otherwise stand beside this run's as if it were one).
+    pub fn figures(&mut self, dir: &Path, figures: Vec<(String, String)>, may_draw: &[&str]) {
         self.dir(dir);
+        for name in may_draw {
+            if !figures.iter().any(|(n, _)| n == name) {
+                self.stale.push(dir.join(name));
+            }
+        }
         for (name, svg) in figures {
             self.file(&dir.join(name), svg);
         }
@@ -170,13 +180,29 @@ impl OutputSet {
             targets.push(target);
         }
         let created = create_dirs(&self.dirs)?;
-        let result = lock_and_clean(&targets).and_then(|_locks| write_all(&self.files, &targets));
+        let result = lock_and_clean(&targets).and_then(|_locks| {
+            write_all(&self.files, &targets)?;
+            remove_stale(&self.stale);
+            Ok(())
+        });
         if result.is_err() {
             for d in created.iter().rev() {
                 let _ = std::fs::remove_dir(d);
             }
         }
         result
+    }
+}
+
+/// Removes the regular files among `paths` (a link or anything else there is left alone: only
+/// a figure this program wrote is taken), with the set's directories still locked. Best
+/// effort: the set is written whole by then, and an error here (the file removed meanwhile by
+/// someone else) must not report a written set as failed.
+fn remove_stale(paths: &[PathBuf]) {
+    for p in paths {
+        if std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_file()) {
+            let _ = std::fs::remove_file(p);
+        }
     }
 }
 

@@ -784,6 +784,31 @@ fn legend_symbol(e: &Series, lx: f64, y: f64) -> String {
     }
 }
 
+/// The min/max envelope of points in order of `x`, in runs of `⌈n / buckets⌉` consecutive
+/// points (at most `buckets` runs, the last one shorter): `(x at the run's middle, least y,
+/// greatest y)` per run. A long record drawn point by point is
+/// a tangle of overlapping markers; its envelope shows the same spread, and every extreme
+/// sample stays inside it. Non-finite values are left out of a run; a run without a finite
+/// value is left out.
+pub fn envelope(points: &[(f64, f64)], buckets: usize) -> Vec<(f64, f64, f64)> {
+    let buckets = buckets.clamp(1, points.len().max(1));
+    let size = points.len().div_ceil(buckets).max(1);
+    points
+        .chunks(size)
+        .filter_map(|run| {
+            let finite = run.iter().filter(|p| p.0.is_finite() && p.1.is_finite());
+            let (lo, hi) = finite
+                .clone()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                    (a.min(p.1), b.max(p.1))
+                });
+            let xs: Vec<f64> = finite.map(|p| p.0).collect();
+            let x = (xs.first()? + xs.last()?) / 2.0;
+            Some((x, lo, hi))
+        })
+        .collect()
+}
+
 /// A histogram of `values` with about `√n` bins (at most 30): bar centres, counts, bin width.
 pub fn histogram(values: &[f64]) -> (Vec<(f64, f64)>, f64) {
     let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
@@ -863,6 +888,26 @@ mod tests {
         assert!((w - 1.5).abs() < 1e-12);
         let (h, _) = histogram(&[0.0, 0.0, 3.0]);
         assert_eq!(h, vec![(0.0, 2.0), (1.0, 0.0), (2.0, 0.0), (3.0, 1.0)]);
+    }
+
+    /// The envelope keeps every sample's extremes: each run's band holds its points, the
+    /// runs cover all points in order, and a run of non-finite values is left out.
+    #[test]
+    fn the_envelope_holds_every_point() {
+        let pts: Vec<(f64, f64)> = (0..601)
+            .map(|k| (k as f64, (k as f64 * 0.7).sin() * (1.0 + k as f64 / 100.0)))
+            .collect();
+        let env = envelope(&pts, 150);
+        let size = 601usize.div_ceil(150);
+        assert_eq!((size, env.len()), (5, 121));
+        for (run, &(x, lo, hi)) in pts.chunks(size).zip(&env) {
+            assert!(run.iter().all(|p| p.1 >= lo && p.1 <= hi), "{x}");
+            assert!(run.iter().any(|p| p.1 == lo) && run.iter().any(|p| p.1 == hi));
+            assert!(x >= run[0].0 && x <= run[run.len() - 1].0);
+        }
+        let gap = [(0.0, 1.0), (1.0, f64::NAN), (2.0, f64::NAN), (3.0, 2.0)];
+        assert_eq!(envelope(&gap, 4), vec![(0.0, 1.0, 1.0), (3.0, 2.0, 2.0)]);
+        assert!(envelope(&[], 10).is_empty());
     }
 
     /// The band is one closed path around both edges, broken where an edge cannot be drawn,

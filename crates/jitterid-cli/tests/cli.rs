@@ -125,7 +125,8 @@ fn table2_fit_is_close_to_the_truth_and_plots() {
         "--out",
         s(&data),
     ]);
-    let plots = dir.join("figures");
+    let figures = dir.join("figures");
+    let plots = figures.join("fit");
     let fit = json(&[
         "fit",
         &example("table2.toml"),
@@ -133,7 +134,7 @@ fn table2_fit_is_close_to_the_truth_and_plots() {
         s(&data),
         "--json",
         "--plot",
-        s(&plots),
+        s(&figures),
     ]);
     let truth = [0.2, -0.5, -0.25, 0.3];
     let names = ["gain", "zero0", "pole0.re", "pole0.im"];
@@ -147,7 +148,14 @@ fn table2_fit_is_close_to_the_truth_and_plots() {
     }
     assert_eq!(
         files_in(&plots),
-        ["bode.svg", "jitter-pdf.svg", "moment.svg", "spectrum.svg"]
+        [
+            "bode.svg",
+            "jitter-pdf.svg",
+            "moment.svg",
+            "residuals.svg",
+            "spectrum.svg",
+            "step.svg"
+        ]
     );
     for f in files_in(&plots) {
         let svg = std::fs::read_to_string(plots.join(&f)).unwrap();
@@ -448,7 +456,10 @@ fn montecarlo_plots() {
         "--plot",
         s(&p1),
     ]);
-    assert_eq!(files_in(&p1), ["bode.svg", "histograms.svg", "moment.svg"]);
+    assert_eq!(
+        files_in(&p1.join("montecarlo")),
+        ["bode.svg", "histograms.svg", "moment.svg"]
+    );
     let p2 = dir.join("table1");
     ok(&[
         "montecarlo",
@@ -458,6 +469,7 @@ fn montecarlo_plots() {
         "--plot",
         s(&p2),
     ]);
+    let p2 = p2.join("montecarlo");
     assert_eq!(
         files_in(&p2),
         ["histograms.svg", "jitter-pdf.svg", "moment.svg"]

@@ -165,6 +165,9 @@ fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
     };
     let o = validate(&["--validation", s(&other)], &out, &figs);
     assert!(o.status.success(), "{}", stderr(&o));
+    // Each command's figures in a subfolder named after it.
+    assert_eq!(files_in(&figs), ["validate"]);
+    let figs = figs.join("validate");
     assert_eq!(
         files_in(&figs),
         ["bode.svg", "correlations.svg", "step.svg", "time.svg"]
@@ -214,7 +217,7 @@ fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
     let one = dir.join("one");
     let o = validate(&[], &out, &one);
     assert!(o.status.success(), "{}", stderr(&o));
-    let t = std::fs::read_to_string(one.join("time.svg")).unwrap();
+    let t = std::fs::read_to_string(one.join("validate/time.svg")).unwrap();
     assert_eq!(solid_lines(&t, BLUE), [200]);
     assert!(!t.contains("validation record"));
 
@@ -227,7 +230,7 @@ fn validate_plot_draws_four_figures_written_with_the_other_outputs() {
     let o = validate(&["--model", s(&fit)], &out, &bare);
     assert!(o.status.success(), "{}", stderr(&o));
     for f in ["bode.svg", "step.svg"] {
-        let t = std::fs::read_to_string(bare.join(f)).unwrap();
+        let t = std::fs::read_to_string(bare.join("validate").join(f)).unwrap();
         assert_well_formed(f, &t);
         assert_eq!(t.matches("<path ").count(), 0, "{f}");
         assert!(t.contains("no covariance, so no bands"), "{f}");
@@ -284,7 +287,7 @@ fn validate_bode_band_of_a_system_with_a_free_initial_response() {
     let args = ["--model", s(&fit), "--bode", s(&bode), "--plot", s(&figs)];
     let o = run(&[&["validate", exp.as_str(), "--data", s(&data)], &args[..]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(files_in(&figs).len(), 4);
+    assert_eq!(files_in(&figs.join("validate")).len(), 4);
     let csv = std::fs::read_to_string(&bode).unwrap();
     for row in csv.lines().skip(1).step_by(40) {
         let v: Vec<f64> = row.split(',').map(|x| x.parse().unwrap()).collect();
@@ -358,7 +361,7 @@ fn validate_bode_band_of_a_system_with_a_free_initial_response() {
     let o = run(&[&["validate", exp.as_str(), "--data", s(&data)], &args[..]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
-        files_in(&figs),
+        files_in(&figs.join("validate")),
         ["bode.svg", "correlations.svg", "step.svg", "time.svg"]
     );
     let csv = std::fs::read_to_string(&bode).unwrap();

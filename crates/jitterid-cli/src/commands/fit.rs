@@ -17,6 +17,7 @@ use jitterid_study::notes::{status, Notes};
 use jitterid_study::records::{read_data, read_data_and_tau, read_experiment, read_input};
 use jitterid_study::select::{auto_start, InitChoice};
 use jitterid_study::study_err;
+use jitterid_study::validate::{frequency_response, signal_covariance, step};
 use jitterid_study::Watch;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -158,7 +159,8 @@ struct Samples<'a> {
     tau: Option<&'a [f64]>,
 }
 
-/// The figures of `fit --plot DIR`, written as one set (the naive LS fit beside the method's).
+/// The figures of `fit --plot DIR`, written as one set into `DIR/fit/` (the naive LS fit beside
+/// the method's; the fit's responses and bands from the study layer, as `validate` draws them).
 fn write_fit_figures(
     dir: &Path,
     exp: &Experiment,
@@ -198,6 +200,15 @@ fn write_fit_figures(
     } else {
         method.as_str()
     };
+    let cov = signal_covariance(f);
+    // The response is drawn from 1/(NT) to the Nyquist frequency 1/(2T): a record of one or
+    // two samples has no such band, and its figures go without the Bode diagram.
+    let bode = if exp.grid.len() > 2 {
+        frequency_response(&f.fitted, &exp.grid, cov.as_deref(), "--plot")?
+    } else {
+        None
+    };
+    let step = step(&f.fitted, &exp.grid, cov.as_deref())?;
     let figs = plots::fit_figures(&plots::FitPlots {
         exp,
         y: data.record.y(),
@@ -210,9 +221,11 @@ fn write_fit_figures(
         },
         main: (main_label, &f.fitted),
         tau: data.tau,
+        bode: bode.as_deref(),
+        step: step.as_deref(),
     })?;
     let mut outputs = OutputSet::new();
-    outputs.figures(dir, figs);
+    outputs.figures(&dir.join(plots::FIT_DIR), figs, &plots::FIT_FIGURES);
     outputs.commit()?;
     Ok(())
 }
@@ -277,8 +290,8 @@ fn fit_text(exp: &Experiment, f: &Fit, notes: &Notes, name: &str, plot: Option<&
     if let Some(dir) = plot {
         let _ = writeln!(
             out,
-            "figures in {}: bode.svg (rational systems), spectrum.svg, moment.svg, jitter-pdf.svg",
-            dir.display()
+            "figures in {}: bode.svg and step.svg (rational systems), residuals.svg, spectrum.svg, moment.svg, jitter-pdf.svg",
+            dir.join(plots::FIT_DIR).display()
         );
     }
     out

@@ -155,7 +155,11 @@ pub fn montecarlo(o: &MonteCarloOptions) -> StudyResult<Outcome> {
             true_signal: &study.signal0,
             fitted,
         });
-        outputs.figures(dir, figs);
+        outputs.figures(
+            &dir.join(plots::MONTECARLO_DIR),
+            figs,
+            &plots::MONTECARLO_FIGURES,
+        );
     }
     let text = emit(j, o.json, o.out.as_deref(), outputs)?;
     Ok(Outcome {

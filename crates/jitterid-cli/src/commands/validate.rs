@@ -60,8 +60,8 @@ fn record_plot<'a>(role: &'a str, r: &'a ValidatedRecord) -> RecordPlot<'a> {
     }
 }
 
-/// Adds the figures of `--plot DIR` to the outputs (the Bode diagram on the `--bode` CSV's
-/// frequencies; it and the step response only for a rational system).
+/// Adds the figures of `--plot DIR` (into `DIR/validate/`) to the outputs (the Bode diagram on
+/// the `--bode` CSV's frequencies; it and the step response only for a rational system).
 fn stage_figures(
     dir: &Path,
     outputs: &mut OutputSet,
@@ -80,7 +80,11 @@ fn stage_figures(
         bode: bode.as_deref(),
         step: step.as_deref(),
     });
-    outputs.figures(dir, figs);
+    outputs.figures(
+        &dir.join(plots::VALIDATE_DIR),
+        figs,
+        &plots::VALIDATE_FIGURES,
+    );
     Ok(())
 }
 

@@ -1,21 +1,70 @@
 //! The figures of `fit --plot`, `montecarlo --plot` and `validate --plot`, one module each,
-//! with the curves and panels they share (spectra, Bode diagrams, densities) here.
+//! with the curves and panels they share (spectra, Bode diagrams, densities, long records)
+//! here and the fitted system's responses with their bands in `response`.
 
 mod fit;
 mod montecarlo;
+mod response;
 mod validate;
 
 pub use fit::{fit_figures, FitPlots};
 pub use montecarlo::{montecarlo_figures, McPlots};
 pub use validate::{validate_figures, RecordPlot, ValidatePlots};
 
-use crate::svg::{figure, Panel, Series, Style, BLACK, BLUE, ORANGE};
+/// The subfolder of `--plot DIR` that `fit` writes its figures into: each command has its own,
+/// so that one folder never holds the figures of two commands' experiments side by side.
+pub const FIT_DIR: &str = "fit";
+/// The subfolder of `--plot DIR` for `montecarlo`'s figures.
+pub const MONTECARLO_DIR: &str = "montecarlo";
+/// The subfolder of `--plot DIR` for `validate`'s figures.
+pub const VALIDATE_DIR: &str = "validate";
+
+/// Every figure `fit` may draw (which it draws depends on the model): those not drawn are
+/// removed from its subfolder, so that it never shows an earlier run's beside this one's.
+pub const FIT_FIGURES: [&str; 6] = [
+    "bode.svg",
+    "jitter-pdf.svg",
+    "moment.svg",
+    "residuals.svg",
+    "spectrum.svg",
+    "step.svg",
+];
+/// Every figure `montecarlo` may draw.
+pub const MONTECARLO_FIGURES: [&str; 4] =
+    ["bode.svg", "histograms.svg", "jitter-pdf.svg", "moment.svg"];
+/// Every figure `validate` may draw.
+pub const VALIDATE_FIGURES: [&str; 4] = ["bode.svg", "correlations.svg", "step.svg", "time.svg"];
+
+use crate::svg::{self, figure, Panel, Series, Style, BLACK, BLUE, ORANGE};
 use jitterid::jitter::AnyJitter;
 use jitterid::jitter::{JitterModel, NoJitter};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::{AnySignal, SampleGrid, Signal};
 use jitterid::window::{transform, DirichletWindow, FrequencySet};
 use jitterid_study::export;
+
+/// Above this many points a data series is drawn as its min/max envelope: a few hundred
+/// markers on a panel 520 pixels wide already overlap into a tangle.
+const MAX_MARKERS: usize = 250;
+
+/// Runs of an envelope: about two and a half pixels each across a panel.
+const ENVELOPE_RUNS: usize = 200;
+
+/// Whether `n` data points are drawn as their envelope rather than as markers.
+fn too_many_markers(n: usize) -> bool {
+    n > MAX_MARKERS
+}
+
+/// Data points as markers, or as their min/max envelope when there are more than
+/// [`MAX_MARKERS`] (the label says how many points each run of the envelope holds).
+fn samples_series(label: &str, color: &'static str, points: Vec<(f64, f64)>) -> Series {
+    if !too_many_markers(points.len()) {
+        return Series::markers(label, color, points);
+    }
+    let per_run = points.len().div_ceil(ENVELOPE_RUNS);
+    let env = svg::envelope(&points, ENVELOPE_RUNS);
+    Series::band(&format!("{label}: min–max of every {per_run}"), color, &env).with_opacity(0.5)
+}
 
 /// `|X(f)|` of a sequence on the grid at the DFT frequencies (zero excluded).
 fn spectrum(grid: &SampleGrid, x: &[f64]) -> Vec<(f64, Complex64)> {
@@ -157,7 +206,8 @@ fn pdf_series(
     out
 }
 
-/// Magnitude and phase panels of a Bode diagram.
+/// Magnitude (linear, log scale) and phase panels of a Bode diagram of several models without
+/// bands (`montecarlo`'s estimates).
 fn bode_figure(heading: &str, title: &str, mag: Vec<Series>, ph: Vec<Series>) -> String {
     figure(
         heading,

@@ -1,6 +1,8 @@
 //! The figures of `validate --plot`: the records against the model, the correlation tests, the Bode
 //! diagram and the step response with their bands.
 
+use super::response;
+use super::{samples_series, too_many_markers};
 use crate::svg::{figure, Panel, Series, Style, BLUE, GREY, RED};
 use jitterid::estimate::validation::{BodePoint, CorrelationTest, StepPoint};
 use jitterid::signal::SampleGrid;
@@ -53,55 +55,81 @@ pub fn validate_figures(p: &ValidatePlots<'_>) -> Vec<(String, String)> {
         ),
     ];
     if let Some(b) = p.bode {
-        out.push(("bode.svg".to_string(), validate_bode(b, &p.title)));
+        let heading = "Bode diagram of the fitted system";
+        let fig = response::bode_figure(("fitted model", b), &[], &[], heading, &p.title);
+        out.push(("bode.svg".to_string(), fig));
     }
     if let Some(s) = p.step {
-        out.push(("step.svg".to_string(), step_figure(s, &p.title)));
+        let heading = "Unit-step response of the fitted system";
+        let fig = response::step_figure(("fitted model", s), &[], heading, &p.title);
+        out.push(("step.svg".to_string(), fig));
     }
     out
 }
 
-/// `y_k` as points and `m_k` as a line against time, one panel per record.
+/// How many samples the zoomed panel of a long record shows, as markers.
+const ZOOM: usize = 120;
+
+/// `y_k` as points and `m_k` as a line against time, one panel per record; a record too long
+/// for markers is drawn as its envelope, with a second panel of its first [`ZOOM`] samples.
 fn time_figure(records: &[&RecordPlot<'_>], title: &str) -> String {
-    let panels: Vec<Panel> = records
-        .iter()
-        .map(|r| {
-            let t: Vec<f64> = r.grid.times().collect();
-            let pts = |v: &[f64]| t.iter().copied().zip(v.iter().copied()).collect();
-            let dense = r.y.len() > 400;
-            // Room above the data for the legend, which would hide samples in any corner.
-            let (lo, hi) =
-                r.y.iter()
-                    .chain(r.expected)
-                    .filter(|v| v.is_finite())
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                        (a.min(v), b.max(v))
-                    });
-            let span = if hi > lo { hi - lo } else { 1.0 };
-            Panel {
-                yrange: (lo <= hi).then_some((lo - 0.04 * span, hi + 0.3 * span)),
-                title: format!("{} record {}: fit {:.1} %", r.role, r.name, r.fit_percent),
-                xlabel: "time (s)".into(),
-                ylabel: "y".into(),
-                series: vec![
-                    Series::markers("data y_k", GREY, pts(r.y)).with_opacity(0.6),
-                    Series::line(
-                        &format!("model m_k (fit {:.1} %)", r.fit_percent),
-                        BLUE,
-                        pts(r.expected),
-                    )
-                    .with_width(if dense { 1.0 } else { 1.6 }),
-                ],
-                ..Default::default()
-            }
-        })
-        .collect();
+    let mut panels = Vec::new();
+    for r in records {
+        let t: Vec<f64> = r.grid.times().collect();
+        panels.push(time_panel(
+            r,
+            &t,
+            format!("{} record {}: fit {:.1} %", r.role, r.name, r.fit_percent),
+        ));
+        if too_many_markers(r.y.len()) && r.y.len() > ZOOM {
+            panels.push(time_panel(
+                &RecordPlot {
+                    y: &r.y[..ZOOM],
+                    expected: &r.expected[..ZOOM.min(r.expected.len())],
+                    ..**r
+                },
+                &t[..ZOOM],
+                format!("{} record {}: its first {ZOOM} samples", r.role, r.name),
+            ));
+        }
+    }
     figure(
         "Model vs data: samples y_k and the model's expected samples m_k",
         title,
         &panels,
         1,
     )
+}
+
+/// One panel of `y_k` (markers, or their envelope when many) and `m_k` (a line) at times `t`.
+fn time_panel(r: &RecordPlot<'_>, t: &[f64], heading: String) -> Panel {
+    let pts = |v: &[f64]| t.iter().copied().zip(v.iter().copied()).collect();
+    let dense = r.y.len() > 400;
+    // Room above the data for the legend, which would hide samples in any corner.
+    let (lo, hi) =
+        r.y.iter()
+            .chain(r.expected)
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    Panel {
+        yrange: (lo <= hi).then_some((lo - 0.04 * span, hi + 0.3 * span)),
+        title: heading,
+        xlabel: "time (s)".into(),
+        ylabel: "y".into(),
+        series: vec![
+            samples_series("data y_k", GREY, pts(r.y)).with_opacity(0.6),
+            Series::line(
+                &format!("model m_k (fit {:.1} %)", r.fit_percent),
+                BLUE,
+                pts(r.expected),
+            )
+            .with_width(if dense { 1.0 } else { 1.6 }),
+        ],
+        ..Default::default()
+    }
 }
 
 /// The ±bound lines of a correlation test across its lags (the label on the upper one).
@@ -190,100 +218,5 @@ fn correlation_figure(records: &[&RecordPlot<'_>], title: &str) -> String {
         title,
         &panels,
         if with_input { 2 } else { 1 },
-    )
-}
-
-/// A central curve and, when every point has both edges, its band.
-fn with_band(
-    label: &str,
-    centre: Vec<(f64, f64)>,
-    band: Option<Vec<(f64, f64, f64)>>,
-) -> Vec<Series> {
-    let mut v = Vec::new();
-    if let Some(b) = band {
-        v.push(Series::band("±2σ band (parameter covariance)", BLUE, &b));
-    }
-    v.push(Series::line(label, BLUE, centre));
-    v
-}
-
-/// The edges `(x, lo, hi)` of a band, `None` when a point has none (no covariance).
-fn band_edges(
-    points: impl Iterator<Item = (f64, Option<f64>, Option<f64>)>,
-) -> Option<Vec<(f64, f64, f64)>> {
-    points.map(|(x, lo, hi)| Some((x, lo?, hi?))).collect()
-}
-
-/// The note on a figure whose bands are missing.
-fn band_note(has_band: bool, title: &str) -> String {
-    if has_band {
-        title.to_string()
-    } else {
-        format!("{title} — no covariance, so no bands")
-    }
-}
-
-/// Magnitude (dB) and phase (degrees) of the fitted system with their ±2σ bands.
-fn validate_bode(points: &[BodePoint], title: &str) -> String {
-    let mag_band = band_edges(
-        points
-            .iter()
-            .map(|p| (p.f_hz, p.magnitude_db_lo, p.magnitude_db_hi)),
-    );
-    let ph_band = band_edges(
-        points
-            .iter()
-            .map(|p| (p.f_hz, p.phase_deg_lo, p.phase_deg_hi)),
-    );
-    let has_band = mag_band.is_some();
-    let mag = with_band(
-        "fitted model",
-        points.iter().map(|p| (p.f_hz, p.magnitude_db)).collect(),
-        mag_band,
-    );
-    let ph = with_band(
-        "fitted model",
-        points.iter().map(|p| (p.f_hz, p.phase_deg)).collect(),
-        ph_band,
-    );
-    let panel = |title: &str, ylabel: &str, series| Panel {
-        title: title.into(),
-        xlabel: "frequency (Hz)".into(),
-        ylabel: ylabel.into(),
-        xlog: true,
-        series,
-        ..Default::default()
-    };
-    figure(
-        "Bode diagram of the fitted system",
-        &band_note(has_band, title),
-        &[
-            panel("magnitude 20 log10|G(i2πf)|", "magnitude (dB)", mag),
-            panel("phase", "phase (degrees)", ph),
-        ],
-        1,
-    )
-}
-
-/// The unit-step response of the fitted system with its ±2σ band.
-fn step_figure(points: &[StepPoint], title: &str) -> String {
-    let band = band_edges(points.iter().map(|p| (p.t, p.lo, p.hi)));
-    let has_band = band.is_some();
-    let series = with_band(
-        "fitted model",
-        points.iter().map(|p| (p.t, p.value)).collect(),
-        band,
-    );
-    figure(
-        "Unit-step response of the fitted system",
-        &band_note(has_band, title),
-        &[Panel {
-            title: "response to a unit step at t = 0".into(),
-            xlabel: "time after the step (s)".into(),
-            ylabel: "output".into(),
-            series,
-            ..Default::default()
-        }],
-        1,
     )
 }
