@@ -3,10 +3,15 @@
 //! [`SIGNAL_POLL`], and hands the work's progress to a Python callback. Signal handlers and
 //! callbacks run on the calling thread only, never on a worker thread, and a fast call is not
 //! slowed down: the wait ends as soon as the work does.
+//!
+//! A report waits until the calling thread has handled it: a callback sees each event before
+//! the work goes on, and a callback that raises stops the work at its next check, whatever
+//! the machine's load (with a report that did not wait, a fast fit could run several more
+//! iterations before the exception was seen).
 
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{self, RecvTimeoutError, Sender};
+use std::sync::mpsc::{self, RecvTimeoutError, Sender, SyncSender};
 use std::time::Duration;
 
 /// How often a waiting call looks for Ctrl-C (and any other Python signal).
@@ -14,7 +19,8 @@ pub const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 /// What the worker tells the waiting thread.
 enum Message<E> {
-    Progress(E),
+    /// An event, and where to say that it was handled.
+    Progress(E, SyncSender<()>),
     Done,
 }
 
@@ -23,9 +29,15 @@ enum Message<E> {
 pub struct Reporter<E>(Sender<Message<E>>);
 
 impl<E> Reporter<E> {
-    /// Hands `event` to the waiting thread (dropped if it has stopped listening).
+    /// Hands `event` to the waiting thread and waits until it has been handled (returns at
+    /// once if the waiting thread has stopped listening).
     pub fn report(&self, event: E) {
-        let _ = self.0.send(Message::Progress(event));
+        let (handled, wait) = mpsc::sync_channel(1);
+        if self.0.send(Message::Progress(event, handled)).is_ok() {
+            // An error is the acknowledgement dropped unsent: the waiting thread stopped
+            // listening, and the work sees `cancel` at its next check.
+            let _ = wait.recv();
+        }
     }
 }
 
@@ -66,16 +78,24 @@ pub fn run_watched<T: Send, E: Send>(
                 (rx, message)
             });
             rx = back;
-            let checked = match message {
-                Ok(Message::Progress(event)) => on_event(event),
+            let (checked, handled) = match message {
+                Ok(Message::Progress(event, handled)) => (on_event(event), Some(handled)),
                 Ok(Message::Done) | Err(RecvTimeoutError::Disconnected) => break,
-                Err(RecvTimeoutError::Timeout) => Ok(()),
-            }
-            .and_then(|()| py.check_signals());
+                Err(RecvTimeoutError::Timeout) => (Ok(()), None),
+            };
+            let checked = checked.and_then(|()| py.check_signals());
             if let Err(error) = checked {
+                // The flag before the acknowledgement: the reporting thread, released, sees it.
                 cancel.store(true, Ordering::Relaxed);
+                drop(handled);
+                // Reports queued behind this one carry their acknowledgements: dropping them
+                // releases their threads, and later reports return at once.
+                drop(rx);
                 let outcome = py.detach(|| worker.join()).ok();
                 return Err(Stopped { error, outcome });
+            }
+            if let Some(handled) = handled {
+                let _ = handled.send(());
             }
         }
         Ok(py.detach(|| worker.join()).ok())
