@@ -52,9 +52,9 @@ pub(crate) enum EdgeKind {
     Axis,
 }
 
-/// The edges a fit that stopped at `report` (not converged: the iteration limit, or every
-/// nearby step refused) may be heading for: positive widths below [`WIDTH_EDGE`] of their
-/// start, and, when every nearby step was refused, system parameters near 0 ([`AXIS_EDGE`])
+/// The edges a fit that stopped at `report` (the iteration limit, every nearby step refused,
+/// or converged) may be heading for: positive widths below [`WIDTH_EDGE`] of their start,
+/// and, when every nearby step was refused, system parameters near 0 ([`AXIS_EDGE`])
 /// for which 0 is in the domain and one side of 0 is not.
 pub(crate) fn candidate_edges<S, J, N>(
     structure: &ModelStructure<S, J, N>,
@@ -67,10 +67,17 @@ where
     J: JitterModel + Clone,
     N: NoiseModel,
 {
-    if !matches!(
+    let stalled = matches!(
         report.termination,
         Termination::NonFinite | Termination::MaxIterations
-    ) {
+    );
+    // A search that converged with a width next to 0 may have stopped there on its
+    // cost-change test while the width was still shrinking towards the bound (each step then
+    // changes the criterion by the square of a small width): the bound is tried too, and kept
+    // only when it is a constrained minimum no worse than where the search stopped.
+    let converged_inside = report.termination.is_convergence()
+        && !matches!(report.termination, Termination::AtBound { .. });
+    if !stalled && !converged_inside {
         return Vec::new();
     }
     let (ns, _, _) = structure.blocks();
@@ -85,11 +92,14 @@ where
         if positive.get(i).copied().unwrap_or(false) && theta[i] <= WIDTH_EDGE * start[i] {
             let edge = Edge {
                 index: i,
-                value: BOUND_FRACTION * start[i],
+                // Never above where the search stopped: the bound's refit must not cost more
+                // than the point it replaces for being held further out.
+                value: (BOUND_FRACTION * start[i]).min(theta[i]),
                 inside: 1.0,
             };
             out.push((edge, EdgeKind::Width));
-        } else if i < ns
+        } else if stalled
+            && i < ns
             && report.termination == Termination::NonFinite
             && theta[i].abs() <= AXIS_EDGE * start[i].abs().max(1.0)
             && valid_with(i, 0.0)

@@ -7,6 +7,7 @@ use crate::criterion::Criterion;
 use crate::data::Record;
 use crate::edges::{candidate_edges, settle_on_edge, EdgeKind, EdgeOutcome};
 use crate::evaluation_memo::{EvaluationMemo, MEMO_MAX_SAMPLES};
+use crate::even_widths::add_even_curvature;
 use crate::frequency_data::FrequencyData;
 use crate::noise::NoiseModel;
 use crate::result::{CostKind, Fit};
@@ -79,9 +80,16 @@ pub struct FitProblem<'a, S, J, N, C: ?Sized, W> {
     /// The data.
     pub data: &'a FrequencyData<W>,
     memo: EvaluationMemo<ModelStructure<S, J, N>>,
+    /// The free parameters that are even jitter widths ([`crate::even_widths`]).
+    even: Vec<usize>,
 }
 
-impl<'a, S, J, N, C: ?Sized, W> FitProblem<'a, S, J, N, C, W> {
+impl<'a, S, J, N, C: ?Sized, W> FitProblem<'a, S, J, N, C, W>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+{
     /// The problem of fitting `structure`'s free parameters to `data` by `criterion`.
     ///
     /// On records of up to a few thousand samples the residuals of the last point evaluated
@@ -94,11 +102,25 @@ impl<'a, S, J, N, C: ?Sized, W> FitProblem<'a, S, J, N, C, W> {
         criterion: &'a C,
         data: &'a FrequencyData<W>,
     ) -> Self {
+        let (ns, nj, _) = structure.blocks();
+        let even = if nj > 0 {
+            structure
+                .jitter
+                .even_params()
+                .iter()
+                .enumerate()
+                .filter(|(_, &e)| e)
+                .map(|(j, _)| ns + j)
+                .collect()
+        } else {
+            Vec::new()
+        };
         FitProblem {
             structure,
             criterion,
             data,
             memo: EvaluationMemo::default(),
+            even,
         }
     }
 
@@ -185,13 +207,17 @@ where
             None => self.model_at(theta),
         };
         Ok(match model {
-            Some(m) => crate::parseval::criterion_normal_equations(
-                self.criterion,
-                self.data,
-                &m,
-                residuals,
-                self.memo.sensitivities(theta),
-            ),
+            Some(m) => {
+                let mut ne = crate::parseval::criterion_normal_equations(
+                    self.criterion,
+                    self.data,
+                    &m,
+                    residuals,
+                    self.memo.sensitivities(theta),
+                );
+                add_even_curvature(&mut ne, theta, &self.even);
+                ne
+            }
             None => NormalEquations::not_finite(self.num_params()),
         })
     }

@@ -61,6 +61,7 @@ mod data;
 mod edges;
 mod error;
 mod evaluation_memo;
+mod even_widths;
 mod fit;
 mod fit_criterion;
 mod flatness;

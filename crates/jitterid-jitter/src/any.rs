@@ -188,6 +188,9 @@ impl JitterModel for AnyJitter {
     fn num_params(&self) -> usize {
         self.model().num_params()
     }
+    fn even_params(&self) -> Vec<bool> {
+        self.model().even_params()
+    }
     fn std_dev(&self) -> f64 {
         self.model().std_dev()
     }

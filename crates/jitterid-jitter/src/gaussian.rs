@@ -72,6 +72,11 @@ impl JitterModel for Gaussian {
         vec!["sigma".to_string()]
     }
 
+    fn even_params(&self) -> Vec<bool> {
+        // A law symmetric about 0 and scaled by its one parameter: γ is even in it.
+        vec![true]
+    }
+
     fn params(&self) -> Vec<f64> {
         vec![self.sigma]
     }

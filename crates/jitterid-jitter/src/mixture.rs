@@ -172,6 +172,20 @@ impl<J: JitterModel + Clone> JitterModel for Mixture<J> {
         p
     }
 
+    fn even_params(&self) -> Vec<bool> {
+        // γ = Σ w_k γ_k: a component's parameter enters through that component only; the
+        // weights linearly.
+        let mut e: Vec<bool> = self
+            .components
+            .iter()
+            .flat_map(|c| c.even_params())
+            .collect();
+        if !self.fixed_weights {
+            e.extend(std::iter::repeat_n(false, self.weights.len() - 1));
+        }
+        e
+    }
+
     fn num_params(&self) -> usize {
         let own: usize = self.components.iter().map(|c| c.num_params()).sum();
         own + if self.fixed_weights {

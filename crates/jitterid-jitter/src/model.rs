@@ -128,6 +128,18 @@ pub trait JitterModel: fmt::Debug + Send + Sync + CfAtParams {
         self.params().len()
     }
 
+    /// For each parameter (in the order of [`params`](Self::params)), whether `γ` depends on
+    /// it only through its square: the width of a law symmetric about 0, whose `γ(f)` is even
+    /// in it and flat at 0. An estimator searches such a parameter in its square, where the
+    /// first moment is smooth through 0 (in the width itself the moment's derivative vanishes
+    /// at 0, and a search towards a small width crawls).
+    ///
+    /// Provided: `false` for every parameter (the search then moves it as it is); a family
+    /// overrides it only where the claim holds, which `check_contract` tests.
+    fn even_params(&self) -> Vec<bool> {
+        vec![false; self.num_params()]
+    }
+
     /// Standard deviation `√Var τ`.
     fn std_dev(&self) -> f64 {
         self.variance().sqrt()

@@ -72,6 +72,13 @@ impl<J: JitterModel> JitterModel for Shifted<J> {
         "shifted"
     }
 
+    fn even_params(&self) -> Vec<bool> {
+        // γ = e^{-i2πf·offset}·γ_inner: the offset enters linearly in the phase.
+        let mut e = vec![false];
+        e.extend(self.inner.even_params());
+        e
+    }
+
     fn param_names(&self) -> Vec<String> {
         let mut names = vec!["offset".to_string()];
         names.extend(self.inner.param_names());

@@ -163,6 +163,13 @@ impl<A: JitterModel + Clone, B: JitterModel + Clone> JitterModel for Sum<A, B> {
         p
     }
 
+    fn even_params(&self) -> Vec<bool> {
+        // γ = γ_a·γ_b: a term's parameter enters through that term only.
+        let mut e = self.a.even_params();
+        e.extend(self.b.even_params());
+        e
+    }
+
     fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
         let na = self.a.num_params();
         let expected = na + self.b.num_params();

@@ -166,6 +166,54 @@ fn closed_forms<J: JitterModel + Clone>(model: &J, fails: &mut Vec<String>) {
     check_structure(model, fails);
     check_rule(model, s, fails);
     check_gradient(model, s, fails);
+    check_even(model, s, fails);
+}
+
+/// `even_params`: one entry per parameter, and each parameter it names is a positive width
+/// that `γ` depends on through its square: `(∂γ/∂θ)/θ` tends to a limit as `θ → 0` (it is
+/// `2G'(θ²)` for `γ = G(θ²)`), where a parameter that enters linearly gives `c/θ`, which
+/// doubles when `θ` halves.
+fn check_even<J: JitterModel + Clone>(model: &J, s: f64, fails: &mut Vec<String>) {
+    let even = model.even_params();
+    let p = model.params();
+    if even.len() != p.len() {
+        fails.push(format!(
+            "even_params() has {} entries for {} parameters",
+            even.len(),
+            p.len()
+        ));
+        return;
+    }
+    for (i, _) in even.iter().enumerate().filter(|(_, &e)| e) {
+        if !(p[i] > 0.0) {
+            fails.push(format!(
+                "even parameter {i} is {} (not a positive width)",
+                p[i]
+            ));
+            continue;
+        }
+        // (∂γ/∂θ)/θ by central differences through `with_params`, at θ scaled by `c`.
+        let slope = |c: f64, f: f64| -> Option<Complex64> {
+            let at = |theta: f64| {
+                let mut q = p.clone();
+                q[i] = theta;
+                model.with_params(&q).ok().map(|m| m.cf(f))
+            };
+            let (theta, h) = (c * p[i], 1e-3 * c * p[i]);
+            Some((at(theta + h)? - at(theta - h)?) / (2.0 * h * theta))
+        };
+        for f in [0.3, 1.0, 3.0].map(|x| x / (std::f64::consts::TAU * s)) {
+            match (slope(1e-2, f), slope(2e-2, f)) {
+                (Some(a), Some(b)) if (a - b).norm() <= 0.05 * a.norm().max(b.norm()) + 1e-9 => {}
+                (Some(a), Some(b)) => fails.push(format!(
+                    "parameter {i} is declared even but (∂γ/∂θ)/θ at f = {f:e} changes from {b} to {a} as θ halves"
+                )),
+                _ => fails.push(format!(
+                    "parameter {i} is declared even but with_params rejects small values of it"
+                )),
+            }
+        }
+    }
 }
 
 fn check_params<J: JitterModel + Clone>(model: &J, fails: &mut Vec<String>) {
@@ -740,6 +788,52 @@ mod tests {
         let err = check_contract(&m, 7).unwrap_err();
         assert!(err.contains("quadrature gives E[e^(-i2πfτ)]"), "{err}");
         assert!(err.contains("empirical E[e^(-i2πfτ)]"), "{err}");
+    }
+
+    #[test]
+    fn a_parameter_wrongly_declared_even_is_caught() {
+        // The exponential delay's mean enters γ = 1/(1 + i2πf·mean) linearly at 0.
+        #[derive(Debug, Clone)]
+        struct ClaimsEven(crate::ExponentialDelay);
+        impl JitterModel for ClaimsEven {
+            fn name(&self) -> &'static str {
+                "claims-even"
+            }
+            fn param_names(&self) -> Vec<String> {
+                self.0.param_names()
+            }
+            fn params(&self) -> Vec<f64> {
+                self.0.params()
+            }
+            fn with_params(&self, params: &[f64]) -> Result<Self, JitterError> {
+                self.0.with_params(params).map(ClaimsEven)
+            }
+            fn cf(&self, f: f64) -> Complex64 {
+                self.0.cf(f)
+            }
+            fn pdf(&self, tau: f64) -> f64 {
+                self.0.pdf(tau)
+            }
+            fn pieces(&self) -> Vec<(f64, f64)> {
+                self.0.pieces()
+            }
+            fn mean(&self) -> f64 {
+                self.0.mean()
+            }
+            fn variance(&self) -> f64 {
+                self.0.variance()
+            }
+            fn even_params(&self) -> Vec<bool> {
+                vec![true]
+            }
+        }
+        let m = ClaimsEven(crate::ExponentialDelay::new(0.3).unwrap());
+        let err = check_closed_forms(&m).unwrap_err();
+        assert!(err.contains("declared even"), "{err}");
+        // The same family without the claim passes, and so do the shipped even widths.
+        check_closed_forms(&m.0).unwrap();
+        check_closed_forms(&Gaussian::new(0.2).unwrap()).unwrap();
+        check_closed_forms(&UniformSum::new(2, 0.3).unwrap()).unwrap();
     }
 
     #[test]

@@ -239,6 +239,11 @@ impl JitterModel for UniformSum {
         vec!["a".to_string()]
     }
 
+    fn even_params(&self) -> Vec<bool> {
+        // A law symmetric about 0 and scaled by its one parameter: γ is even in it.
+        vec![true]
+    }
+
     fn params(&self) -> Vec<f64> {
         vec![self.a]
     }

@@ -24,8 +24,9 @@ use rayon::prelude::*;
 
 /// Index of the best screened candidate of every family, in the order the families first
 /// appear: the converged one of lowest BCLS BIC, else (no converged fit in the family) the
-/// fitted one of lowest BIC that did not stop at the stability boundary; families without
-/// such a candidate have no finalist.
+/// fitted one of lowest BIC that did not stop at the stability boundary; candidates with a pole
+/// beyond the sampling's reach are never finalists; families without such a candidate have no
+/// finalist.
 pub(super) fn finalists(candidates: &[Candidate]) -> Vec<usize> {
     let mut families: Vec<&str> = Vec::new();
     for c in candidates {
@@ -46,6 +47,9 @@ pub(super) fn finalists(candidates: &[Candidate]) -> Vec<usize> {
                         // `|p|/|Re p|` oscillations per sample: a refit that would spend the
                         // whole time limit on a candidate that is no model of the record.
                         && c.failure_kind != Some(super::FailureKind::StabilityBoundary)
+                        // A pole the samples do not determine: the refit would tabulate the
+                        // response at its time scale around every switch, for nothing.
+                        && c.failure_kind != Some(super::FailureKind::PoleBeyondSampling)
                 })
                 .min_by(|&a, &b| {
                     let (ca, cb) = (&candidates[a], &candidates[b]);

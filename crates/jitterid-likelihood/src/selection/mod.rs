@@ -33,7 +33,9 @@
 //!    sees the jitter's whole law through the spread of `s(t_k + τ)`, not only `γ(f)`.
 //!
 //! The ranking: finalists whose likelihood fit converged, by that BIC; then the other
-//! converged candidates by the screen's BIC; then the failed ones, with their reason.
+//! converged candidates by the screen's BIC, those with a pole beyond the sampling's reach
+//! ([`FailureKind::PoleBeyondSampling`], never finalists) after the rest; then the failed ones,
+//! with their reason.
 //! The two BICs are never compared with each other.
 
 use jitterid_jitter::{registry::JitterRegistry, AnyJitter};
@@ -140,6 +142,14 @@ pub enum FailureKind {
     /// order with a pole to spare, its extra pair pushed to the axis while the jitter's
     /// spread grows to absorb the misfit.
     StabilityBoundary,
+    /// The fit converged with a pole so fast that the samples do not determine it: `|p|·T`
+    /// above [`BEYOND_SAMPLING`], so that its mode decays by more than `e^{−10π} ≈ 2·10⁻¹⁴`
+    /// within one sampling interval. Typically an order with a pole to spare, placed far
+    /// beyond the sampling rate where it changes the sampled response by a small lag only. The
+    /// candidate keeps its screen BIC but ranks after the identifiable converged ones and is
+    /// never a likelihood finalist (its exact-likelihood refit would tabulate the response at
+    /// that time scale around every input switch, for parameters the data do not fix).
+    PoleBeyondSampling,
     /// The fit ran but did not converge (the solver's reason in the failure).
     NotConverged,
     /// The fit could not be made (the start, the initializer or the criterion failed).
@@ -405,7 +415,15 @@ fn fit_candidate(
         return failed(format!("cost {} is not positive and finite", fit.cost));
     };
     let (failure, failure_kind) = if fit.converged {
-        (None, None)
+        match fast_poles(&structure, &fit.params, record.grid().interval()) {
+            Some(fast) => (
+                Some(format!(
+                    "pole(s) {fast} beyond the sampling's reach (|p|·T above 10π = {BEYOND_SAMPLING:.1}): the samples do not determine them; ranked after the identifiable candidates and not refitted by exact likelihood"
+                )),
+                Some(FailureKind::PoleBeyondSampling),
+            ),
+            None => (None, None),
+        }
     } else {
         match axis_poles(&structure, &fit.params) {
             Some(on_axis) => (
@@ -451,9 +469,18 @@ fn fit_candidate(
 /// at most 10⁷ samples resolves.
 const ON_AXIS: f64 = 1e-6;
 
-/// The poles of the candidate at `params` that lie on the imaginary axis, written out, or
-/// `None` when there are none (or the system is not a transfer function).
-fn axis_poles(structure: &Structure, params: &[f64]) -> Option<String> {
+/// `|p|·T` above which a pole is beyond the sampling's reach ([`FailureKind::PoleBeyondSampling`]):
+/// `10π`, where its mode decays by `e^{−10π} ≈ 2·10⁻¹⁴` within one interval, below the
+/// resolution of the samples in double precision.
+const BEYOND_SAMPLING: f64 = 10.0 * std::f64::consts::PI;
+
+/// The poles of the candidate at `params` that satisfy `keep`, written out, or `None` when
+/// there are none (or the system is not a transfer function).
+fn poles_where(
+    structure: &Structure,
+    params: &[f64],
+    keep: impl Fn(&num_complex::Complex64) -> bool,
+) -> Option<String> {
     let at = structure.with_params(params).ok()?;
     let spec = at.signal.spec();
     let r = SignalRegistry::builtin()
@@ -461,15 +488,27 @@ fn axis_poles(structure: &Structure, params: &[f64]) -> Option<String> {
         .reader(&spec)
         .ok()?;
     let tf = TfForm::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok()?;
-    let on_axis: Vec<String> = tf
+    let kept: Vec<String> = tf
         .to_zpk()
         .ok()?
         .poles()
         .iter()
-        .filter(|p| p.re.abs() <= ON_AXIS * p.norm().max(1.0))
+        .filter(|p| keep(p))
         .map(|p| format!("{:.4}{:+.4}i", p.re, p.im))
         .collect();
-    (!on_axis.is_empty()).then(|| on_axis.join(", "))
+    (!kept.is_empty()).then(|| kept.join(", "))
+}
+
+/// The poles of the candidate at `params` that lie on the imaginary axis.
+fn axis_poles(structure: &Structure, params: &[f64]) -> Option<String> {
+    poles_where(structure, params, |p| {
+        p.re.abs() <= ON_AXIS * p.norm().max(1.0)
+    })
+}
+
+/// The poles of the candidate at `params` beyond the sampling's reach at interval `t`.
+fn fast_poles(structure: &Structure, params: &[f64], t: f64) -> Option<String> {
+    poles_where(structure, params, |p| p.norm() * t > BEYOND_SAMPLING)
 }
 
 /// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first
@@ -510,8 +549,9 @@ pub fn select(
     // A stable sort keeps grid order among equal keys: deterministic for any thread count.
     let group = |c: &Candidate| match (c.ranked_by_likelihood, c.converged) {
         (true, _) => 0,
+        (false, true) if c.failure_kind == Some(FailureKind::PoleBeyondSampling) => 2,
         (false, true) => 1,
-        (false, false) => 2,
+        (false, false) => 3,
     };
     out.sort_by(|a, b| {
         group(a)

@@ -180,6 +180,41 @@ fn finalists_are_the_screens_best_of_each_family() {
     let mut c = c;
     c[6].failure_kind = Some(FailureKind::StabilityBoundary);
     assert_eq!(likelihood::finalists(&c), vec![2, 1, 5]);
+    // Nor is a converged fit with a pole beyond the sampling's reach: gaussian's next best is.
+    c[1].failure_kind = Some(FailureKind::PoleBeyondSampling);
+    assert_eq!(likelihood::finalists(&c), vec![2, 4, 5]);
+}
+
+/// The screen's outcome for a pole the samples cannot see: the Table 2 system with a third pole
+/// at `−p` (T = 1 s) is named beyond the sampling's reach exactly when `p > 10π`.
+#[test]
+fn a_pole_beyond_the_sampling_is_named() {
+    let (record, input) = record();
+    let t = record.grid().interval();
+    let structure = |fast: f64| {
+        // 0.2·p (s + 0.5) / ((s² + 0.5 s + 0.1525)(s + p)): the Table 2 system with a pole
+        // at −p to spare, its static gain kept.
+        let spec = serde_json::json!({
+            "kind": "tf",
+            "num": [0.2 * fast, 0.1 * fast],
+            "den": [1.0, 0.5 + fast, 0.1525 + 0.5 * fast, 0.1525 * fast],
+        });
+        let signal = SignalRegistry::builtin()
+            .build(spec.as_object().unwrap(), Some(&input))
+            .unwrap();
+        let none = JitterRegistry::builtin()
+            .from_std_dev("none", 0.0, &serde_json::Map::new())
+            .unwrap();
+        ModelStructure::joe(signal, none)
+    };
+    for (fast, beyond) in [(396.0, true), (32.0, true), (30.0, false), (2.0, false)] {
+        let s = structure(fast);
+        let found = fast_poles(&s, &s.params(), t);
+        assert_eq!(found.is_some(), beyond, "pole at -{fast}: {found:?}");
+        if let Some(text) = found {
+            assert!(text.contains(&format!("{:.4}", -fast)), "{text}");
+        }
+    }
 }
 
 /// `c` with its fitted jitter replaced by its family's at standard deviation `std`.
