@@ -98,6 +98,12 @@ pub struct InitOptions {
     pub tolerance: f64,
     /// Include the jitter's damping `γ(−f)` of the structure's jitter model. Default true.
     pub compensate_jitter: bool,
+    /// The record has an unknown output offset `y₀` (an operating point): leave out the bin
+    /// `f = 0`, the only DFT bin a constant reaches (it adds `N y₀` there and nothing at
+    /// `j/(NT)`, `j ≠ 0`), so that the model is fitted to the bins the offset leaves alone.
+    /// The offset's own start is then [`offset_start`]. Default false.
+    #[serde(default)]
+    pub offset: bool,
 }
 
 impl Default for InitOptions {
@@ -107,6 +113,7 @@ impl Default for InitOptions {
             iterations: 30,
             tolerance: 1e-10,
             compensate_jitter: true,
+            offset: false,
         }
     }
 }
@@ -250,6 +257,21 @@ where
     Ok(out)
 }
 
+/// The start of an output offset `y₀` for a model whose response (without the offset) is
+/// `response`: `mean(y) − mean(m_k)` with `m_k = E[s(t_k + τ)]` under `jitter`, the value that
+/// zeroes the residuals' mean, which is the least-squares offset for the response held (time
+/// domain) and the one that fits the bin `f = 0` exactly (frequency domain, where the offset
+/// adds `N y₀`).
+pub fn offset_start<S: jitterid_signal::Signal + ?Sized>(
+    response: &S,
+    record: &Record,
+    jitter: &dyn JitterModel,
+) -> f64 {
+    let m = response.expected_values(record.grid(), jitter);
+    let n = record.y().len().max(1) as f64;
+    record.y().iter().zip(&m).map(|(y, m)| y - m).sum::<f64>() / n
+}
+
 /// The linear frequency-response fit with `m` zeros and `n` poles; see the module docs.
 ///
 /// # Errors
@@ -286,9 +308,11 @@ pub fn fit_rational(
         }
     };
     // Bins 0..=last: `last` from the band, raised until the equations suffice, capped at N/2.
+    let first = usize::from(options.offset);
     let equations = |last: usize| {
         let nyquist = len % 2 == 0 && last == len / 2 && last > 0;
-        2 * (last + 1) - 1 - usize::from(nyquist)
+        // One real equation at 0 Hz (left out with an offset) and at Nyquist, two elsewhere.
+        (2 * (last + 1) - 1 - usize::from(nyquist)).saturating_sub(first)
     };
     let mut last = ((f_max * len as f64 * t).floor() as usize).min(len / 2);
     while equations(last) < unknowns + 1 && last < len / 2 {
@@ -312,7 +336,7 @@ pub fn fit_rational(
     let t_b = t_a + len as f64 * t;
     let omega_n = TAU * freqs[last];
     let mut bins = Vec::with_capacity(freqs.len());
-    for (j, &f) in freqs.iter().enumerate() {
+    for (j, &f) in freqs.iter().enumerate().skip(first) {
         let damp = jitter.map_or(Complex64::new(1.0, 0.0), |g| g.cf(f).conj());
         let u = damp * windowed_input(input, t_a, t_b, t0, f) / t;
         let e = Complex64::from_polar(1.0 / t, PI * f * t);
