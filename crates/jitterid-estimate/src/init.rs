@@ -857,4 +857,60 @@ mod tests {
             assert!((got - want).abs() < 0.15 * want, "{:?}", g.params());
         }
     }
+
+    /// With `offset`, the fit leaves out the bin `f = 0`, the only one a constant reaches: the
+    /// exact mean moved by `y₀ = 3` gives the model of the unmoved mean (to the rounding of the
+    /// DTFT, `y₀ N ε`), and [`offset_start`] of that model gives back `y₀`.
+    #[test]
+    fn an_offset_leaves_the_model_and_is_started_from_the_mean() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        let u = RandomBinary::paper()
+            .generate(0.0, 201.0, &mut rng)
+            .unwrap();
+        let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
+        let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
+        let m = LtiResponse::new(paper(), u.clone()).expected_values(&grid, &jitter);
+        let moved: Vec<f64> = m.iter().map(|v| v + 3.0).collect();
+        let options = InitOptions {
+            offset: true,
+            ..InitOptions::default()
+        };
+        let input: Input = u.into();
+        let fit = |y: Vec<f64>| {
+            let record = Record::new(grid, y).unwrap();
+            let g = initial_model(&paper(), &record, &input, Some(&jitter), &options).unwrap();
+            (g, record)
+        };
+        let (plain, _) = fit(m);
+        let (g, record) = fit(moved);
+        for (a, b) in g.params().iter().zip(plain.params()) {
+            assert!(
+                (a - b).abs() < 1e-8,
+                "{:?} vs {:?}",
+                g.params(),
+                plain.params()
+            );
+        }
+        for (got, want) in g.params().iter().zip([0.2, -0.5, -0.25, 0.3]) {
+            assert!(
+                (got - want).abs() < 0.05 * f64::abs(want),
+                "{:?}",
+                g.params()
+            );
+        }
+        let truth = LtiResponse::new(paper(), input.clone());
+        assert!((offset_start(&truth, &record, &jitter) - 3.0).abs() < 1e-12);
+        // Without the option the bin f = 0 pulls the model towards the offset.
+        let record = Record::new(grid, record.y().to_vec()).unwrap();
+        let pulled = initial_model(
+            &paper(),
+            &record,
+            &input,
+            Some(&jitter),
+            &InitOptions::default(),
+        )
+        .unwrap();
+        let moved_by = (pulled.params()[0] - g.params()[0]).abs();
+        assert!(moved_by > 1e-3, "{:?}", pulled.params());
+    }
 }
