@@ -761,7 +761,7 @@ fn match_kinds(template: &[Root], roots: &[Complex64]) -> Vec<Root> {
 mod tests {
     use super::*;
     use jitterid_jitter::UniformSum;
-    use jitterid_signal::{simulate, RandomBinary, SampleGrid, Signal};
+    use jitterid_signal::{simulate, PiecewiseConstant, RandomBinary, SampleGrid, Signal};
     use rand::SeedableRng;
 
     fn paper() -> Zpk {
@@ -773,8 +773,8 @@ mod tests {
         .unwrap()
     }
 
-    #[test]
-    fn recovers_the_paper_system_from_its_exact_mean() {
+    /// The paper's input (seed 11), jitter and grid, and the exact mean `m_k` of its system.
+    fn exact_mean() -> (PiecewiseConstant, UniformSum, SampleGrid, Vec<f64>) {
         let mut rng = rand::rngs::StdRng::seed_from_u64(11);
         let u = RandomBinary::paper()
             .generate(0.0, 201.0, &mut rng)
@@ -782,6 +782,12 @@ mod tests {
         let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
         let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
         let m = LtiResponse::new(paper(), u.clone()).expected_values(&grid, &jitter);
+        (u, jitter, grid, m)
+    }
+
+    #[test]
+    fn recovers_the_paper_system_from_its_exact_mean() {
+        let (u, jitter, grid, m) = exact_mean();
         let record = Record::new(grid, m).unwrap();
         let template = Zpk::new(
             1.0,
@@ -863,13 +869,7 @@ mod tests {
     /// DTFT, `y₀ N ε`), and [`offset_start`] of that model gives back `y₀`.
     #[test]
     fn an_offset_leaves_the_model_and_is_started_from_the_mean() {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
-        let u = RandomBinary::paper()
-            .generate(0.0, 201.0, &mut rng)
-            .unwrap();
-        let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
-        let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
-        let m = LtiResponse::new(paper(), u.clone()).expected_values(&grid, &jitter);
+        let (u, jitter, grid, m) = exact_mean();
         let moved: Vec<f64> = m.iter().map(|v| v + 3.0).collect();
         let options = InitOptions {
             offset: true,
