@@ -278,8 +278,40 @@ def _model(system: Any, jitter_model: Any, input: Any) -> None:
         raise TypeError(f"input: expected an Input or None, found {type(input).__name__}")
 
 
+def _output(system: Any, offset: Any, estimate_offset: Any) -> Tuple[Any, dict, Optional[dict]]:
+    """The output offset of a set-up: ``(system, system_keys, output)``.
+
+    A ``System`` may carry the registry keys ``offset`` and ``estimate_offset`` itself (a fitted
+    system does); the arguments ``offset`` and ``estimate_offset``, when given, replace them.
+    ``system`` is the system with the offset in its spec (what the extension simulates),
+    ``system_keys`` its ``[system]`` section without the two keys, and ``output`` the
+    ``[output]`` section (``None`` without either key, so that nothing changes). ``offset`` not
+    a real number and ``estimate_offset`` not a boolean raise ``ValueError`` naming the
+    argument; its range is the experiment reader's to check."""
+    spec = dict(system.spec)
+    output = {k: spec.pop(k) for k in ("offset", "estimate_offset") if k in spec}
+    if offset is not None:
+        if isinstance(offset, (bool, np.bool_)):
+            raise ValueError("offset: expected a real number, found bool")
+        try:
+            output["offset"] = real_number(offset, "offset")
+        except TypeError as e:
+            raise ValueError(str(e)) from None
+        if not np.isfinite(output["offset"]):
+            raise ValueError(f"offset: expected a finite number, found {output['offset']}")
+    if estimate_offset is not None:
+        if not isinstance(estimate_offset, (bool, np.bool_)):
+            raise ValueError(f"estimate_offset: expected True or False, found {type(estimate_offset).__name__}")
+        output["estimate_offset"] = bool(estimate_offset)
+    if not output:
+        return system, spec, None
+    if offset is not None or estimate_offset is not None:
+        system = System(json.dumps(dict(spec, **output)))
+    return system, spec, output
+
+
 def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval: Any, start: Any,
-              noise_std: Any, what: str) -> None:
+              noise_std: Any, what: str, output: Optional[dict] = None) -> None:
     """Refuses what the command line refuses for the same set-up: the arguments are read as
     the sections of an experiment file (``[sampling]``, ``[input]``, ``[system]``, ``[jitter]``,
     ``[noise]``), whose reader checks every value against the grid (a zero gain, a pole or a
@@ -292,7 +324,13 @@ def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval
     sections: dict = {"sampling": {"interval": interval, "samples": samples, "start": start}}
     if input is not None:
         sections["input"] = json.loads(input.section_json())
-    sections["system"] = dict(system.spec, estimate=False)
+    spec = dict(system.spec)
+    for key in ("offset", "estimate_offset"):
+        spec.pop(key, None)
+    sections["system"] = dict(spec, estimate=False)
+    if output is not None:
+        # Only the offset's value is checked here: nothing is estimated.
+        sections["output"] = {k: v for k, v in output.items() if k == "offset"}
     sections["jitter"] = dict(jitter_model.spec, estimate=False)
     sections["noise"] = {"std": real_number(noise_std, "noise_std"), "estimate": False}
     Experiment.from_sections(spec_json(sections), what)
@@ -300,13 +338,17 @@ def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval
 
 def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
              interval: float, start: float = 0.0, noise_std: float = 0.0, seed: int = DEFAULT_SEED,
-             truth: bool = False) -> dict:
-    """``samples`` jittered samples ``y_k = s(t_k + τ_k) + v_k`` of ``system`` driven by
+             truth: bool = False, offset: Optional[float] = None) -> dict:
+    """``samples`` jittered samples ``y_k = y₀ + s(t_k + τ_k) + v_k`` of ``system`` driven by
     ``input`` at ``t_k = start + k·interval``, white noise of std ``noise_std``, seeded by
     ``seed``: a dict of arrays ``t``, ``y``, ``u`` (with an input), and with ``truth`` the drawn
-    ``tau`` and ``v``. The GIL is released while it runs. The arguments are checked as the
-    command line checks an experiment file (``ValueError`` naming the key)."""
-    _in_range(system, jitter, input, samples, interval, start, noise_std, "simulate arguments")
+    ``tau`` and ``v``. ``offset`` is the output offset ``y₀`` (the operating point, as
+    ``[output] offset``; default the system's own, else 0). The GIL is released while it runs.
+    The arguments are checked as the command line checks an experiment file (``ValueError``
+    naming the key)."""
+    _model(system, jitter, input)
+    system, _, output = _output(system, offset, None)
+    _in_range(system, jitter, input, samples, interval, start, noise_std, "simulate arguments", output)
     return _jitterid.simulate(system, jitter, input, *_grid(samples, interval, start),
                               real_number(noise_std, "noise_std"), integer(seed, "seed"), bool(truth))
 
@@ -330,7 +372,8 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         estimate: Iterable[str] = ("system",), interval: Optional[float] = None,
         start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
         options: Optional[Mapping[str, Any]] = None, init: str = "experiment",
-        progress: Optional[Callable[[int, float], Any]] = None) -> FitResult:
+        progress: Optional[Callable[[int, float], Any]] = None, offset: Optional[float] = None,
+        estimate_offset: Optional[bool] = None) -> FitResult:
     """Fits a record's samples with ``method``, starting from ``system`` and ``jitter``.
 
     Arguments:
@@ -358,6 +401,10 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
     * ``progress``: called as ``progress(iteration, cost)`` after the solver's start and each
       of its iterations, on the calling thread (see ``Experiment.fit`` for Ctrl-C and for an
       exception it raises).
+    * ``offset``, ``estimate_offset``: the output offset ``y₀`` (operating point) and whether
+      it is estimated with the system, as the parameter ``offset`` (the keys of ``[output]``;
+      default the system's own, else no offset). ``estimate_offset=True`` needs ``"system"``
+      among the estimated parts.
 
     Returns a ``FitResult`` (``names``, ``params``, ``std_errors``, ``covariance``, …), equal
     to ``Experiment.fit`` on an experiment with the same sections. Raises ``ValueError``
@@ -424,7 +471,10 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         sections["input"] = json.loads(input.section_json())
     if options is not None and not isinstance(options, Mapping):
         raise TypeError(f"options: expected a mapping of [estimate] keys, found {type(options).__name__}")
-    sections["system"] = dict(system.spec, estimate="system" in parts)
+    _, system_keys, output = _output(system, offset, estimate_offset)
+    sections["system"] = dict(system_keys, estimate="system" in parts)
+    if output is not None:
+        sections["output"] = output
     sections["jitter"] = dict(jitter.spec, estimate="jitter" in parts)
     sections["noise"] = {"std": real_number(noise_std, "noise_std"), "estimate": "noise" in parts}
     sections["estimate"] = {"method": method, **dict(options or {})}

@@ -13,7 +13,7 @@ use jitterid_study::experiment::{self, InputSpec, Method, Paths, Purpose};
 use jitterid_study::fingerprint::experiment_fingerprint;
 use jitterid_study::inputs;
 use jitterid_study::montecarlo::DEFAULT_SEED;
-use jitterid_study::select::{auto_start, InitChoice};
+use jitterid_study::select::InitChoice;
 use jitterid_study::{fit as fitting, records, simulate, Registries};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError};
@@ -297,7 +297,7 @@ impl Experiment {
             };
             let mut signal = fitting::signal_of(&exp, input.as_ref())?;
             if init == InitChoice::Auto {
-                signal = auto_start(&exp, &signal, input.as_ref(), &y, "y")?;
+                signal = fitting::data_start(&exp, &signal, input.as_ref(), &y, "y")?;
             }
             fitting::fit_values(&exp, signal, y, "y", &watch)
         };

@@ -260,6 +260,7 @@ pub fn select(
         }
         exp.estimate.max_seconds = Some(t);
     }
+    exp.selectable().map_err(study_error)?;
     let selection = py
         .detach(|| run_selection(&exp, &data, validation.as_deref()))
         .map_err(study_error)?;

@@ -79,6 +79,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "sine" => crate::reproduce_ml::sine(o),
         "starts" => crate::reproduce_starts::starts(o),
         "initial" => crate::reproduce_initial::initial(o),
+        "models" => crate::reproduce_models::models(o),
         "select" => crate::reproduce_select::select_case(o),
         "validate" => crate::reproduce_validate::validate_case(o),
         "all" => {
@@ -91,6 +92,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
                 "sine",
                 "starts",
                 "initial",
+                "models",
                 "select",
                 "validate",
             ] {
@@ -99,7 +101,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate or all)"
         )),
     }
 }

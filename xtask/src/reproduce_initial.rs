@@ -15,8 +15,8 @@ use crate::outputs::{fmt_opt, write_outputs};
 use crate::paper::RUNS;
 use crate::Options;
 use jitterid::estimate::montecarlo::Summary;
-use jitterid_study::experiment::{self, Purpose};
-use jitterid_study::montecarlo::montecarlo_realizations;
+use jitterid_study::experiment::{self, Method, Purpose};
+use jitterid_study::montecarlo::{montecarlo_realizations, Realization, Realizations};
 use serde::Serialize;
 use serde_json::json;
 use std::fmt::Write as _;
@@ -62,45 +62,76 @@ struct Case {
     parameters: Vec<Row>,
 }
 
-fn study(file: &str, runs: u64, seed: u64) -> Result<Case, String> {
+/// One parameter's statistics over the kept runs: its name, truth, estimates and the
+/// standard errors the fits reported (`None` when a kept run reported none).
+pub(crate) struct Kept {
+    pub name: String,
+    pub truth: Option<f64>,
+    pub values: Summary,
+    pub reported: Option<Summary>,
+}
+
+/// The Monte Carlo study of the example experiment `file` (with `method`, or the file's own):
+/// every realisation, and the wall time it took.
+pub(crate) fn realizations(
+    file: &str,
+    method: Option<Method>,
+    runs: u64,
+    seed: u64,
+) -> Result<(Realizations, f64), String> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/experiments")
         .join(file);
-    let exp = experiment::read(&path, Purpose::Estimate(None)).map_err(|e| e.to_string())?;
+    let exp = experiment::read(&path, Purpose::Estimate(method)).map_err(|e| e.to_string())?;
     let t = Instant::now();
     let s = montecarlo_realizations(&exp, runs, seed, None).map_err(|e| e.to_string())?;
-    let seconds = t.elapsed().as_secs_f64();
-    // Every run with estimates: a fit flagged for its residual spectrum is still a fit.
-    let fitted: Vec<(Vec<f64>, &Vec<Option<f64>>)> = s
+    Ok((s, t.elapsed().as_secs_f64()))
+}
+
+/// The statistics of every parameter over the runs `keep` accepts that have every estimate,
+/// and how many runs those are.
+pub(crate) fn kept(s: &Realizations, keep: impl Fn(&Realization) -> bool) -> (usize, Vec<Kept>) {
+    let runs: Vec<(Vec<f64>, &Vec<Option<f64>>)> = s
         .runs
         .iter()
         .zip(&s.stderr)
-        .filter(|(r, _)| !r.termination.starts_with("failed"))
+        .filter(|(r, _)| keep(r))
         .filter_map(|(r, se)| Some((r.values.iter().copied().collect::<Option<Vec<_>>>()?, se)))
         .collect();
-    let parameters = s
+    let rows = s
         .names
         .iter()
         .enumerate()
-        .map(|(i, name)| {
-            let v: Summary = fitted.iter().map(|(v, _)| v[i]).collect();
-            let reported: Option<Summary> = fitted.iter().map(|(_, se)| se[i]).collect();
-            let truth = s.truth[i];
-            Row {
-                name: name.clone(),
-                truth,
-                mean: v.mean,
-                std: v.std(),
-                se: v.se(),
-                reported_std: reported.map(|r| r.mean),
-                bias_se: truth.map(|t| (v.mean - t) / v.se()),
-            }
+        .map(|(i, name)| Kept {
+            name: name.clone(),
+            truth: s.truth[i],
+            values: runs.iter().map(|(v, _)| v[i]).collect(),
+            reported: runs.iter().map(|(_, se)| se[i]).collect(),
+        })
+        .collect();
+    (runs.len(), rows)
+}
+
+fn study(file: &str, runs: u64, seed: u64) -> Result<Case, String> {
+    let (s, seconds) = realizations(file, None, runs, seed)?;
+    // Every run with estimates: a fit flagged for its residual spectrum is still a fit.
+    let (fitted, rows) = kept(&s, |r| !r.termination.starts_with("failed"));
+    let parameters = rows
+        .into_iter()
+        .map(|k| Row {
+            bias_se: k.truth.map(|t| (k.values.mean - t) / k.values.se()),
+            name: k.name,
+            truth: k.truth,
+            mean: k.values.mean,
+            std: k.values.std(),
+            se: k.values.se(),
+            reported_std: k.reported.map(|r| r.mean),
         })
         .collect();
     Ok(Case {
         file: format!("examples/experiments/{file}"),
         runs,
-        fitted: fitted.len(),
+        fitted,
         flagged: s.runs.iter().filter(|r| !r.converged).count(),
         seconds,
         parameters,

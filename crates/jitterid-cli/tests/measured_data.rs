@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{jitterid, scratch_in, stderr, stdout};
+use common::{jitterid, param, scratch_in, stderr, stdout};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -31,20 +31,6 @@ fn json(dir: &Path, args: &[&str], status: i32) -> Value {
     let o = run(dir, args);
     assert_eq!(o.status.code(), Some(status), "{args:?}: {}", stderr(&o));
     serde_json::from_str(&stdout(&o)).unwrap_or_else(|e| panic!("{args:?}: {e}"))
-}
-
-/// A fit's estimate and standard error of `name`.
-fn param(fit: &Value, name: &str) -> (f64, f64) {
-    let p = fit["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|p| p["name"] == name)
-        .unwrap_or_else(|| panic!("no {name} in {fit}"));
-    (
-        p["estimate"].as_f64().unwrap(),
-        p["stderr"].as_f64().unwrap_or(f64::NAN),
-    )
 }
 
 /// The page's `awk` line: `y − offset`, printed with 17 significant digits (the same `f64`).
@@ -315,4 +301,33 @@ fn select_fit_validate_export_recover_the_generator() {
         ),
         "-0.602 0.799"
     );
+}
+
+/// The page's other way: the offset estimated with the system (`--set
+/// output.estimate_offset=true`, the key the note names) converges where the fit without it
+/// stopped, finds the sensor's bias of 0.3 within its standard error, and leaves no note.
+#[test]
+fn the_offset_estimated_with_the_system_is_the_sensor_bias() {
+    let dir = guide_dir("offset-estimated");
+    let first = stdout(&run(&dir, &["fit", "model.toml", "--data", "record.csv"]));
+    assert!(
+        first.contains("--set output.estimate_offset=true"),
+        "{first}"
+    );
+    let v = json(
+        &dir,
+        &[
+            "fit",
+            "model.toml",
+            "--data",
+            "record.csv",
+            "--set",
+            "output.estimate_offset=true",
+            "--json",
+        ],
+        0,
+    );
+    let (est, se) = param(&v, "offset");
+    assert!((est - 0.3).abs() < 3.0 * se, "offset {est} ± {se}");
+    assert!(v["notes"]["offset"].is_null(), "{v}");
 }

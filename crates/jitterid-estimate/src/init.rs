@@ -98,6 +98,12 @@ pub struct InitOptions {
     pub tolerance: f64,
     /// Include the jitter's damping `γ(−f)` of the structure's jitter model. Default true.
     pub compensate_jitter: bool,
+    /// The record has an unknown output offset `y₀` (an operating point): leave out the bin
+    /// `f = 0`, the only DFT bin a constant reaches (it adds `N y₀` there and nothing at
+    /// `j/(NT)`, `j ≠ 0`), so that the model is fitted to the bins the offset leaves alone.
+    /// The offset's own start is then [`offset_start`]. Default false.
+    #[serde(default)]
+    pub offset: bool,
 }
 
 impl Default for InitOptions {
@@ -107,6 +113,7 @@ impl Default for InitOptions {
             iterations: 30,
             tolerance: 1e-10,
             compensate_jitter: true,
+            offset: false,
         }
     }
 }
@@ -250,6 +257,21 @@ where
     Ok(out)
 }
 
+/// The start of an output offset `y₀` for a model whose response (without the offset) is
+/// `response`: `mean(y) − mean(m_k)` with `m_k = E[s(t_k + τ)]` under `jitter`, the value that
+/// zeroes the residuals' mean, which is the least-squares offset for the response held (time
+/// domain) and the one that fits the bin `f = 0` exactly (frequency domain, where the offset
+/// adds `N y₀`).
+pub fn offset_start<S: jitterid_signal::Signal + ?Sized>(
+    response: &S,
+    record: &Record,
+    jitter: &dyn JitterModel,
+) -> f64 {
+    let m = response.expected_values(record.grid(), jitter);
+    let n = record.y().len().max(1) as f64;
+    record.y().iter().zip(&m).map(|(y, m)| y - m).sum::<f64>() / n
+}
+
 /// The linear frequency-response fit with `m` zeros and `n` poles; see the module docs.
 ///
 /// # Errors
@@ -286,9 +308,11 @@ pub fn fit_rational(
         }
     };
     // Bins 0..=last: `last` from the band, raised until the equations suffice, capped at N/2.
+    let first = usize::from(options.offset);
     let equations = |last: usize| {
         let nyquist = len % 2 == 0 && last == len / 2 && last > 0;
-        2 * (last + 1) - 1 - usize::from(nyquist)
+        // One real equation at 0 Hz (left out with an offset) and at Nyquist, two elsewhere.
+        (2 * (last + 1) - 1 - usize::from(nyquist)).saturating_sub(first)
     };
     let mut last = ((f_max * len as f64 * t).floor() as usize).min(len / 2);
     while equations(last) < unknowns + 1 && last < len / 2 {
@@ -312,7 +336,7 @@ pub fn fit_rational(
     let t_b = t_a + len as f64 * t;
     let omega_n = TAU * freqs[last];
     let mut bins = Vec::with_capacity(freqs.len());
-    for (j, &f) in freqs.iter().enumerate() {
+    for (j, &f) in freqs.iter().enumerate().skip(first) {
         let damp = jitter.map_or(Complex64::new(1.0, 0.0), |g| g.cf(f).conj());
         let u = damp * windowed_input(input, t_a, t_b, t0, f) / t;
         let e = Complex64::from_polar(1.0 / t, PI * f * t);
@@ -737,7 +761,7 @@ fn match_kinds(template: &[Root], roots: &[Complex64]) -> Vec<Root> {
 mod tests {
     use super::*;
     use jitterid_jitter::UniformSum;
-    use jitterid_signal::{simulate, RandomBinary, SampleGrid, Signal};
+    use jitterid_signal::{simulate, PiecewiseConstant, RandomBinary, SampleGrid, Signal};
     use rand::SeedableRng;
 
     fn paper() -> Zpk {
@@ -749,8 +773,8 @@ mod tests {
         .unwrap()
     }
 
-    #[test]
-    fn recovers_the_paper_system_from_its_exact_mean() {
+    /// The paper's input (seed 11), jitter and grid, and the exact mean `m_k` of its system.
+    fn exact_mean() -> (PiecewiseConstant, UniformSum, SampleGrid, Vec<f64>) {
         let mut rng = rand::rngs::StdRng::seed_from_u64(11);
         let u = RandomBinary::paper()
             .generate(0.0, 201.0, &mut rng)
@@ -758,6 +782,12 @@ mod tests {
         let jitter = UniformSum::new(2, 0.5 / 3f64.sqrt()).unwrap();
         let grid = SampleGrid::new(0.0, 1.0, 200).unwrap();
         let m = LtiResponse::new(paper(), u.clone()).expected_values(&grid, &jitter);
+        (u, jitter, grid, m)
+    }
+
+    #[test]
+    fn recovers_the_paper_system_from_its_exact_mean() {
+        let (u, jitter, grid, m) = exact_mean();
         let record = Record::new(grid, m).unwrap();
         let template = Zpk::new(
             1.0,
@@ -832,5 +862,55 @@ mod tests {
         for (got, want) in g.params().iter().zip([0.2, 0.1, 0.5, 0.1525]) {
             assert!((got - want).abs() < 0.15 * want, "{:?}", g.params());
         }
+    }
+
+    /// With `offset`, the fit leaves out the bin `f = 0`, the only one a constant reaches: the
+    /// exact mean moved by `y₀ = 3` gives the model of the unmoved mean (to the rounding of the
+    /// DTFT, `y₀ N ε`), and [`offset_start`] of that model gives back `y₀`.
+    #[test]
+    fn an_offset_leaves_the_model_and_is_started_from_the_mean() {
+        let (u, jitter, grid, m) = exact_mean();
+        let moved: Vec<f64> = m.iter().map(|v| v + 3.0).collect();
+        let options = InitOptions {
+            offset: true,
+            ..InitOptions::default()
+        };
+        let input: Input = u.into();
+        let fit = |y: Vec<f64>| {
+            let record = Record::new(grid, y).unwrap();
+            let g = initial_model(&paper(), &record, &input, Some(&jitter), &options).unwrap();
+            (g, record)
+        };
+        let (plain, _) = fit(m);
+        let (g, record) = fit(moved);
+        for (a, b) in g.params().iter().zip(plain.params()) {
+            assert!(
+                (a - b).abs() < 1e-8,
+                "{:?} vs {:?}",
+                g.params(),
+                plain.params()
+            );
+        }
+        for (got, want) in g.params().iter().zip([0.2, -0.5, -0.25, 0.3]) {
+            assert!(
+                (got - want).abs() < 0.05 * f64::abs(want),
+                "{:?}",
+                g.params()
+            );
+        }
+        let truth = LtiResponse::new(paper(), input.clone());
+        assert!((offset_start(&truth, &record, &jitter) - 3.0).abs() < 1e-12);
+        // Without the option the bin f = 0 pulls the model towards the offset.
+        let record = Record::new(grid, record.y().to_vec()).unwrap();
+        let pulled = initial_model(
+            &paper(),
+            &record,
+            &input,
+            Some(&jitter),
+            &InitOptions::default(),
+        )
+        .unwrap();
+        let moved_by = (pulled.params()[0] - g.params()[0]).abs();
+        assert!(moved_by > 1e-3, "{:?}", pulled.params());
     }
 }

@@ -94,7 +94,8 @@ pub use fit_criterion::{fit, fit_profile, FitCriterion};
 pub use flatness::{residual_flatness, FLATNESS_BANDS, FLATNESS_LIMIT, FLATNESS_MIN_PER_BAND};
 pub use frequency_data::FrequencyData;
 pub use init::{
-    fit_rational, initial_model, initialize, InitError, InitOptions, InitialModel, RationalFit,
+    fit_rational, initial_model, initialize, offset_start, InitError, InitOptions, InitialModel,
+    RationalFit,
 };
 pub use jitter_floor::{mean_jitter_variance, JITTER_FLOOR_ROUNDS};
 /// The optimisation layer (`jitterid-optim`): objectives, least squares, solvers.

@@ -26,6 +26,8 @@
 //! * [`Delayed`]: an LTI response to its input delayed by a dead time `D` (a parameter).
 //! * [`WithInitialState`]: a response plus the free response from an unknown state at the
 //!   record's start.
+//! * [`Offset`]: a signal plus a constant output offset `y₀` (an operating point), known or
+//!   the parameter `offset`.
 //! * [`Sinusoid`]: `A sin(2πf0 t + φ)` with parameters `(A, f0, φ)`, spectral lines only.
 //! * [`PulseResponse`]: a discrete-time pulse response `g(t) = Σ h_l δ(t − lT_s)` driven by a
 //!   piecewise-constant input.
@@ -50,6 +52,7 @@ mod initial;
 mod input;
 mod integrators;
 mod lti;
+mod offset;
 pub mod poly;
 mod pulse;
 mod rational;
@@ -70,6 +73,7 @@ pub use grid::SampleGrid;
 pub use initial::{ModalSignal, WithInitialState, INITIAL_PREFIX};
 pub use input::{Input, Multisine, PiecewiseConstant, RandomBinary, Tone, MAX_SWITCHES};
 pub use lti::{LtiResponse, ModalState};
+pub use offset::{Offset, OFFSET_PARAM};
 pub use pulse::PulseResponse;
 pub use rational::{Modal, Rational, RationalModel, TransferFunction};
 pub use root::Root;

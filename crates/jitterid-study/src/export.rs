@@ -1,7 +1,8 @@
 //! The fitted model taken out of the command line: transfer-function coefficients, zeros,
 //! poles and gain, and a state-space realisation (`fit --json`'s `model`), with the input
-//! delay `D` of a delayed system (the model is `G(s) e^{−sD}`), and the covariance of the
-//! reported parameters.
+//! delay `D` of a delayed system (the model is `G(s) e^{−sD}`), the output offset `y₀` of a
+//! model around an operating point (`y = y₀ + G(s)u`), and the covariance of the reported
+//! parameters.
 
 use jitterid::estimate::validation::{BodePoint, StepPoint};
 use jitterid::estimate::{validation, EstimateError};
@@ -24,6 +25,19 @@ pub struct ModelForms {
     /// three forms above (absent without a delay).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub delay: Option<f64>,
+    /// The output offset `y₀` of a model around an operating point: the model is
+    /// `y = y₀ + G(s)u` (in state space `ẋ = Ax + Bu`, `y = Cx + Du + y₀`), reported beside the
+    /// three forms because none of them has a constant term (absent without an offset).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<f64>,
+}
+
+/// The output offset `y₀` of a signal around an operating point, `None` when it has none.
+pub fn offset_of(signal: &AnySignal) -> Option<f64> {
+    signal
+        .spec()
+        .get("offset")
+        .and_then(serde_json::Value::as_f64)
 }
 
 /// The input delay `D` (s) of a signal's system, `None` when it has none.
@@ -109,6 +123,7 @@ pub fn model_forms(signal: &AnySignal) -> Result<Option<ModelForms>, SignalError
         ss: tf.to_state_space(),
         tf,
         delay: delay_of(signal),
+        offset: offset_of(signal),
     }))
 }
 

@@ -50,6 +50,65 @@ pub fn signal_of(exp: &Experiment, input: Option<&Input>) -> StudyResult<AnySign
         .map_err(|e| study_err!("[system]: {e}"))
 }
 
+/// `signal` with its estimated output offset started from `record`: `mean(y) − mean(m_k)` for
+/// the response without the offset under the experiment's jitter model
+/// ([`jitterid::estimate::offset_start`]), the start a data-driven fit (`--init auto`) gives
+/// the offset beside the initializer's system. A signal without an estimated offset is
+/// returned unchanged.
+///
+/// # Errors
+///
+/// The signal does not rebuild without its offset (it was built by the same registry, so
+/// only a registry that lost its kind fails), or the start is not finite (non-finite data).
+pub fn with_offset_start(
+    exp: &Experiment,
+    signal: &AnySignal,
+    input: Option<&Input>,
+    y: &[f64],
+) -> StudyResult<AnySignal> {
+    let mut spec = signal.spec();
+    if spec.get("estimate_offset") != Some(&serde_json::Value::Bool(true)) {
+        return Ok(signal.clone());
+    }
+    let mut bare = spec.clone();
+    bare.remove("offset");
+    bare.remove("estimate_offset");
+    let build = |spec: &jitterid::signal::registry::SpecTable| {
+        exp.registries
+            .signal
+            .build(spec, input)
+            .map_err(|e| study_err!("[output] offset: the start's model: {e}"))
+    };
+    let response = build(&bare)?;
+    let record = record(&exp.grid, y.to_vec()).map_err(|e| study_err!("[output] offset: {e}"))?;
+    let y0 = jitterid::estimate::offset_start(&response, &record, &exp.jitter.model);
+    if !y0.is_finite() {
+        return Err(study_err!(
+            "[output] offset: the record gives no finite start for the offset"
+        ));
+    }
+    spec.insert("offset".into(), serde_json::json!(y0));
+    build(&spec)
+}
+
+/// The data-driven start of `fit --init auto`: the initializer's system
+/// ([`crate::select::auto_start`]), then its output offset ([`with_offset_start`]); `data`
+/// names the record in messages.
+///
+/// # Errors
+///
+/// Those of the two steps.
+pub fn data_start(
+    exp: &Experiment,
+    signal: &AnySignal,
+    input: Option<&Input>,
+    y: &[f64],
+    data: &str,
+) -> StudyResult<AnySignal> {
+    let signal = crate::select::auto_start(exp, signal, input, y, data)?;
+    with_offset_start(exp, &signal, input, y)
+}
+
 /// The model structure for `signal` as the experiment says (free parts, noise, method).
 pub fn structure(exp: &Experiment, signal: AnySignal, method: Method) -> StudyResult<Structure> {
     let shape_free = exp.noise.estimate

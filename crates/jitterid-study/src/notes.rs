@@ -14,7 +14,8 @@
 //! - **An output offset.** The model's expected samples have no constant term: a DC offset in
 //!   `y` puts a bias into every residual, which the flatness check then reports as a residual
 //!   spectrum that is not flat (its power sits in the lowest band). A t-test of the residuals'
-//!   mean against their standard deviation names it.
+//!   mean against their standard deviation names it, and the note names the key that estimates
+//!   the offset with the system (`[output] estimate_offset = true`).
 
 use crate::fit::{Fit, Structure};
 use jitterid::estimate::NoiseModel;
@@ -72,7 +73,7 @@ impl Notes {
         }
         if let Some(o) = &self.offset {
             out.push(format!(
-                "note: the output probably has an offset the model lacks, about {:.4e} (residual mean test t = {:.2}, p = {:.1e}, residual std {:.4e}): subtract it (or the output's level at rest) from y and fit again",
+                "note: the output probably has an offset the model lacks, about {:.4e} (residual mean test t = {:.2}, p = {:.1e}, residual std {:.4e}): estimate it with the system ([output] estimate_offset = true, or --set output.estimate_offset=true), or subtract it (or the output's level at rest) from y and fit again",
                 o.estimate, o.t, o.p_value, o.std
             ));
         }

@@ -297,13 +297,15 @@ pub fn validation_grid(
 
 /// The system's part of a signal's parameter covariance, `G`'s parameters then the delay: its
 /// leading block, since a signal lists the system's own parameters first (then `delay`, then
-/// the `initial.*` coefficients of a free response, on which `G e^{−sD}` does not depend).
-/// `None` without a covariance.
+/// the `initial.*` coefficients of a free response and the output `offset`, on which
+/// `G e^{−sD}` does not depend). `None` without a covariance.
 fn system_covariance(s: &Structure, cov: Option<&[Vec<f64>]>) -> Option<Vec<Vec<f64>>> {
     let names = s.signal.param_names();
     let p = names
         .iter()
-        .take_while(|n| !n.starts_with(validation::INITIAL_PREFIX))
+        .take_while(|n| {
+            !n.starts_with(validation::INITIAL_PREFIX) && *n != jitterid::signal::OFFSET_PARAM
+        })
         .count();
     let cov = cov?;
     (cov.len() >= p && cov.iter().take(p).all(|r| r.len() >= p))

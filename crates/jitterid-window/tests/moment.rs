@@ -421,3 +421,41 @@ proptest! {
         prop_assert!(worst < 1e-10);
     }
 }
+
+/// An output offset `y₀` is a line at `f = 0`: route (a) takes it in closed form
+/// (`y₀ γ(0) Γ_N(f)`), route (b) as `y₀ + m_k`; they agree on and off the DFT grid, and on the
+/// DFT grid the offset moves only the bin `f = 0`, by `N y₀`.
+#[test]
+fn routes_agree_on_an_output_offset() {
+    let jitter = Gaussian::new(0.1).unwrap();
+    let options = IntegralOptions::default();
+    for grid in grids(64) {
+        let pulse = ExpPulse {
+            alpha: 0.3,
+            start: grid.start() + 2.5,
+            len: 40.0,
+        };
+        let y0 = 0.75;
+        let moved = jitterid_signal::Offset::new(pulse.clone(), y0, true).unwrap();
+        for freqs in [FrequencySet::dft(&grid), off_grid(&grid)] {
+            let worst = compare(
+                "gaussian, pulse + offset",
+                &moved,
+                &jitter,
+                &grid,
+                &DirichletWindow,
+                &freqs,
+                &options,
+            );
+            assert!(worst < 1e-10, "{worst:e}");
+        }
+        let dft = FrequencySet::dft(&grid);
+        let with = first_moment(&moved, &jitter, &grid, &DirichletWindow, &dft);
+        let without = first_moment(&pulse, &jitter, &grid, &DirichletWindow, &dft);
+        let n = grid.len() as f64;
+        for (j, (a, b)) in with.iter().zip(&without).enumerate() {
+            let want = if j == 0 { n * y0 } else { 0.0 };
+            assert!(((a - b).re - want).abs() < 1e-12 * n && (a - b).im.abs() < 1e-12 * n);
+        }
+    }
+}

@@ -15,7 +15,7 @@ use jitterid_study::fit::{self, fit_json_noted, fit_record, Fit};
 use jitterid_study::joint::{fit_joint, read_records};
 use jitterid_study::notes::{status, Notes};
 use jitterid_study::records::{read_data, read_data_and_tau, read_experiment, read_input};
-use jitterid_study::select::{auto_start, InitChoice};
+use jitterid_study::select::InitChoice;
 use jitterid_study::study_err;
 use jitterid_study::validate::{frequency_response, signal_covariance, step};
 use jitterid_study::Watch;
@@ -78,7 +78,7 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let input = read_input(&exp, data_file, o.input.as_deref())?;
     let mut signal = fit::signal_of(&exp, input.as_ref())?;
     if o.init == InitChoice::Auto {
-        signal = auto_start(&exp, &signal, input.as_ref(), record.y(), &name)?;
+        signal = fit::data_start(&exp, &signal, input.as_ref(), record.y(), &name)?;
     }
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let watch = Watch {
@@ -282,6 +282,13 @@ fn fit_text(exp: &Experiment, f: &Fit, notes: &Notes, name: &str, plot: Option<&
             out,
             "model: G(s) e^(-sD) with input delay D = {} s (the parameter delay; --json: model.zpk, model.tf, model.ss give G, model.delay gives D)",
             fmt_num(d)
+        );
+    }
+    if let (Some(y0), Ok(Some(_))) = (export::offset_of(&f.fitted.signal), &tf) {
+        let _ = writeln!(
+            out,
+            "model: y = y0 + G(s)u with output offset y0 = {} (--json: model.offset; model.ss is x' = Ax + Bu, y = Cx + Du + y0)",
+            fmt_num(y0)
         );
     }
     for line in notes.lines() {

@@ -46,6 +46,7 @@ pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
         None,
         o.time_limit,
     )?;
+    exp.selectable()?;
     let selection = run_selection(&exp, &o.data, o.validation.as_deref())?;
     let (ranked, fits) = (&selection.ranked, &selection.validation_fits);
     let status = Status::of_convergence(ranked.first().is_some_and(|c| c.converged), false);

@@ -99,3 +99,18 @@ pub fn simulate_text(group: &str, name: &str, text: &str) -> (Output, PathBuf) {
         .unwrap();
     (o, out)
 }
+
+/// A fit's estimate and standard error of the parameter `name` (`fit --json`'s
+/// `parameters`); the standard error is NaN where the fit reports none.
+pub fn param(fit: &serde_json::Value, name: &str) -> (f64, f64) {
+    let p = fit["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {fit}"));
+    (
+        p["estimate"].as_f64().unwrap(),
+        p["stderr"].as_f64().unwrap_or(f64::NAN),
+    )
+}

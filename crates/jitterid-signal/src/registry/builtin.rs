@@ -2,8 +2,8 @@
 
 use super::{KindReader, ParamSpec, SignalKind, SignalRegistry, SpecReader, SpecTable};
 use crate::{
-    AnySignal, Delayed, Input, LtiResponse, PulseResponse, RationalModel, Root, SignalError,
-    Sinusoid, TransferFunction, WithInitialState, Zpk,
+    AnySignal, Delayed, Input, LtiResponse, Offset, PulseResponse, RationalModel, Root,
+    SignalError, Sinusoid, TransferFunction, WithInitialState, Zpk,
 };
 use serde_json::{json, Value};
 
@@ -252,12 +252,70 @@ fn response_keys() -> Vec<ParamSpec> {
             "finite",
         )
         .with_default(0.0),
+        ParamSpec::new(
+            "offset",
+            "output offset y₀ (operating point): the model is y₀ + the response",
+            "",
+            "optional; finite (absent: no offset)",
+        ),
+        ParamSpec::new(
+            "estimate_offset",
+            "whether y₀ is estimated, the parameter `offset` (true), or known (false, the default)",
+            "",
+            "optional; true or false",
+        ),
     ]
+}
+
+/// `signal` plus the spec table's output offset, when it has `offset` or `estimate_offset`
+/// (else `signal` unchanged: no wrapper, no parameter, every number as before). The wrapped
+/// signal writes back the inner signal's keys and the two offset keys.
+fn with_offset(
+    kind: &'static str,
+    r: &SpecReader<'_>,
+    signal: AnySignal,
+) -> Result<AnySignal, SignalError> {
+    if !r.has("offset") && !r.has("estimate_offset") {
+        return Ok(signal);
+    }
+    let offset = if r.has("offset") {
+        r.f64("offset")?
+    } else {
+        0.0
+    };
+    let estimated = r.flag("estimate_offset")?;
+    let spectrum = signal.has_spectrum();
+    let wrapped = Offset::new(signal, offset, estimated).map_err(|e| r.invalid("offset", e))?;
+    let to_spec = |s: &Offset<AnySignal>| {
+        let mut out = s.signal().spec();
+        out.remove(super::KIND_KEY);
+        out.insert("offset".into(), json!(s.offset()));
+        if s.estimated() {
+            out.insert("estimate_offset".into(), json!(true));
+        }
+        out
+    };
+    Ok(if spectrum {
+        AnySignal::with_spectrum(kind, wrapped, to_spec)
+    } else {
+        AnySignal::new(kind, wrapped, to_spec)
+    })
 }
 
 /// `response`, delayed and given a free response as the spec table asks, with `keys` writing
 /// the model's keys back.
 fn lti_signal<M: RationalModel + Clone + 'static>(
+    kind: &'static str,
+    r: &SpecReader<'_>,
+    response: LtiResponse<M>,
+    keys: fn(&M) -> SpecTable,
+) -> Result<AnySignal, SignalError> {
+    with_offset(kind, r, lti_response(kind, r, response, keys)?)
+}
+
+/// `response`, delayed and given a free response as the spec table asks (without the output
+/// offset, which [`with_offset`] adds around it).
+fn lti_response<M: RationalModel + Clone + 'static>(
     kind: &'static str,
     r: &SpecReader<'_>,
     response: LtiResponse<M>,

@@ -15,7 +15,9 @@
 //! `zpk` and `tf` also take `delay` (s, ≥ 0: an input delay, the parameter `delay`; see
 //! [`Delayed`](crate::Delayed)) and `initial` (one value per pole: the free response from an
 //! unknown state at `origin`, default 0, parameters `initial.j`; see
-//! [`WithInitialState`](crate::WithInitialState)), each a parameter only when given.
+//! [`WithInitialState`](crate::WithInitialState)), each a parameter only when given, and
+//! `offset` with `estimate_offset` (an output offset `y₀` added to the response, the parameter
+//! `offset` when `estimate_offset = true`; see [`Offset`](crate::Offset)).
 //!
 //! A root (in `zeros`, `poles`) is a number (a real root) or `[re, im]` with `im > 0` (the pair
 //! `re ± i·im`). Errors name the offending key ([`SignalError::key`]).

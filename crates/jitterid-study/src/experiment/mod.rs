@@ -131,6 +131,45 @@ pub fn parse_edited(
     }
 }
 
+/// An estimated output offset `y₀` must be seen by a frequency-domain criterion. Its first
+/// moment is `y₀ Γ_N(f)`: `N y₀` at `f = 0` and exactly zero at every other point of the DFT
+/// grid `j/(NT)`, so a frequency set without `f = 0` whose points all lie on that grid (a band
+/// above 0, a list of nonzero grid points) leaves the offset without information and its
+/// estimate arbitrary. Such a set is refused, naming `[output] estimate_offset` (the choice
+/// that needs `f = 0`), rather than fitting the offset to nothing or estimating it outside the
+/// criterion. A list with a point off the grid sees the offset through the window's leakage.
+fn offset_seen(
+    cx: &diagnostics::Source,
+    raw: &RawExperiment,
+    system: &SystemSpec,
+    frequencies: &Frequencies,
+    grid: &jitterid::signal::SampleGrid,
+) -> StudyResult<()> {
+    if system.kind.get("estimate_offset") != Some(&serde_json::Value::Bool(true)) {
+        return Ok(());
+    }
+    let n = grid.len() as f64;
+    let nonzero_bin = |f: &f64| {
+        let j = f * n * grid.interval();
+        (j - j.round()).abs() <= 1e-9 * n && j.round().rem_euclid(n) != 0.0
+    };
+    let blind = match frequencies {
+        Frequencies::Dft => false,
+        Frequencies::Band { min, .. } => *min > 0.0,
+        Frequencies::List(f) => f.iter().all(nonzero_bin),
+    };
+    if !blind {
+        return Ok(());
+    }
+    let key = raw.output.as_ref().and_then(|o| o.estimate_offset.as_ref());
+    Err(cx.err_at(
+        "output",
+        "estimate_offset",
+        key,
+        "an estimated offset is seen only at f = 0 by the frequency-domain criterion, and [estimate] frequencies leaves f = 0 out; include it (frequencies = \"dft\", or a band from 0) or use method = \"ml\"",
+    ))
+}
+
 /// The text of the experiment file at `path`, read as every front end reads it: only a regular
 /// file of at most [`csvio::MAX_FILE_BYTES`] (a device such as `/dev/zero` or a pipe is refused
 /// before it is read), and only UTF-8 text.
@@ -199,7 +238,8 @@ pub fn parse_with(
         )
     })?;
     let grid = sampling::parse_sampling(&cx, r_sampling)?;
-    let system = system::parse_system(&cx, r_system, &grid)?;
+    let mut system = system::parse_system(&cx, r_system, &grid)?;
+    system::output_keys(&cx, raw.output.as_ref(), &mut system)?;
     let (input, history) = input::parse_input_section(&cx, raw.input.as_ref(), &system, &grid)?;
     if let (Some(d), InputSpec::Known(Input::Tones(_))) = (&r_system.delay, &input) {
         // A tone's delay is a phase: the delayed response needs an input made of steps.
@@ -245,6 +285,9 @@ pub fn parse_with(
             noise: &noise,
         };
         method::check_method(&cx, &raw, &parts, estimate.method, chosen.is_some())?;
+        if !estimate.method.is_likelihood_in(&registries.criteria) {
+            offset_seen(&cx, &raw, &system, &estimate.frequencies, &grid)?;
+        }
     }
     let select = match &raw.select {
         Some(r) => Some(select::parse_select(&cx, r, grid.len())?),

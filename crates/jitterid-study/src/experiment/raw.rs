@@ -73,6 +73,11 @@ section!(RawSystem, "table [system]" {
     integrators: i64,
 });
 
+section!(RawOutput, "table [output]" {
+    offset: f64,
+    estimate_offset: bool,
+});
+
 section!(RawNoise, "table [noise]" {
     std: f64,
     model: String,
@@ -111,6 +116,8 @@ pub(super) struct RawExperiment {
     #[serde(default)]
     pub(super) jitter: Option<RawTable>,
     #[serde(default)]
+    pub(super) output: Option<RawOutput>,
+    #[serde(default)]
     pub(super) noise: Option<RawNoise>,
     #[serde(default)]
     pub(super) estimate: Option<RawEstimate>,
@@ -119,7 +126,7 @@ pub(super) struct RawExperiment {
 }
 
 pub(super) const SECTIONS: &[&str] = &[
-    "title", "sampling", "input", "system", "jitter", "noise", "estimate", "select",
+    "title", "sampling", "input", "system", "output", "jitter", "noise", "estimate", "select",
 ];
 
 pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
@@ -127,9 +134,34 @@ pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
         "sampling" => RawSampling::KEYS,
         "input" => RawInput::KEYS,
         "system" => RawSystem::KEYS,
+        "output" => RawOutput::KEYS,
         "noise" => RawNoise::KEYS,
         "estimate" => RawEstimate::KEYS,
         "select" => RawSelect::KEYS,
         _ => SECTIONS,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RawOutput;
+
+    /// The `[output]` table of `docs/experiments.md` lists exactly the keys the reader takes,
+    /// in order: the reference cannot drift from the reader.
+    #[test]
+    fn the_docs_output_table_lists_the_reader_s_keys() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
+        let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
+        let start = text
+            .find("### `[output]`")
+            .expect("docs/experiments.md has an [output] section");
+        let keys: Vec<&str> = text[start..]
+            .lines()
+            .skip_while(|l| !l.starts_with("| key |"))
+            .skip(2)
+            .take_while(|l| l.starts_with('|'))
+            .filter_map(|l| l.split('`').nth(1))
+            .collect();
+        assert_eq!(keys, RawOutput::KEYS);
     }
 }

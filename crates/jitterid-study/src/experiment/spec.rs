@@ -316,3 +316,30 @@ pub struct Experiment {
     /// The `[select]` grid of model orders and jitter families, when the file has one.
     pub select: Option<jitterid::estimate::selection::SelectionGrid>,
 }
+
+impl Experiment {
+    /// The output offset of `[output]`: `(y₀, estimated)`, `None` without one (the system's
+    /// spec table holds it as the keys `offset` and `estimate_offset`).
+    pub fn output_offset(&self) -> Option<(f64, bool)> {
+        let y0 = self.system.kind.get("offset")?.as_f64()?;
+        let estimated = self.system.kind.get("estimate_offset") == Some(&true.into());
+        Some((y0, estimated))
+    }
+
+    /// Whether `select` can run this experiment: its candidates are built from the `[select]`
+    /// orders with the system's delay and free response, and do not carry an output offset
+    /// yet, so an experiment with one is refused rather than ranked without it.
+    ///
+    /// # Errors
+    ///
+    /// One line naming `[output]` when the experiment has an output offset.
+    pub fn selectable(&self) -> crate::error::StudyResult<()> {
+        match self.output_offset() {
+            None => Ok(()),
+            Some(_) => Err(crate::study_err!(
+                "{}: [output]: select does not carry an output offset into its candidates yet; fit the record with the offset (jitterid fit), or subtract the offset from y and select without [output]",
+                self.file
+            )),
+        }
+    }
+}

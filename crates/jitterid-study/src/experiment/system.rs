@@ -3,7 +3,7 @@
 use super::checks::{describe, number};
 use super::diagnostics::Source;
 use super::range;
-use super::raw::RawSystem;
+use super::raw::{RawOutput, RawSystem};
 use super::spec::{quoted_list, SystemSpec};
 use crate::error::StudyResult;
 use jitterid::signal::registry::{roots_json, SignalKind, SignalRegistry, SpecTable, KIND_KEY};
@@ -17,8 +17,8 @@ const S: &str = "system";
 const OWN_KEYS: &[&str] = &["estimate"];
 
 /// Keys of a kind's spec table that the command line sets itself: a free response starts at
-/// the record's first instant.
-const SET_HERE: &[&str] = &["origin"];
+/// the record's first instant; the output offset comes from `[output]`.
+const SET_HERE: &[&str] = &["origin", "offset", "estimate_offset"];
 
 /// The keys `[system]` takes for `kind`: `kind`, the kind's registry keys (but those set here)
 /// and the command line's own.
@@ -235,6 +235,69 @@ fn response_keys(
             format!("unknown initial state \"{other}\"; expected \"zero\" or \"estimate\""),
         )),
     }
+}
+
+/// `[output]`: the output offset `y₀` (operating point) and whether it is estimated, written
+/// into the system's spec table as the signal registry reads them (`offset`,
+/// `estimate_offset`). An absent section, or one that leaves both keys out, writes nothing:
+/// the model and every number it gives stay those of the system alone.
+///
+/// The offset is estimated with the system (a parameter of the same signal), so
+/// `estimate_offset = true` needs `[system] estimate = true`.
+pub(super) fn output_keys(
+    cx: &Source,
+    r: Option<&RawOutput>,
+    system: &mut SystemSpec,
+) -> StudyResult<()> {
+    const O: &str = "output";
+    let Some(r) = r else {
+        return Ok(());
+    };
+    let (offset, estimate) = (r.offset.as_ref(), r.estimate_offset.as_ref());
+    let Some((key, span)) = offset
+        .map(|o| ("offset", o.span()))
+        .or_else(|| estimate.map(|e| ("estimate_offset", e.span())))
+    else {
+        return Ok(());
+    };
+    let name = system
+        .kind
+        .get(KIND_KEY)
+        .and_then(Value::as_str)
+        .unwrap_or_default()
+        .to_string();
+    let takes = cx
+        .registries
+        .signal
+        .kind(&name)
+        .is_some_and(|k| k.params().iter().any(|p| p.key == "offset"));
+    if !takes {
+        return Err(cx.err(
+            O,
+            key,
+            &span,
+            format!("the system kind \"{name}\" takes no output offset; expected kind = \"zpk\" or \"tf\""),
+        ));
+    }
+    let y0 = match offset {
+        Some(v) => cx.checked(O, "offset", v, range::level)?,
+        None => 0.0,
+    };
+    let estimated = estimate.is_some_and(|e| *e.get_ref());
+    if estimated && !system.estimate {
+        let span = estimate.map(Spanned::span).unwrap_or_default();
+        return Err(cx.err(
+            O,
+            "estimate_offset",
+            &span,
+            "the offset is estimated with the system; expected [system] estimate = true (or estimate_offset = false)",
+        ));
+    }
+    system.kind.insert("offset".into(), json!(y0));
+    if estimated {
+        system.kind.insert("estimate_offset".into(), json!(true));
+    }
+    Ok(())
 }
 
 /// The number of poles of a zpk spec table (a pair `[re, im]` counts two).

@@ -1,0 +1,239 @@
+//! The output offset `[output]` through the binary: a record simulated by the tool with an
+//! offset is fitted and the offset recovered within the reported standard error; `validate`
+//! and `fit --json`'s `model` carry it; bad `[output]` values exit 2 naming the key.
+
+mod common;
+
+use common::{example, example_with, param, run, s, scratch_in, simulate_text, stderr, stdout};
+use serde_json::Value;
+
+/// Simulates run `run` of `exp` into `dir` and fits it; the fit's JSON.
+fn simulate_and_fit(dir: &std::path::Path, exp: &str, run_no: &str, extra: &[&str]) -> Value {
+    let data = dir.join("d.csv");
+    let o = run(&["simulate", exp, "--run", run_no, "--out", s(&data)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut args = vec!["fit", exp, "--data", s(&data), "--json"];
+    args.extend(extra);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_str(&stdout(&o)).unwrap()
+}
+
+#[test]
+fn a_simulated_offset_is_recovered_within_its_standard_error() {
+    let dir = scratch_in("jitterid-offset", "recovered");
+    let exp = example("offset.toml");
+    let fit = simulate_and_fit(&dir, &exp, "2", &[]);
+    assert_eq!(fit["converged"], true, "{fit}");
+    let (est, se) = param(&fit, "offset");
+    // The reported standard error is that of the Monte Carlo spread within 15 %
+    // (docs/reproduction.md), so 4 standard errors leave a chance of about 6e-5 per run.
+    assert!(se > 0.0 && se < 0.01, "se {se}");
+    assert!(
+        (est - 1.5).abs() < 4.0 * se,
+        "offset {est} ± {se}, truth 1.5"
+    );
+    // The system's parameters are recovered as well (the offset does not take their place).
+    let (e, se) = param(&fit, "pole0.im");
+    assert!((e - 0.3).abs() < 4.0 * se, "pole0.im {e} ± {se}");
+    // The export reports the offset beside the transfer function.
+    assert_eq!(
+        fit["model"]["offset"].as_f64(),
+        Some(est),
+        "{}",
+        fit["model"]
+    );
+}
+
+#[test]
+fn the_naive_fit_sees_the_offset_only_through_the_note_and_the_offset_fit_has_none() {
+    let dir = scratch_in("jitterid-offset", "note");
+    let exp = example("offset.toml");
+    let data = dir.join("d.csv");
+    assert!(run(&["simulate", &exp, "--run", "1", "--out", s(&data)])
+        .status
+        .success());
+    // Fitted without an offset the residuals' mean is flagged and the note names the key.
+    let without = run(&[
+        "fit",
+        &exp,
+        "--data",
+        s(&data),
+        "--set",
+        "output.estimate_offset=false",
+        "--set",
+        "output.offset=0",
+    ]);
+    let text = stdout(&without);
+    assert!(
+        text.contains("[output] estimate_offset = true"),
+        "{text}{}",
+        stderr(&without)
+    );
+    let with = run(&["fit", &exp, "--data", s(&data)]);
+    let text = stdout(&with);
+    assert!(with.status.success(), "{text}{}", stderr(&with));
+    assert!(!text.contains("offset the model lacks"), "{text}");
+    assert!(text.contains("model: y = y0 + G(s)u"), "{text}");
+}
+
+#[test]
+fn validate_uses_the_offset_in_its_residuals() {
+    let dir = scratch_in("jitterid-offset", "validate");
+    let exp = example("offset.toml");
+    let data = dir.join("d.csv");
+    assert!(run(&["simulate", &exp, "--run", "4", "--out", s(&data)])
+        .status
+        .success());
+    let o = run(&["validate", &exp, "--data", s(&data), "--json"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let text = v.to_string();
+    // With the offset in the model the fit explains the record (a model without it would
+    // leave the offset, 1.5, against a response of about 0.4 in the residuals).
+    let fit_percent = find_number(&v, "fit_percent").unwrap_or_else(|| panic!("{text}"));
+    assert!(fit_percent > 90.0, "{fit_percent}: {text}");
+}
+
+/// The first number at `key` anywhere in `v`.
+fn find_number(v: &Value, key: &str) -> Option<f64> {
+    match v {
+        Value::Object(m) => m
+            .get(key)
+            .and_then(Value::as_f64)
+            .or_else(|| m.values().find_map(|x| find_number(x, key))),
+        Value::Array(a) => a.iter().find_map(|x| find_number(x, key)),
+        _ => None,
+    }
+}
+
+/// `simulate` of the offset example with one line replaced: exit 2, one line holding
+/// every one of `expect`, no data written.
+fn refused(name: &str, from: &str, to: &str, expect: &[&str]) {
+    let (o, out) = simulate_text(
+        "jitterid-offset-door",
+        name,
+        &example_with("offset.toml", from, to),
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+    assert!(!out.exists(), "{name}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+    for e in expect {
+        assert!(err.contains(e), "{name}: expected {e:?} in {err}");
+    }
+}
+
+#[test]
+fn bad_output_values_exit_2_naming_the_key() {
+    refused(
+        "nan",
+        "offset = ",
+        "offset = nan",
+        &["[output] offset", "finite"],
+    );
+    refused("inf", "offset = ", "offset = -inf", &["[output] offset"]);
+    refused(
+        "huge",
+        "offset = ",
+        "offset = 1e60",
+        &["[output] offset", "magnitude"],
+    );
+    refused(
+        "string",
+        "offset = ",
+        "offset = \"1.5\"",
+        &["[output] offset"],
+    );
+    refused(
+        "flag",
+        "estimate_offset",
+        "estimate_offset = 1",
+        &["[output] estimate_offset"],
+    );
+    refused(
+        "unknown",
+        "estimate_offset",
+        "estimate_ofset = true",
+        &["[output]", "estimate_ofset"],
+    );
+    refused(
+        "known system",
+        "estimate = true",
+        "estimate = false",
+        &["[output] estimate_offset", "[system] estimate = true"],
+    );
+}
+
+#[test]
+fn a_band_without_f_0_cannot_see_the_offset() {
+    let text = example_with(
+        "offset.toml",
+        "frequencies",
+        "frequencies = { min = 0.01, max = 0.2 }",
+    );
+    let dir = scratch_in("jitterid-offset-door", "band");
+    let exp = dir.join("e.toml");
+    std::fs::write(&exp, &text).unwrap();
+    let data = dir.join("d.csv");
+    assert!(run(&["simulate", s(&exp), "--out", s(&data)])
+        .status
+        .success());
+    let o = run(&["fit", s(&exp), "--data", s(&data)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("[output] estimate_offset"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("f = 0"), "{}", stderr(&o));
+}
+
+#[test]
+fn an_absent_output_table_changes_nothing() {
+    // Table 2 with an `[output]` table that says what the default says: the same numbers.
+    let dir = scratch_in("jitterid-offset", "absent");
+    let plain = example("table2.toml");
+    let explicit = dir.join("e.toml");
+    let text = std::fs::read_to_string(&plain).unwrap() + "\n[output]\n";
+    std::fs::write(&explicit, text).unwrap();
+    let a = simulate_and_fit(&dir, &plain, "0", &[]);
+    let b = simulate_and_fit(&dir, s(&explicit), "0", &[]);
+    assert_eq!(a["parameters"], b["parameters"]);
+    assert!(a["model"].get("offset").is_none());
+}
+
+#[test]
+fn init_auto_starts_the_offset_from_the_record() {
+    // Every start badly wrong, the offset at 0 against a truth of 1.5: the data-driven start
+    // (the initializer's system, then mean(y) − mean(m_k) for the offset) reaches the fit
+    // from the truth.
+    let dir = scratch_in("jitterid-offset", "init-auto");
+    let truth = example("offset.toml");
+    let wrong = std::fs::read_to_string(&truth)
+        .unwrap()
+        .replace("gain = 0.2", "gain = 0.001")
+        .replace("zeros = [-0.5]", "zeros = [-0.01]")
+        .replace("poles = [[-0.25, 0.3]]", "poles = [[-3.0, 0.01]]")
+        .replace("offset = 1.5 ", "offset = 0.0 ");
+    let wrong_path = dir.join("wrong.toml");
+    std::fs::write(&wrong_path, wrong).unwrap();
+    let from_truth = simulate_and_fit(&dir, &truth, "2", &[]);
+    let data = dir.join("d.csv");
+    let o = run(&[
+        "fit",
+        s(&wrong_path),
+        "--data",
+        s(&data),
+        "--init",
+        "auto",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let auto: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    for name in ["gain", "zero0", "pole0.re", "pole0.im", "offset"] {
+        let ((a, se), (b, _)) = (param(&from_truth, name), param(&auto, name));
+        // The same optimum: far within its standard error.
+        assert!((a - b).abs() < 1e-3 * se, "{name}: {a} vs {b} (± {se})");
+    }
+}
