@@ -8,6 +8,7 @@ mod paper;
 mod reproduce;
 mod reproduce_initial;
 mod reproduce_ml;
+mod reproduce_models;
 mod reproduce_select;
 mod reproduce_starts;
 mod reproduce_validate;
@@ -25,7 +26,7 @@ const USAGE: &str = "usage:
   cargo xtask memory [N] [--out DIR]
       peak memory of the release binary's simulate, fit and montecarlo at N samples (default 10^7)
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
-      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate, all";
+      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate, models, all";
 
 /// Options of `reproduce`.
 #[derive(Debug, Clone)]

@@ -81,6 +81,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "initial" => crate::reproduce_initial::initial(o),
         "select" => crate::reproduce_select::select_case(o),
         "validate" => crate::reproduce_validate::validate_case(o),
+        "models" => crate::reproduce_models::models(o),
         "all" => {
             for c in [
                 "table2",
@@ -93,13 +94,14 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
                 "initial",
                 "select",
                 "validate",
+                "models",
             ] {
                 run(c, &Options { json: None, ..o.clone() })?;
             }
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, select, validate, models or all)"
         )),
     }
 }

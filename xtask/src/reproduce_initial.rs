@@ -38,31 +38,31 @@ const CASES: [(&str, &str); 3] = [
 
 /// One parameter's summary over the fitted runs.
 #[derive(Debug, Clone, Serialize)]
-struct Row {
-    name: String,
+pub(crate) struct Row {
+    pub(crate) name: String,
     #[serde(rename = "true")]
-    truth: Option<f64>,
-    mean: f64,
-    std: f64,
-    se: f64,
+    pub(crate) truth: Option<f64>,
+    pub(crate) mean: f64,
+    pub(crate) std: f64,
+    pub(crate) se: f64,
     /// Mean of the standard errors the fits reported.
-    reported_std: Option<f64>,
+    pub(crate) reported_std: Option<f64>,
     /// `(mean − true)/se`.
-    bias_se: Option<f64>,
+    pub(crate) bias_se: Option<f64>,
 }
 
 /// One example file's study.
 #[derive(Debug, Clone, Serialize)]
-struct Case {
-    file: String,
-    runs: u64,
-    fitted: usize,
-    flagged: usize,
-    seconds: f64,
-    parameters: Vec<Row>,
+pub(crate) struct Case {
+    pub(crate) file: String,
+    pub(crate) runs: u64,
+    pub(crate) fitted: usize,
+    pub(crate) flagged: usize,
+    pub(crate) seconds: f64,
+    pub(crate) parameters: Vec<Row>,
 }
 
-fn study(file: &str, runs: u64, seed: u64) -> Result<Case, String> {
+pub(crate) fn study(file: &str, runs: u64, seed: u64) -> Result<Case, String> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/experiments")
         .join(file);
@@ -107,7 +107,7 @@ fn study(file: &str, runs: u64, seed: u64) -> Result<Case, String> {
     })
 }
 
-fn table(rows: &[Row]) -> String {
+pub(crate) fn table(rows: &[Row]) -> String {
     let mut s = String::from(
         "| parameter | true | mean | std | se of mean | mean reported std error | (mean − true)/se |\n|---|---|---|---|---|---|---|\n",
     );
