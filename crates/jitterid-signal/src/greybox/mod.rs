@@ -10,7 +10,7 @@
 //! * **Distinct poles**: the transfer function `C adj(sI − A) B / det(sI − A) + D` with the
 //!   exact derivatives of its coefficients with respect to `θ` (forward-mode
 //!   Faddeev–LeVerrier, `rational.rs`) goes through the modal form of
-//!   [`LtiResponse`](crate::LtiResponse): a grey-box fit then costs what the coefficient fit
+//!   [`LtiResponse`]: a grey-box fit then costs what the coefficient fit
 //!   costs. The augmented realisation below costs 6.5× the modal form for `m_k` and its
 //!   gradient (`docs/performance.md`), which a fit pays at every evaluation.
 //! * **Repeated poles, integrators** (no modal form), and wherever the coefficients cannot be
