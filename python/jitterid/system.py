@@ -34,6 +34,27 @@ class System(SpecTable, _jitterid.System):
         """``N(s)/A(s)`` from coefficients, highest power first."""
         return from_name("tf", num=real_array(num, "num"), den=real_array(den, "den"))
 
+    @staticmethod
+    def grey_box(
+        params: Dict[str, float],
+        a: Any,
+        b: Any,
+        c: Any,
+        d: Any = None,
+        fixed: Optional[Dict[str, float]] = None,
+        bounds: Optional[Dict[str, Any]] = None,
+    ) -> "System":
+        """``ẋ = A(θ)x + B(θ)u, y = C(θ)x + D(θ)u`` with named physical parameters ``params``
+        (``{"m": 1.0, "damp": 0.4, "k": 2.0}``): ``a`` (n×n), ``b`` (n×1), ``c`` (1×n) and ``d``
+        (1×1, default 0) are rows of expressions (``"-k/m"``) or numbers; ``fixed`` names known
+        constants the expressions may use, ``bounds`` gives ``[lo, hi]`` per parameter. A bad
+        expression, shape or value is a ``ValueError`` naming the key and the expression."""
+        keys: Dict[str, Any] = {"params": params, "a": a, "b": b, "c": c}
+        for key, value in (("d", d), ("fixed", fixed), ("bounds", bounds)):
+            if value is not None:
+                keys[key] = value
+        return from_name("grey-box", **keys)
+
     @property
     def names(self) -> List[str]:
         """Names of the parameters, in the estimator's order."""
@@ -50,7 +71,8 @@ class System(SpecTable, _jitterid.System):
         return System.zpk(z, p, k)
 
     def to_ss(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """The controllable canonical realisation ``(A, B, C, D)``."""
+        """A realisation ``(A, B, C, D)``: a grey-box system's own matrices at its parameters,
+        the controllable canonical form of the others."""
         return self.state_space()
 
     def to_control(self, pade_order: Optional[int] = None) -> Any:

@@ -6,6 +6,7 @@ use crate::arrays::{finite_complexes, finite_reals, map_reals};
 use crate::errors::{json_text, spec_table, value_error};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{TfForm, ZpkForm};
+use jitterid::signal::greybox::{ExprModel, GreyBox};
 use jitterid::signal::registry::{SignalRegistry, SpecTable};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
 use jitterid_study::export::{delay_of, tf_of};
@@ -159,13 +160,17 @@ impl System {
         ))
     }
 
-    /// The controllable canonical realisation `(A, B, C, D)`: `A` n×n, `B` n×1, `C` 1×n, `D`
-    /// 1×1.
+    /// A state-space realisation `(A, B, C, D)`: `A` n×n, `B` n×1, `C` 1×n, `D` 1×1; a
+    /// grey-box model's own matrices at its parameters, the controllable canonical form of
+    /// other rational systems.
     fn state_space<'py>(
         &self,
         py: Python<'py>,
     ) -> PyResult<(Matrix<'py>, Matrix<'py>, Matrix<'py>, Matrix<'py>)> {
-        let ss = self.rational()?.to_state_space();
+        let ss = match self.model.downcast::<GreyBox<ExprModel>>() {
+            Some(g) => g.state_space(),
+            None => self.rational()?.to_state_space(),
+        };
         let n = ss.order();
         let a = Array2::from_shape_fn((n, n), |(i, j)| ss.a()[i][j]);
         let b = Array2::from_shape_fn((n, 1), |(i, _)| ss.b()[i]);

@@ -6,7 +6,7 @@
 //! "std", "se", "mean_stderr"}]}`: `std` is the spread of the estimates over the converged
 //! runs, `se` the mean of the standard errors the fits reported, `mean_stderr` the Monte Carlo
 //! standard error of the mean (`std/√converged`). A case is one row of [`CASES`]; another model
-//! (several inputs, grey box) adds its file and method there.
+//! (several inputs) adds its file and method there.
 
 use crate::outputs::write_outputs;
 use crate::paper::RUNS;
@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 
 /// The cases: name, example file, method, what it shows.
-const CASES: [(&str, &str, &str, &str); 2] = [
+const CASES: [(&str, &str, &str, &str); 6] = [
     (
         "offset",
         "offset.toml",
@@ -29,6 +29,30 @@ const CASES: [(&str, &str, &str, &str); 2] = [
         "offset.toml",
         "ml",
         "the same records by exact maximum likelihood",
+    ),
+    (
+        "msd-uniform",
+        "msd-uniform.toml",
+        "bcls",
+        "grey box: a mass–spring–damper in its physical parameters (m, damp, k), uniform-sum jitter",
+    ),
+    (
+        "msd-gaussian",
+        "msd-gaussian.toml",
+        "bcls",
+        "grey box: the mass–spring–damper, Gaussian jitter",
+    ),
+    (
+        "dc-motor-uniform",
+        "dc-motor-uniform.toml",
+        "bcls",
+        "grey box: a DC motor (J, b, K; R and L known), uniform-sum jitter",
+    ),
+    (
+        "dc-motor-gaussian",
+        "dc-motor-gaussian.toml",
+        "bcls",
+        "grey box: the DC motor, Gaussian jitter",
     ),
 ];
 

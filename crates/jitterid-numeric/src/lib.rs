@@ -21,6 +21,10 @@
 //! * [`limits`]: the documented limits on the sizes a caller can ask for (samples, switches,
 //!   tones, poles, sum terms, quadrature nodes, file sizes, realisations), checked where each
 //!   size enters the library;
+//! * [`dual`]: forward-mode derivatives (dual numbers) and the [`Real`](dual::Real) trait a
+//!   model is written over to get them;
+//! * [`expr`]: arithmetic expressions of named parameters, parsed once and evaluated on `f64`
+//!   or on dual numbers (the matrices of a grey-box model written in an experiment file);
 //! * [`budget`]: the wall-clock budget and cancel flag that every long loop checks;
 //! * [`validate`]: the validators of a constructor's real parameters (`finite`, `positive`,
 //!   `non_negative`), whose error names the parameter.
@@ -45,6 +49,8 @@ pub mod budget;
 pub mod chebyshev;
 pub mod clenshaw_curtis;
 pub mod complex;
+pub mod dual;
+pub mod expr;
 pub mod filon;
 pub mod gauss;
 pub mod limits;

@@ -102,6 +102,12 @@ impl AnySignal {
         self.0.model()
     }
 
+    /// The model inside as its own type, when it is a `T` (a front end that needs more of a
+    /// model than [`Signal`] gives: the matrices of a grey-box model for export).
+    pub fn downcast<T: 'static>(&self) -> Option<&T> {
+        self.0.as_any().downcast_ref()
+    }
+
     /// Whether the model has a closed-form spectrum.
     pub fn has_spectrum(&self) -> bool {
         self.0.spectrum().is_some()
@@ -134,6 +140,7 @@ struct Entry<T> {
 trait DynSignal: Send + Sync {
     fn kind(&self) -> &str;
     fn model(&self) -> &dyn Signal;
+    fn as_any(&self) -> &dyn std::any::Any;
     fn spectrum(&self) -> Option<&dyn Spectrum>;
     fn spec(&self) -> SpecTable;
     fn with_params(&self, params: &[f64]) -> Result<Arc<dyn DynSignal>, SignalError>;
@@ -144,6 +151,9 @@ impl<T: Signal + Clone + 'static> DynSignal for Entry<T> {
         &self.kind
     }
     fn model(&self) -> &dyn Signal {
+        &self.model
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
         &self.model
     }
     fn spectrum(&self) -> Option<&dyn Spectrum> {

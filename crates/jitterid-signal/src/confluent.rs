@@ -36,6 +36,7 @@ use crate::SampleGrid;
 use jitterid_jitter::rule::QuadratureRule;
 use jitterid_jitter::JitterModel;
 use jitterid_numeric::budget;
+use num_complex::Complex64;
 
 /// A rational model and its parameter derivatives as readouts of one linear system.
 #[derive(Debug, Clone, PartialEq)]
@@ -53,10 +54,9 @@ pub(crate) struct Confluent {
     /// `ρ`: the largest pole modulus (1 when every pole is at the origin), the rate that sets
     /// the quadrature's resolution.
     scale: f64,
-    /// `A²`, the realisation's denominator.
-    den2: Vec<f64>,
-    /// `A`.
-    den: Vec<f64>,
+    /// Whether the generator is the scaled companion form of a rational model (whose product
+    /// with a vector has a structured `O(d)` route); a general linear readout system is not.
+    companion: bool,
     /// Refinement zones of a mode started at 0 ([`crate::reach`]'s): `(x_end, rate)`, beyond
     /// the last end every mode has decayed below `e^{−50}`.
     zones: Vec<(f64, f64)>,
@@ -113,6 +113,41 @@ impl Confluent {
                 readout(&p)
             })
             .collect();
+        Self::assemble(generator, value, grads, scale, r.poles, true)
+    }
+
+    /// A general linear readout system: the generator `M` (`dim × dim`, row-major, whose last
+    /// state is the input level: its last row is zero), the readout of `s` and one of each
+    /// `∂s/∂θ_j`, and the eigenvalues of `M` but the input level's zero (with their
+    /// multiplicity, or at least every distinct one), which set the quadrature's refinement.
+    /// The grey-box state-space model's sensitivities are such a system (the state and its
+    /// parameter derivatives driven by the level).
+    pub(crate) fn linear(
+        generator: Vec<f64>,
+        value: Vec<f64>,
+        grads: Vec<Vec<f64>>,
+        poles: &[Complex64],
+    ) -> Self {
+        let rho = poles.iter().map(|p| p.norm()).fold(0.0, f64::max);
+        let scale = if rho > 0.0 && rho.is_finite() {
+            rho
+        } else {
+            1.0
+        };
+        Self::assemble(generator, value, grads, scale, poles, false)
+    }
+
+    /// The tables shared by every generator: the rate readout, the block length and its
+    /// powers, the step's Taylor terms and the refinement zones.
+    fn assemble(
+        generator: Vec<f64>,
+        value: Vec<f64>,
+        grads: Vec<Vec<f64>>,
+        scale: f64,
+        poles: &[Complex64],
+        companion: bool,
+    ) -> Self {
+        let dim = value.len();
         let mut rate = vec![0.0; dim];
         vec_mat(&value, &generator, &mut rate);
         let norm = (0..dim)
@@ -136,7 +171,7 @@ impl Confluent {
             }
             step_taylor.push(v.clone());
         }
-        let zones = crate::reach::zones(r.poles, 1.0);
+        let zones = crate::reach::zones(poles, 1.0);
         Self {
             dim,
             generator,
@@ -144,13 +179,18 @@ impl Confluent {
             grads,
             rate,
             scale,
-            den2: a2,
-            den: den.to_vec(),
+            companion,
             zones,
             block,
             powers,
             step_taylor,
         }
+    }
+
+    /// The state dimension (the sensitivity blocks a grey-box realisation needs, in tests).
+    #[cfg(test)]
+    pub(crate) fn dim(&self) -> usize {
+        self.dim
     }
 
     /// `e^{Mx} v` for `x ≥ 0`: the Taylor series on `x mod h` (`taylor`, when given, holds
@@ -204,13 +244,13 @@ impl Confluent {
         out
     }
 
-    /// `M v` into `out` by the companion form's structure: a full first row, the scaled
+    /// `M v` into `out`; for the companion form by its structure: a full first row, the scaled
     /// shift `ρ v_{i−1}` below it and a zero last row (the input level is constant), `O(d)`
     /// instead of `O(d²)`. The first row's sum runs in the dense product's order and the other
     /// rows add only exact zeros to their one term there, so the result is the same to the bit.
     fn generator_apply(&self, v: &[f64], out: &mut [f64]) {
         let d = self.dim;
-        if d < 2 {
+        if d < 2 || !self.companion {
             mat_vec(&self.generator, v, out);
             return;
         }
@@ -280,21 +320,24 @@ impl Confluent {
     /// the response, its derivative with respect to each of `r`'s parameters
     /// (`−q A'_j/A²`), and with respect to each `q_i` (`s^i A/A²`).
     pub(crate) fn free_rows(&self, r: &Coefficients<'_>, q: &[f64]) -> FreeRows {
+        // The companion realisation of `r` (the only one a free response is read from).
+        let den = r.den;
+        let den2 = poly::mul(den, den);
         let q_desc: Vec<f64> = q.iter().rev().copied().collect();
-        let value = readout(&self.den2, self.scale, &poly::mul(&q_desc, &self.den));
+        let value = readout(&den2, self.scale, &poly::mul(&q_desc, den));
         let grads = r
             .d_den
             .iter()
             .map(|da| {
                 let p: Vec<f64> = poly::mul(&q_desc, da).iter().map(|c| -c).collect();
-                readout(&self.den2, self.scale, &p)
+                readout(&den2, self.scale, &p)
             })
             .collect();
         let basis = (0..q.len())
             .map(|i| {
                 let mut si = vec![1.0];
                 si.extend(std::iter::repeat_n(0.0, i));
-                readout(&self.den2, self.scale, &poly::mul(&si, &self.den))
+                readout(&den2, self.scale, &poly::mul(&si, den))
             })
             .collect();
         FreeRows {

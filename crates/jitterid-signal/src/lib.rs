@@ -34,6 +34,10 @@
 //! * Inputs: [`PiecewiseConstant`] (and [`RandomBinary`], the paper's input, and zero-order
 //!   hold), [`Multisine`].
 //!
+//! * [`greybox`]: a grey-box state-space model `ẋ = A(θ)x + B(θ)u, y = C(θ)x + D(θ)u` of named
+//!   physical parameters (a Rust type implementing [`greybox::StateSpaceModel`], or matrices
+//!   written as expressions, [`greybox::ExprModel`]), its sensitivities by the augmented
+//!   matrix exponential.
 //! * [`forms`]: plain transfer-function, zero-pole-gain and state-space forms of a model, with
 //!   conversions and readable display, for export.
 //!
@@ -47,6 +51,7 @@ mod delay;
 mod error;
 mod expm;
 pub mod forms;
+pub mod greybox;
 mod grid;
 mod initial;
 mod input;

@@ -502,3 +502,23 @@ fn check_monte_carlo<S: Signal>(
         }
     }
 }
+
+/// A mass–spring–damper as a grey-box model written with expressions: force in, position out,
+/// `ẋ = [[0, 1], [−k/m, −damp/m]] x + [0, 1/m] u`, `y = x₁`, parameters `m, damp, k` (in this
+/// order) with `m` bounded to `[0, 10³]`: `1/(m s² + damp s + k)`.
+pub fn mass_spring_damper() -> crate::greybox::ExprModel {
+    use crate::greybox::{ExprModel, WrittenMatrices};
+    let written = WrittenMatrices {
+        a: vec![
+            vec!["0".into(), "1".into()],
+            vec!["-k/m".into(), "-damp/m".into()],
+        ],
+        b: vec![vec![0.0.into()], vec!["1/m".into()]],
+        c: vec![vec![1.0.into(), 0.0.into()]],
+        d: None,
+    };
+    let names = ["m", "damp", "k"].map(String::from);
+    // The matrices above parse against these names: a failure is a bug of this function.
+    ExprModel::new(&names, &[], &[("m".into(), (0.0, 1e3))], &written)
+        .expect("the mass–spring–damper's expressions parse")
+}

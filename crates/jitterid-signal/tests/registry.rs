@@ -26,6 +26,12 @@ fn specs() -> Vec<SpecTable> {
         table(
             json!({"kind": "pulse-response", "coefficients": [0.6, 0.3, -0.15], "interval": 0.5}),
         ),
+        // A mass–spring–damper with a known constant and a bound.
+        table(json!({
+            "kind": "grey-box", "params": {"m": 1.0, "damp": 0.4}, "fixed": {"k": 2.0},
+            "bounds": {"m": [0.0, 1e3]}, "a": [["0", "1"], ["-k/m", "-damp/m"]],
+            "b": [[0], ["1/m"]], "c": [[1, 0]], "d": [["0.1"]],
+        })),
     ]
 }
 
@@ -33,7 +39,10 @@ fn specs() -> Vec<SpecTable> {
 fn every_builtin_kind_builds_passes_the_contract_and_rebuilds() {
     let registry = SignalRegistry::builtin();
     let names: Vec<&str> = registry.kinds().map(SignalKind::name).collect();
-    assert_eq!(names, ["zpk", "tf", "sinusoid", "pulse-response"]);
+    assert_eq!(
+        names,
+        ["zpk", "tf", "sinusoid", "pulse-response", "grey-box"]
+    );
     let grid = SampleGrid::new(0.0, 1.0, 30).unwrap();
     let jitter = UniformSum::new(2, 0.2887).unwrap();
     let u = input();

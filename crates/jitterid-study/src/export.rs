@@ -7,6 +7,7 @@
 use jitterid::estimate::validation::{BodePoint, StepPoint};
 use jitterid::estimate::{validation, EstimateError};
 use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
+use jitterid::signal::greybox::{ExprModel, GreyBox};
 use jitterid::signal::registry::{KindReader, SignalRegistry};
 use jitterid::signal::RationalModel;
 use jitterid::signal::{AnySignal, SignalError, TransferFunction, Zpk};
@@ -98,17 +99,21 @@ impl RationalSystem {
     }
 }
 
-/// The coefficients of a rational system (rebuilt from the signal's spec table), `None` for
-/// other signal kinds.
+/// The coefficients of a rational system (rebuilt from the signal's spec table; a grey-box
+/// model's `C(sI − A)⁻¹B + D`), `None` for other signal kinds.
 ///
 /// # Errors
 ///
 /// The spec table of a `zpk` or `tf` signal does not rebuild its system.
 pub fn tf_of(signal: &AnySignal) -> Result<Option<TfForm>, SignalError> {
+    if let Some(g) = signal.downcast::<GreyBox<ExprModel>>() {
+        return g.transfer_function().map(Some);
+    }
     Ok(RationalSystem::of(signal)?.map(|g| g.tf()))
 }
 
-/// The fitted model in every export form, `None` for signals that are not rational systems.
+/// The fitted model in every export form, `None` for signals that are not rational systems
+/// (transfer functions, zeros and poles, grey-box state space).
 ///
 /// # Errors
 ///
@@ -118,9 +123,14 @@ pub fn model_forms(signal: &AnySignal) -> Result<Option<ModelForms>, SignalError
     let Some(tf) = tf_of(signal)? else {
         return Ok(None);
     };
+    // A grey-box model exports its own realisation (the fitted A, B, C, D).
+    let ss = match signal.downcast::<GreyBox<ExprModel>>() {
+        Some(g) => g.state_space(),
+        None => tf.to_state_space(),
+    };
     Ok(Some(ModelForms {
         zpk: tf.to_zpk()?,
-        ss: tf.to_state_space(),
+        ss,
         tf,
         delay: delay_of(signal),
         offset: offset_of(signal),

@@ -52,7 +52,7 @@ impl StateSpace {
     }
 
     /// Built by a conversion that guarantees the shapes.
-    pub(super) fn from_parts(a: Vec<Vec<f64>>, b: Vec<f64>, c: Vec<f64>, d: f64) -> Self {
+    pub(crate) fn from_parts(a: Vec<Vec<f64>>, b: Vec<f64>, c: Vec<f64>, d: f64) -> Self {
         Self { a, b, c, d }
     }
 

@@ -9,7 +9,13 @@ use serde_json::{json, Value};
 
 pub(super) fn registry() -> SignalRegistry {
     let mut r = SignalRegistry::new();
-    for kind in [zpk(), tf(), sinusoid(), pulse_response()] {
+    for kind in [
+        zpk(),
+        tf(),
+        sinusoid(),
+        pulse_response(),
+        super::greybox::kind(),
+    ] {
         // Names are distinct by construction.
         let _ = r.register(kind);
     }

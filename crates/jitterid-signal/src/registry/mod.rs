@@ -11,6 +11,7 @@
 //! | `tf` | `num`, `den` | piecewise constant or tones |
 //! | `sinusoid` | `amplitude`, `frequency` (Hz), `phase` (rad, default 0) | none |
 //! | `pulse-response` | `coefficients`, `interval` (s) | piecewise constant |
+//! | `grey-box` | `params`, `fixed` (optional), `bounds` (optional), `a`, `b`, `c`, `d` (optional) | piecewise constant |
 //!
 //! `zpk` and `tf` also take `delay` (s, ≥ 0: an input delay, the parameter `delay`; see
 //! [`Delayed`](crate::Delayed)) and `initial` (one value per pole: the free response from an
@@ -49,6 +50,7 @@
 //! [`SignalError`]s.
 
 mod builtin;
+mod greybox;
 mod reader;
 
 pub use builtin::roots_json;

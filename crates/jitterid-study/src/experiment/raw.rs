@@ -71,6 +71,13 @@ section!(RawSystem, "table [system]" {
     delay: f64,
     unstable: bool,
     integrators: i64,
+    params: toml::Value,
+    fixed: toml::Value,
+    bounds: toml::Value,
+    a: toml::Value,
+    b: toml::Value,
+    c: toml::Value,
+    d: toml::Value,
 });
 
 section!(RawOutput, "table [output]" {

@@ -6,8 +6,9 @@ use super::range;
 use super::raw::{RawOutput, RawSystem};
 use super::spec::{quoted_list, SystemSpec};
 use crate::error::StudyResult;
+use jitterid::signal::greybox::{ExprModel, GreyBox};
 use jitterid::signal::registry::{roots_json, SignalKind, SignalRegistry, SpecTable, KIND_KEY};
-use jitterid::signal::{Root, SampleGrid, Sinusoid, TransferFunction, Zpk};
+use jitterid::signal::{PiecewiseConstant, Root, SampleGrid, Sinusoid, TransferFunction, Zpk};
 use serde_json::{json, Value};
 use toml::Spanned;
 
@@ -89,6 +90,7 @@ pub(super) fn parse_system(
         "zpk" => zpk(cx, r, grid)?,
         "tf" => tf(cx, r, grid)?,
         "sinusoid" => sinusoid(cx, r, grid)?,
+        "grey-box" => grey_box(cx, r, grid)?,
         other => {
             return Err(cx.err(
                 S,
@@ -177,6 +179,59 @@ fn tf(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
         ),
         n,
     ))
+}
+
+/// A grey-box model, checked by building it on a unit step: the expressions, the shapes, the
+/// bounds, the stability and the poles' range, each error at its key.
+fn grey_box(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
+    let why = "kind = \"grey-box\" needs params, a, b and c (and optionally fixed, bounds, d)";
+    let mut table = SpecTable::new();
+    table.insert(KIND_KEY.into(), json!("grey-box"));
+    let keys = [
+        ("params", &r.params),
+        ("fixed", &r.fixed),
+        ("bounds", &r.bounds),
+        ("a", &r.a),
+        ("b", &r.b),
+        ("c", &r.c),
+        ("d", &r.d),
+    ];
+    let mut spans = Vec::new();
+    for (key, v) in keys {
+        let Some(v) = v else {
+            if matches!(key, "params" | "a" | "b" | "c") {
+                cx.required(S, key, v, why)?;
+            }
+            continue;
+        };
+        // TOML's infinities have no JSON form: an infinite bound is written as an open side.
+        let value = serde_json::to_value(v.get_ref()).map_err(|e| cx.err(S, key, &v.span(), e))?;
+        table.insert(key.into(), value);
+        spans.push((key, v.span()));
+    }
+    let span_of = |key: Option<&str>| {
+        spans
+            .iter()
+            .find(|(k, _)| Some(*k) == key)
+            .or(spans.first())
+            .map(|(k, s)| (*k, s.clone()))
+            .unwrap_or(("kind", 0..0))
+    };
+    let end = grid.start() + grid.duration().max(grid.interval());
+    let step = PiecewiseConstant::new(vec![grid.start(), end], vec![1.0])
+        .map_err(|e| cx.err(S, "kind", &(0..0), e))?;
+    let built = SignalRegistry::builtin()
+        .build(&table, Some(&step.into()))
+        .map_err(|e| {
+            let (key, span) = span_of(e.key());
+            cx.err(S, key, &span, e)
+        })?;
+    if let Some(g) = built.downcast::<GreyBox<ExprModel>>() {
+        let (key, span) = span_of(Some("a"));
+        range::poles(g.poles().iter().map(|p| p.norm()), grid)
+            .map_err(|m| cx.err(S, key, &span, m))?;
+    }
+    Ok(built.spec())
 }
 
 fn sinusoid(cx: &Source, r: &RawSystem, grid: &SampleGrid) -> StudyResult<SpecTable> {
