@@ -66,8 +66,9 @@ print(f"estimation: {len(estimation['y'])} samples, validation: {len(validation[
 # %%
 select_exp = jitterid.Experiment.from_toml(WALK / "select.toml")
 if small:
-    # Two candidates of the walkthrough's grid: two poles and one zero, without jitter and
-    # with the two-point family that the full selection ranks first.
+    # Two candidates of the walkthrough's grid: two poles and one zero (the structure step 2
+    # fits, with the delay), without jitter and with the two-point family that the full
+    # selection ranks first.
     text = select_exp.text.replace('families = ["none", "gaussian", "two-point", "periodic"]',
                                    'families = ["none", "two-point"]')
     text = text.replace("poles = [1, 3]", "poles = [2, 2]").replace("zeros = [0, 1]", "zeros = [1, 1]")

@@ -176,7 +176,7 @@ fn an_unknown_system_kind_lists_the_registry_kinds_a_file_can_describe() {
             "e.toml:23:",
             "[system] kind",
             "unknown system kind \"zpq\"",
-            "expected \"zpk\", \"tf\" or \"sinusoid\"",
+            "expected \"zpk\", \"tf\", \"sinusoid\" or \"grey-box\"",
         ],
     );
 }

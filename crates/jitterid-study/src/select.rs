@@ -249,9 +249,15 @@ pub fn auto_start(
     })?;
     let record = fit::record(&exp.grid, y.to_vec()).map_err(|e| study_err!("{data}: {e}"))?;
     let jitter: &dyn JitterModel = &exp.jitter.model;
-    let opts = InitOptions::default();
-    let init_err = |e: InitError| study_err!("{data}: --init auto: the initializer failed: {e}");
     let mut spec = signal.spec();
+    // An estimated output offset moves only the bin f = 0: the initializer leaves it out, so
+    // that the system's start is not bent towards a constant (the offset's own start comes
+    // from the record's mean, in the fit).
+    let opts = InitOptions {
+        offset: spec.get("estimate_offset") == Some(&Value::Bool(true)),
+        ..InitOptions::default()
+    };
+    let init_err = |e: InitError| study_err!("{data}: --init auto: the initializer failed: {e}");
     let driven = delayed_input(input, spec.get("delay").and_then(Value::as_f64))
         .map_err(|e| study_err!("{}: [system] delay: {e}", exp.file))?;
     match signal.kind() {

@@ -143,7 +143,7 @@ pub enum FailureKind {
     /// spread grows to absorb the misfit.
     StabilityBoundary,
     /// The fit converged with a pole so fast that the samples do not determine it: `|p|·T`
-    /// above [`BEYOND_SAMPLING`], so that its mode decays by more than `e^{−10π} ≈ 2·10⁻¹⁴`
+    /// above `10π`, so that its mode decays by more than `e^{−10π} ≈ 2·10⁻¹⁴`
     /// within one sampling interval. Typically an order with a pole to spare, placed far
     /// beyond the sampling rate where it changes the sampled response by a small lag only. The
     /// candidate keeps its screen BIC but ranks after the identifiable converged ones and is
