@@ -49,14 +49,17 @@ where
         .collect()
 }
 
+/// Whether a search converged with every parameter free (not already held at a bound).
+pub(crate) fn converged_inside(termination: &Termination) -> bool {
+    termination.is_convergence() && !matches!(termination, Termination::AtBound { .. })
+}
+
 /// The parameters on their bound after a fit that stalled against the domain's edge, or that
 /// converged with a width already there (an even width goes to 0 quadratically once the
 /// search's matrix has its curvature, [`crate::even_widths`], and the search then stops on its
 /// cost-change test with the width far below [`BOUND_FRACTION`] of its start).
 pub(crate) fn bound_params(report: &SolverReport, start: &[f64], positive: &[bool]) -> Vec<usize> {
-    let converged_inside = report.termination.is_convergence()
-        && !matches!(report.termination, Termination::AtBound { .. });
-    if report.termination != Termination::NonFinite && !converged_inside {
+    if report.termination != Termination::NonFinite && !converged_inside(&report.termination) {
         return Vec::new();
     }
     (0..report.params.len())

@@ -10,7 +10,7 @@
 //! records stop at the iteration limit with the width at a tenth of its start); a pole on the
 //! axis stops the search at its first refused step, wherever the other parameters are.
 
-use crate::boundary::{settle_at_bounds, BOUND_FRACTION};
+use crate::boundary::{converged_inside, settle_at_bounds, BOUND_FRACTION};
 use crate::noise::NoiseModel;
 use crate::solver::{LeastSquares, SolverError, SolverReport, Termination};
 use crate::structure::ModelStructure;
@@ -75,9 +75,7 @@ where
     // cost-change test while the width was still shrinking towards the bound (each step then
     // changes the criterion by the square of a small width): the bound is tried too, and kept
     // only when it is a constrained minimum no worse than where the search stopped.
-    let converged_inside = report.termination.is_convergence()
-        && !matches!(report.termination, Termination::AtBound { .. });
-    if !stalled && !converged_inside {
+    if !stalled && !converged_inside(&report.termination) {
         return Vec::new();
     }
     let (ns, _, _) = structure.blocks();
