@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut times = Vec::with_capacity(repeats);
     for _ in 0..repeats {
         let t0 = Instant::now();
-        let signal = signal_of(&exp, data.input.as_ref())?;
+        let signal = signal_of(&exp, &data.inputs)?;
         let fit = fit_values(
             &exp,
             signal,

@@ -188,13 +188,14 @@ impl Experiment {
     /// input realisation).
     #[getter]
     fn random_input(&self) -> bool {
-        matches!(self.exp.input, InputSpec::RandomBinary(_))
+        self.exp.random_input()
     }
 
     /// Record `run` of the experiment's truth under master `seed`, as `jitterid simulate`
     /// writes it: a dict of arrays `t`, `y`, `u` (when there is an input), the random input's
     /// switch times and levels `input_t`, `input_u` (its side file), and with `truth` the drawn
-    /// `tau` and `v`.
+    /// `tau` and `v`. With several inputs, `u` and `input_u` are dicts by input name (the
+    /// random-binary inputs' levels at the switch times `input_t` of all of them).
     #[pyo3(signature = (seed = DEFAULT_SEED, run = 0, truth = false))]
     fn simulate<'py>(
         &self,
@@ -209,17 +210,44 @@ impl Experiment {
         let out = PyDict::new(py);
         out.set_item("t", data.t.into_pyarray(py))?;
         out.set_item("y", data.y.into_pyarray(py))?;
-        if let Some(u) = data.u {
-            out.set_item("u", u.into_pyarray(py))?;
-        }
-        if let (InputSpec::RandomBinary(_), Some(Input::Piecewise(p))) =
-            (&self.exp.input, &data.input)
-        {
-            // The side file's columns: the switch times, and the levels with a closing 0.
-            let mut levels = p.levels().to_vec();
-            levels.push(0.0);
-            out.set_item("input_t", p.edges().to_vec().into_pyarray(py))?;
-            out.set_item("input_u", levels.into_pyarray(py))?;
+        let drawn: Vec<(&str, &PiecewiseConstant)> = self
+            .exp
+            .inputs
+            .iter()
+            .zip(&data.inputs)
+            .filter_map(|(c, u)| match (&c.spec, u) {
+                (InputSpec::RandomBinary(_), Input::Piecewise(p)) => Some((c.name.as_str(), p)),
+                _ => None,
+            })
+            .collect();
+        if let ([u], [_]) = (data.u.as_slice(), self.exp.inputs.as_slice()) {
+            out.set_item("u", u.clone().into_pyarray(py))?;
+            if let [(_, p)] = drawn.as_slice() {
+                // The side file's columns: the switch times, and the levels with a closing 0.
+                let mut levels = p.levels().to_vec();
+                levels.push(0.0);
+                out.set_item("input_t", p.edges().to_vec().into_pyarray(py))?;
+                out.set_item("input_u", levels.into_pyarray(py))?;
+            }
+        } else if !data.u.is_empty() {
+            let u = PyDict::new(py);
+            for (c, v) in self.exp.inputs.iter().zip(data.u) {
+                u.set_item(&c.name, v.into_pyarray(py))?;
+            }
+            out.set_item("u", u)?;
+            if !drawn.is_empty() {
+                // One time column for all (the side file's), each input's level from then on.
+                let mut t: Vec<f64> = drawn.iter().flat_map(|(_, p)| p.edges().to_vec()).collect();
+                t.sort_by(f64::total_cmp);
+                t.dedup();
+                let levels = PyDict::new(py);
+                for (name, p) in &drawn {
+                    let l: Vec<f64> = t.iter().map(|&t| p.value(t)).collect();
+                    levels.set_item(name, l.into_pyarray(py))?;
+                }
+                out.set_item("input_t", t.into_pyarray(py))?;
+                out.set_item("input_u", levels)?;
+            }
         }
         if truth {
             out.set_item("tau", data.tau.into_pyarray(py))?;
@@ -295,9 +323,9 @@ impl Experiment {
                 cancel: Some(Arc::clone(&cancel)),
                 ..jitterid_study::Watch::none()
             };
-            let mut signal = fitting::signal_of(&exp, input.as_ref())?;
+            let mut signal = fitting::signal_of(&exp, &input)?;
             if init == InitChoice::Auto {
-                signal = fitting::data_start(&exp, &signal, input.as_ref(), &y, "y")?;
+                signal = fitting::data_start(&exp, &signal, &input, &y, "y")?;
             }
             fitting::fit_values(&exp, signal, y, "y", &watch)
         };
@@ -362,29 +390,49 @@ impl Experiment {
     }
 }
 
-/// The input of a record on `grid`: the experiment's known input, or for a random-binary
-/// experiment the record's realisation (`input_t`, `input_u`). `prefix` names the record's
-/// arguments in messages (`""` for the fitted record, `"validation "` for a validation
-/// record).
+/// The inputs of a record on `grid`, in order: the experiment's known inputs, and for a
+/// random-binary input the record's realisation (`input_t`, `input_u`; with several inputs,
+/// `input_u` is a dict of levels by input name). `prefix` names the record's arguments in
+/// messages (`""` for the fitted record, `"validation "` for a validation record).
 pub fn record_input(
     exp: &experiment::Experiment,
     input_t: Option<&Bound<'_, PyAny>>,
     input_u: Option<&Bound<'_, PyAny>>,
     grid: &SampleGrid,
     prefix: &str,
-) -> PyResult<Option<Input>> {
-    Ok(match &exp.input {
-        InputSpec::None => None,
-        InputSpec::Known(i) => Some(i.clone()),
-        InputSpec::RandomBinary(_) => {
-            let (Some(t), Some(u)) = (input_t, input_u) else {
-                return Err(value_error(format!(
-                    "{prefix}input: the experiment's input is random-binary, so the {prefix}record needs its input realisation (input_t and input_u, as simulate returns them)",
-                )));
-            };
-            Some(Input::Piecewise(realisation(t, u, grid, prefix)?))
-        }
-    })
+) -> PyResult<Vec<Input>> {
+    let several = exp.inputs.len() > 1;
+    exp.inputs
+        .iter()
+        .map(|c| {
+            Ok(match &c.spec {
+                InputSpec::Known(i) => i.clone(),
+                InputSpec::RandomBinary(_) => {
+                    let (Some(t), Some(u)) = (input_t, input_u) else {
+                        return Err(value_error(format!(
+                            "{prefix}input: the experiment's input is random-binary, so the {prefix}record needs its input realisation (input_t and input_u, as simulate returns them)",
+                        )));
+                    };
+                    if several {
+                        let levels = u
+                            .cast::<PyDict>()
+                            .map_err(|_| value_error(format!(
+                                "{prefix}input_u: the experiment has several inputs; expected a dict of levels by input name, found {}",
+                                u.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+                            )))?
+                            .get_item(&c.name)?
+                            .ok_or_else(|| value_error(format!(
+                                "{prefix}input_u: no levels for the input \"{}\"",
+                                c.name
+                            )))?;
+                        Input::Piecewise(realisation(t, &levels, grid, prefix)?)
+                    } else {
+                        Input::Piecewise(realisation(t, u, grid, prefix)?)
+                    }
+                }
+            })
+        })
+        .collect()
 }
 
 /// The random input's realisation from its switch times `t` and levels `u` (the side file's

@@ -203,17 +203,17 @@ pub fn validate(
     let level = check_level(level, "level").map_err(value_error)?;
     let exp = experiment.for_method(method)?;
     let (y, grid) = samples_on(&exp, y, t, false)?;
-    let input = record_input(&exp, input_t, input_u, &grid, "")?;
+    let inputs = record_input(&exp, input_t, input_u, &grid, "")?;
     let estimation = RecordSamples {
         name: "record".into(),
         grid,
         y,
-        input,
+        inputs,
     };
     let validation = match validation_y {
         Some(vy) => {
             let (y, grid) = samples_on(&exp, vy, validation_t, true)?;
-            let input = record_input(
+            let inputs = record_input(
                 &exp,
                 validation_input_t,
                 validation_input_u,
@@ -224,7 +224,7 @@ pub fn validate(
                 name: "validation".into(),
                 grid,
                 y,
-                input,
+                inputs,
             })
         }
         None => None,

@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 
 /// The cases: name, example file, method, what it shows.
-const CASES: [(&str, &str, &str, &str); 6] = [
+const CASES: [(&str, &str, &str, &str); 8] = [
     (
         "offset",
         "offset.toml",
@@ -27,6 +27,18 @@ const CASES: [(&str, &str, &str, &str); 6] = [
     (
         "offset-ml",
         "offset.toml",
+        "ml",
+        "the same records by exact maximum likelihood",
+    ),
+    (
+        "two-input",
+        "two-input.toml",
+        "bcls",
+        "two inputs with different jitter-sensitive dynamics (a fast first-order channel and a lightly damped one), estimated jointly by BCLS",
+    ),
+    (
+        "two-input-ml",
+        "two-input.toml",
         "ml",
         "the same records by exact maximum likelihood",
     ),

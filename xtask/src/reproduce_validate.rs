@@ -93,7 +93,8 @@ fn param(f: &jitterid_study::fit::Fit, name: &str) -> Option<f64> {
 /// Fits `exp` to the record `y` with input `input` and validates it at `level`.
 fn fit_and_check(exp: &Experiment, y: &[f64], input: &Input, r: u64) -> Result<Outcome, String> {
     let name = format!("run {r}");
-    let signal = signal_of(exp, Some(input)).map_err(|e| e.to_string())?;
+    let inputs = std::slice::from_ref(input);
+    let signal = signal_of(exp, inputs).map_err(|e| e.to_string())?;
     let f =
         fit_values(exp, signal, y.to_vec(), &name, &Watch::none()).map_err(|e| e.to_string())?;
     let (report, _) = check_record(
@@ -101,7 +102,8 @@ fn fit_and_check(exp: &Experiment, y: &[f64], input: &Input, r: u64) -> Result<O
         &exp.grid,
         y,
         f.noise_std,
-        Some(input),
+        inputs,
+        &[],
         LEVELS[0],
         &name,
     )
@@ -125,7 +127,7 @@ fn one(r: u64, seed: u64, exps: &[Experiment]) -> Vec<Result<Outcome, String>> {
     let Ok(data) = simulate_data(&exps[0], seed, r) else {
         return vec![Err("simulation failed".into()); CASES.len()];
     };
-    let (Some(truth), Some(u)) = (data.input.as_ref(), data.u.as_ref()) else {
+    let (Some(truth), Some(u)) = (data.inputs.first(), data.u.first()) else {
         return vec![Err("no input".into()); CASES.len()];
     };
     // The input as its samples on the grid, held: what a user with only sampled input has.

@@ -68,6 +68,7 @@ mod signal;
 mod simulate;
 mod sinusoid;
 mod spectrum;
+pub mod superposition;
 pub mod testing;
 mod zpk;
 
@@ -86,4 +87,5 @@ pub use signal::{local_breaks, Jacobian, Signal};
 pub use simulate::{simulate, Simulation};
 pub use sinusoid::Sinusoid;
 pub use spectrum::{SpectralLine, Spectrum};
+pub use superposition::{Channel, Superposition};
 pub use zpk::Zpk;

@@ -10,7 +10,7 @@ use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
 use jitterid::signal::greybox::{ExprModel, GreyBox};
 use jitterid::signal::registry::{KindReader, SignalRegistry};
 use jitterid::signal::RationalModel;
-use jitterid::signal::{AnySignal, SignalError, TransferFunction, Zpk};
+use jitterid::signal::{AnySignal, Offset, SignalError, Superposition, TransferFunction, Zpk};
 use serde::Serialize;
 
 /// The model in the three export forms.
@@ -135,6 +135,112 @@ pub fn model_forms(signal: &AnySignal) -> Result<Option<ModelForms>, SignalError
         delay: delay_of(signal),
         offset: offset_of(signal),
     }))
+}
+
+/// The fitted model of `fit --json`: one input's [`ModelForms`], or a multi-input system's
+/// forms per input with one state-space realisation of them all.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum ExportedModel {
+    /// A system with one input.
+    One(ModelForms),
+    /// A system with several inputs.
+    Several(SeveralInputs),
+}
+
+/// A multi-input system's export: `y = y₀ + Σᵢ Gᵢ(s) e^{−sDᵢ} uᵢ`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SeveralInputs {
+    /// Each input's transfer function in the three forms (with its delay), in input order.
+    pub inputs: Vec<InputForms>,
+    /// One realisation of them all: the channels' realisations side by side
+    /// (block-diagonal `A`, `B` with one column per input, `C` and `D` one row), without the
+    /// delays.
+    pub ss: MultiInputStateSpace,
+    /// The output offset `y₀` (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<f64>,
+}
+
+/// One input's part of a multi-input export.
+#[derive(Debug, Clone, Serialize)]
+pub struct InputForms {
+    /// The input's name.
+    pub name: String,
+    /// `Gᵢ` in the three forms, with its delay.
+    #[serde(flatten)]
+    pub forms: ModelForms,
+}
+
+/// `ẋ = A x + B u`, `y = C x + D u` with `m` inputs: `{"a": n×n, "b": n×m, "c": 1×n, "d": 1×m}`.
+#[derive(Debug, Clone, Serialize)]
+pub struct MultiInputStateSpace {
+    /// `A`, rows.
+    pub a: Vec<Vec<f64>>,
+    /// `B`, rows (one column per input).
+    pub b: Vec<Vec<f64>>,
+    /// `C`, one row.
+    pub c: Vec<Vec<f64>>,
+    /// `D`, one row (one column per input).
+    pub d: Vec<Vec<f64>>,
+}
+
+impl MultiInputStateSpace {
+    /// The realisations `parts` (one per input) side by side.
+    fn of(parts: &[&StateSpace]) -> Self {
+        let n: usize = parts.iter().map(|p| p.order()).sum();
+        let m = parts.len();
+        let mut a = vec![vec![0.0; n]; n];
+        let mut b = vec![vec![0.0; m]; n];
+        let mut c = Vec::with_capacity(n);
+        let mut d = Vec::with_capacity(m);
+        let mut at = 0;
+        for (j, p) in parts.iter().enumerate() {
+            for (i, row) in p.a().iter().enumerate() {
+                a[at + i][at..at + row.len()].copy_from_slice(row);
+                b[at + i][j] = p.b()[i];
+            }
+            c.extend_from_slice(p.c());
+            d.push(p.d());
+            at += p.order();
+        }
+        Self {
+            a,
+            b,
+            c: vec![c],
+            d: vec![d],
+        }
+    }
+}
+
+/// The fitted model of `fit --json` ([`model_forms`] for one input; each channel's forms and
+/// their joint realisation for several), `None` for signals that are not rational systems.
+///
+/// # Errors
+///
+/// Those of [`model_forms`], for any channel.
+pub fn exported_model(signal: &AnySignal) -> Result<Option<ExportedModel>, SignalError> {
+    let Some(sum) = signal.downcast::<Offset<Superposition>>() else {
+        return Ok(model_forms(signal)?.map(ExportedModel::One));
+    };
+    let mut inputs = Vec::with_capacity(sum.signal().channels().len());
+    for c in sum.signal().channels() {
+        let Some(forms) = model_forms(&c.signal)? else {
+            return Ok(None);
+        };
+        inputs.push(InputForms {
+            name: c.name.clone(),
+            forms,
+        });
+    }
+    let parts: Vec<&StateSpace> = inputs.iter().map(|i| &i.forms.ss).collect();
+    let ss = MultiInputStateSpace::of(&parts);
+    let offset = (sum.offset() != 0.0 || sum.estimated()).then_some(sum.offset());
+    Ok(Some(ExportedModel::Several(SeveralInputs {
+        inputs,
+        ss,
+        offset,
+    })))
 }
 
 /// Where a reported parameter sits in the estimator's covariance: its index there and the

@@ -16,14 +16,33 @@ use std::fmt::Write as _;
 pub fn experiment_fingerprint(exp: &Experiment) -> String {
     let mut h = HashWriter(Sha256::new());
     // Writing into a hasher cannot fail.
+    // One input is written as it was before inputs had names and could be several, so that
+    // such an experiment keeps its fingerprint (and its studies stay mergeable).
+    let _ = write!(h, "title={:?}\ngrid={:?}\ninput=", exp.title, exp.grid);
+    match exp.inputs.as_slice() {
+        [] => {
+            let _ = write!(h, "None");
+        }
+        [one] => {
+            let _ = write!(h, "{:?}", one.spec);
+        }
+        several => {
+            let _ = write!(h, "{several:?}");
+        }
+    }
     let _ = write!(
         h,
-        "title={:?}\ngrid={:?}\ninput={:?}\nsystem={:?}\njitter={:?}\nnoise={:?}\nestimate={:?}",
-        exp.title, exp.grid, exp.input, exp.system, exp.jitter, exp.noise, exp.estimate
+        "\nsystem={:?}\njitter={:?}\nnoise={:?}\nestimate={:?}",
+        exp.system, exp.jitter, exp.noise, exp.estimate
     );
-    // Entered only when given, so that an experiment without a history keeps its fingerprint.
-    if exp.history != 0.0 {
-        let _ = write!(h, "\nhistory={:?}", exp.history);
+    if let [one] = exp.inputs.as_slice() {
+        // Entered only when given, so that an experiment without them keeps its fingerprint.
+        if one.history != 0.0 {
+            let _ = write!(h, "\nhistory={:?}", one.history);
+        }
+        if one.name != "u" {
+            let _ = write!(h, "\ninput_name={:?}", one.name);
+        }
     }
     let mut hex = String::with_capacity(64);
     for byte in h.0.finalize() {

@@ -34,20 +34,45 @@ pub type Structure = ModelStructure<AnySignal, AnyJitter, AnyNoise>;
 
 /// The signal of the experiment's system driven by `input` (a kind that needs one, such as a
 /// rational system, fails without it), built through the experiment's signal registry.
-pub fn signal_of(exp: &Experiment, input: Option<&Input>) -> StudyResult<AnySignal> {
-    let registry = &exp.registries.signal;
+pub fn signal_of(exp: &Experiment, inputs: &[Input]) -> StudyResult<AnySignal> {
     let spec = &exp.system.kind;
     let needs_input = spec
         .get(KIND_KEY)
         .and_then(|k| k.as_str())
-        .and_then(|name| registry.kind(name))
+        .and_then(|name| exp.registries.signal.kind(name))
         .is_some_and(|k| k.needs_input());
-    if needs_input && input.is_none() {
+    if needs_input && inputs.is_empty() {
+        return Err(study_err!("a rational system needs an input"));
+    }
+    build_signal(exp, spec, inputs).map_err(|e| study_err!("[system]: {e}"))
+}
+
+/// The model of the spec table `spec` (the experiment's system's, or one derived from it)
+/// driven by `inputs`: a multi-input system's `superposition` table builds each input's
+/// response with the experiment's signal registry, any other kind is built by the registry
+/// from the first input (none for a kind without one).
+///
+/// # Errors
+///
+/// The registry's build errors, and a kind driven by an input given none.
+pub fn build_signal(
+    exp: &Experiment,
+    spec: &jitterid::signal::registry::SpecTable,
+    inputs: &[Input],
+) -> StudyResult<AnySignal> {
+    let registry = &exp.registries.signal;
+    let name = spec.get(KIND_KEY).and_then(|k| k.as_str()).unwrap_or("");
+    if name == jitterid::signal::superposition::SUPERPOSITION_KIND {
+        return jitterid::signal::superposition::build(registry, spec, inputs)
+            .map_err(|e| study_err!("{e}"));
+    }
+    let needs_input = registry.kind(name).is_some_and(|k| k.needs_input());
+    if needs_input && inputs.is_empty() {
         return Err(study_err!("a rational system needs an input"));
     }
     registry
-        .build(spec, input)
-        .map_err(|e| study_err!("[system]: {e}"))
+        .build(spec, inputs.first())
+        .map_err(|e| study_err!("{e}"))
 }
 
 /// `signal` with its estimated output offset started from `record`: `mean(y) − mean(m_k)` for
@@ -63,7 +88,7 @@ pub fn signal_of(exp: &Experiment, input: Option<&Input>) -> StudyResult<AnySign
 pub fn with_offset_start(
     exp: &Experiment,
     signal: &AnySignal,
-    input: Option<&Input>,
+    inputs: &[Input],
     y: &[f64],
 ) -> StudyResult<AnySignal> {
     let mut spec = signal.spec();
@@ -74,9 +99,7 @@ pub fn with_offset_start(
     bare.remove("offset");
     bare.remove("estimate_offset");
     let build = |spec: &jitterid::signal::registry::SpecTable| {
-        exp.registries
-            .signal
-            .build(spec, input)
+        build_signal(exp, spec, inputs)
             .map_err(|e| study_err!("[output] offset: the start's model: {e}"))
     };
     let response = build(&bare)?;
@@ -101,12 +124,12 @@ pub fn with_offset_start(
 pub fn data_start(
     exp: &Experiment,
     signal: &AnySignal,
-    input: Option<&Input>,
+    inputs: &[Input],
     y: &[f64],
     data: &str,
 ) -> StudyResult<AnySignal> {
-    let signal = crate::select::auto_start(exp, signal, input, y, data)?;
-    with_offset_start(exp, &signal, input, y)
+    let signal = crate::select::auto_start(exp, signal, inputs, y, data)?;
+    with_offset_start(exp, &signal, inputs, y)
 }
 
 /// The model structure for `signal` as the experiment says (free parts, noise, method).
@@ -251,7 +274,9 @@ pub fn truth_values(
         // realisation's state at t0: no one truth.
         let names = signal_truth.param_names();
         out.extend(signal_truth.params().into_iter().zip(&names).map(|(p, n)| {
-            (exp.history == 0.0 || !n.starts_with(jitterid::signal::INITIAL_PREFIX)).then_some(p)
+            let initial = n.starts_with(jitterid::signal::INITIAL_PREFIX)
+                || n.contains(&format!(".{}", jitterid::signal::INITIAL_PREFIX));
+            (!exp.has_history() || !initial).then_some(p)
         }));
     }
     if s.estimate_jitter {
@@ -601,7 +626,7 @@ pub struct FitJson<'a> {
     covariance: Option<&'a [Vec<Option<f64>>]>,
     /// The fitted system in zpk, tf and state-space form (rational systems only).
     #[serde(skip_serializing_if = "Option::is_none")]
-    model: Option<export::ModelForms>,
+    model: Option<export::ExportedModel>,
     /// Why a rational system's export could not be made (absent when it was, or for a system
     /// that is not rational): an export never goes missing without a word.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -655,7 +680,7 @@ pub fn fit_json_noted<'a>(f: &'a Fit, notes: &crate::notes::Notes) -> FitJson<'a
 
 /// The JSON of `jitterid fit --json`.
 pub fn fit_json(f: &Fit) -> FitJson<'_> {
-    let (model, model_error) = match export::model_forms(&f.fitted.signal) {
+    let (model, model_error) = match export::exported_model(&f.fitted.signal) {
         Ok(m) => (m, None),
         Err(e) => (
             None,

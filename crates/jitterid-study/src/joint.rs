@@ -23,9 +23,9 @@ pub struct JointRecord {
     pub grid: SampleGrid,
     /// Its samples.
     pub y: Vec<f64>,
-    /// Its input (the experiment's own, or for a random-binary experiment the record's side
-    /// file).
-    pub input: Option<Input>,
+    /// Its inputs, in order (the experiment's own, or for a random-binary experiment the
+    /// record's side file).
+    pub inputs: Vec<Input>,
 }
 
 /// The records of the data files `paths`: the first on the experiment's grid (as for one
@@ -55,12 +55,12 @@ pub fn read_records(exp: &Experiment, paths: &[&Path]) -> StudyResult<Vec<JointR
             };
             (table.name.clone(), grid, table.column("y")?.to_vec())
         };
-        let input = read_input_on(exp, path, None, &grid)?;
+        let inputs = read_input_on(exp, path, None, &grid)?;
         out.push(JointRecord {
             name,
             grid,
             y,
-            input,
+            inputs,
         });
     }
     Ok(out)
@@ -91,7 +91,7 @@ pub fn fit_joint(exp: &Experiment, records: &[JointRecord], watch: &Watch) -> St
     }
     let structures = records
         .iter()
-        .map(|r| fit::structure(exp, fit::signal_of(exp, r.input.as_ref())?, method))
+        .map(|r| fit::structure(exp, fit::signal_of(exp, &r.inputs)?, method))
         .collect::<StudyResult<Vec<_>>>()?;
     let first = structures
         .first()
@@ -111,9 +111,11 @@ pub fn fit_joint(exp: &Experiment, records: &[JointRecord], watch: &Watch) -> St
             let record =
                 Record::new(r.grid, r.y.clone()).map_err(|e| study_err!("{}: {e}", r.name))?;
             let m = MeasuredRecord::new(r.name.clone(), record);
-            Ok(match &r.input {
-                Some(u) => m.with_input(u.clone()),
-                None => m,
+            // The record's input serves the initializer and the validation of one-input
+            // models; a joint fit uses neither, but a single input is kept as it always was.
+            Ok(match r.inputs.as_slice() {
+                [u] => m.with_input(u.clone()),
+                _ => m,
             })
         })
         .collect::<StudyResult<Vec<_>>>()?;

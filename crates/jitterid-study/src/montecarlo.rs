@@ -7,7 +7,7 @@ use crate::error::{StudyError, StudyResult};
 use crate::experiment::{Experiment, Method};
 use crate::fingerprint::experiment_fingerprint;
 use crate::fit::{self, Fit, Structure};
-use crate::simulate::{realize_input, seen_input, simulate_record};
+use crate::simulate::{realize_inputs, seen_inputs, simulate_record};
 use crate::study_err;
 use crate::{RunsDone, Watch};
 use jitterid::budget::Budget;
@@ -230,16 +230,16 @@ fn one_run(
 ) -> RunOut {
     let mut go = || -> Result<Fit, String> {
         let text = |e: StudyError| e.to_string();
-        let truth = realize_input(exp, rng).map_err(text)?;
-        let signal = fit::signal_of(exp, truth.as_ref()).map_err(text)?;
+        let truth = realize_inputs(exp, rng).map_err(text)?;
+        let signal = fit::signal_of(exp, &truth).map_err(text)?;
         // Only the samples are fitted: the drawn jitter and noise go at once, and so does the
         // true signal, so that a long record's fit holds no copy of what made it.
         let y = simulate_record(exp, &signal, rng).map_err(text)?.y;
         drop(signal);
         // The model sees the input from t0 on only, as a fit of measured data would.
-        let seen = seen_input(exp, truth.as_ref()).map_err(text)?;
+        let seen = seen_inputs(exp, &truth).map_err(text)?;
         drop(truth);
-        let model = fit::signal_of(exp, seen.as_ref()).map_err(text)?;
+        let model = fit::signal_of(exp, &seen).map_err(text)?;
         drop(seen);
         let s = fit::structure(exp, model, method).map_err(text)?;
         let start = fit::perturb(&s.params(), exp.estimate.perturb, rng);
@@ -320,9 +320,9 @@ pub fn run_study(
     // Only the signal is kept (for the figures): the inputs it was built from go at once, not
     // at the end of the study.
     let signal0 = {
-        let truth0 = realize_input(exp, &mut rng0)?;
-        let input0 = seen_input(exp, truth0.as_ref())?;
-        fit::signal_of(exp, input0.as_ref())?
+        let truth0 = realize_inputs(exp, &mut rng0)?;
+        let input0 = seen_inputs(exp, &truth0)?;
+        fit::signal_of(exp, &input0)?
     };
     let names = fit::param_names(exp, &signal0, method)?;
     let truth = fit::truth_values(exp, &signal0, method)?;

@@ -55,10 +55,10 @@ pub struct Notes {
 }
 
 impl Notes {
-    /// The notes of the fit `f` of the samples `y` on `grid`, driven by `input`.
-    pub fn of(f: &Fit, grid: &SampleGrid, y: &[f64], input: Option<&Input>) -> Self {
+    /// The notes of the fit `f` of the samples `y` on `grid`, driven by `inputs`.
+    pub fn of(f: &Fit, grid: &SampleGrid, y: &[f64], inputs: &[Input]) -> Self {
         Self {
-            switches_on_grid: input.and_then(|u| switches_on_grid(u, grid)),
+            switches_on_grid: inputs.iter().find_map(|u| switches_on_grid(u, grid)),
             offset: residual_offset(&f.fitted, grid, y),
         }
     }

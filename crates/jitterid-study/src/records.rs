@@ -133,13 +133,10 @@ pub fn read_experiment(
     Ok(exp)
 }
 
-/// The input of the record in `data`: the experiment's known input, or for a random-binary
-/// experiment the realisation in `input` (default: the side file of `data`).
-pub fn read_input(
-    exp: &Experiment,
-    data: &Path,
-    input: Option<&Path>,
-) -> StudyResult<Option<Input>> {
+/// The inputs of the record in `data`, in order: the experiment's known inputs, and for a
+/// random-binary input the realisation in `input` (default: the side file of `data`), from
+/// its column `u` for a single input or the column named after the input for several.
+pub fn read_input(exp: &Experiment, data: &Path, input: Option<&Path>) -> StudyResult<Vec<Input>> {
     read_input_on(exp, data, input, &exp.grid)
 }
 
@@ -149,22 +146,55 @@ pub fn read_input_on(
     data: &Path,
     input: Option<&Path>,
     grid: &SampleGrid,
-) -> StudyResult<Option<Input>> {
-    Ok(match &exp.input {
-        InputSpec::None => None,
-        InputSpec::Known(i) => Some(i.clone()),
-        InputSpec::RandomBinary(_) => {
-            let side = input.map_or_else(|| input_side_file(data), Path::to_path_buf);
-            if !side.exists() {
-                return Err(study_err!(
-                    "{}: cannot read: file does not exist; the experiment's input is random-binary, so fit reads the input realisation written by `jitterid simulate` (or give --input FILE with columns t,u)",
-                    side.display()
-                ));
+) -> StudyResult<Vec<Input>> {
+    let mut table = None;
+    let mut out = Vec::with_capacity(exp.inputs.len());
+    for c in &exp.inputs {
+        out.push(match &c.spec {
+            InputSpec::Known(i) => i.clone(),
+            InputSpec::RandomBinary(_) => {
+                if table.is_none() {
+                    let side = input.map_or_else(|| input_side_file(data), Path::to_path_buf);
+                    if !side.exists() {
+                        return Err(study_err!(
+                            "{}: cannot read: file does not exist; the experiment's input is random-binary, so fit reads the input realisation written by `jitterid simulate` (or give --input FILE with columns {})",
+                            side.display(),
+                            side_columns(exp).join(",")
+                        ));
+                    }
+                    table = Some(csvio::read(&side)?);
+                }
+                let t = table.as_ref().ok_or_else(|| study_err!("unreachable"))?;
+                Input::Piecewise(inputs::piecewise_from_table(
+                    t,
+                    "t",
+                    side_column(exp, &c.name),
+                    grid,
+                )?)
             }
-            let t = csvio::read(&side)?;
-            Some(Input::Piecewise(inputs::piecewise_from_table(
-                &t, "t", "u", grid,
-            )?))
-        }
-    })
+        });
+    }
+    Ok(out)
+}
+
+/// The column of input `name` in a record's input file: `u` for the only input, its name when
+/// there are several.
+pub fn side_column<'a>(exp: &Experiment, name: &'a str) -> &'a str {
+    if exp.inputs.len() == 1 {
+        "u"
+    } else {
+        name
+    }
+}
+
+/// The columns of a record's input file: `t`, then one per random-binary input.
+pub fn side_columns(exp: &Experiment) -> Vec<String> {
+    let mut cols = vec!["t".to_string()];
+    cols.extend(
+        exp.inputs
+            .iter()
+            .filter(|c| matches!(c.spec, InputSpec::RandomBinary(_)))
+            .map(|c| side_column(exp, &c.name).to_string()),
+    );
+    cols
 }

@@ -95,12 +95,16 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
         )
     })?;
     let table = read_data(exp, data)?;
-    let input: Input = read_input(exp, data, None)?.ok_or_else(|| {
-        study_err!(
-            "{}: [input]: selection needs an input to identify a system",
-            exp.file
-        )
-    })?;
+    exp.selectable()?;
+    let input: Input = read_input(exp, data, None)?
+        .into_iter()
+        .next()
+        .ok_or_else(|| {
+            study_err!(
+                "{}: [input]: selection needs an input to identify a system",
+                exp.file
+            )
+        })?;
     let record = fit::record(&exp.grid, table.y).map_err(|e| study_err!("{}: {e}", table.name))?;
     // The candidates carry the system's delay (a parameter when the system is estimated,
     // else the input is delayed by it) and, with `initial = "estimate"`, a free response.
@@ -116,7 +120,7 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
     let validation = match validation {
         Some(path) => {
             let t = read_data(exp, path)?;
-            let vi = match read_input(exp, path, None)? {
+            let vi = match read_input(exp, path, None)?.into_iter().next() {
                 Some(vi) => delayed_input(&vi, known_delay).map_err(delay_err)?,
                 None => input.clone(),
             };
@@ -237,11 +241,17 @@ fn delayed_input(input: &Input, delay: Option<f64>) -> Result<Input, String> {
 pub fn auto_start(
     exp: &Experiment,
     signal: &AnySignal,
-    input: Option<&Input>,
+    inputs: &[Input],
     y: &[f64],
     data: &str,
 ) -> StudyResult<AnySignal> {
-    let input = input.ok_or_else(|| {
+    if exp.multi_input() {
+        return Err(study_err!(
+            "{}: --init auto: the initializer fits a single-input system's frequency response; a system with several inputs starts from the experiment's values (--init experiment)",
+            exp.file
+        ));
+    }
+    let input = inputs.first().ok_or_else(|| {
         study_err!(
             "{}: --init auto fits the system's frequency response to the input's, but the experiment has no [input]",
             exp.file

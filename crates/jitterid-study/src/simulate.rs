@@ -12,32 +12,43 @@ use jitterid::estimate::NoiseModel;
 use jitterid::rand::rngs::StdRng;
 use jitterid::signal::{simulate, AnySignal, Input};
 
-/// The true input of one realisation: a random binary input is drawn from `rng` (from
-/// `history` seconds before `t0`), others are fixed.
-pub fn realize_input(exp: &Experiment, rng: &mut StdRng) -> StudyResult<Option<Input>> {
-    Ok(match &exp.input {
-        InputSpec::None => None,
-        InputSpec::Known(i) => Some(i.clone()),
-        InputSpec::RandomBinary(rb) => {
-            let (a, b) = input_span(&exp.grid);
-            Some(Input::Piecewise(
-                rb.generate(a - exp.history, b, rng)
-                    .map_err(|e| study_err!("{}: [input] random-binary: {e}", exp.file))?,
-            ))
-        }
-    })
+/// The true inputs of one realisation, in order: a random binary input is drawn from `rng`
+/// (from its `history` seconds before `t0`), others are fixed. Inputs are drawn in order from
+/// the one generator, so a single input is drawn as it always was.
+pub fn realize_inputs(exp: &Experiment, rng: &mut StdRng) -> StudyResult<Vec<Input>> {
+    exp.inputs
+        .iter()
+        .map(|c| {
+            Ok(match &c.spec {
+                InputSpec::Known(i) => i.clone(),
+                InputSpec::RandomBinary(rb) => {
+                    let (a, b) = input_span(&exp.grid);
+                    Input::Piecewise(rb.generate(a - c.history, b, rng).map_err(|e| {
+                        study_err!("{}: [input] {}: random-binary: {e}", exp.file, c.name)
+                    })?)
+                }
+            })
+        })
+        .collect()
 }
 
-/// The input as a fit sees it: the true input from the record's first instant `t0` on (what
-/// `simulate` writes beside the record), as a measurement of it would.
-pub fn seen_input(exp: &Experiment, truth: Option<&Input>) -> StudyResult<Option<Input>> {
-    Ok(match truth {
-        Some(Input::Piecewise(p)) if exp.history > 0.0 => Some(Input::Piecewise(
-            crate::inputs::from_start(p, exp.grid.start())
-                .map_err(|e| study_err!("{}: [input] history: {e}", exp.file))?,
-        )),
-        other => other.cloned(),
-    })
+/// The inputs as a fit sees them: each true input from the record's first instant `t0` on
+/// (what `simulate` writes beside the record), as a measurement of it would.
+pub fn seen_inputs(exp: &Experiment, truth: &[Input]) -> StudyResult<Vec<Input>> {
+    exp.inputs
+        .iter()
+        .zip(truth)
+        .map(|(c, u)| {
+            Ok(match u {
+                Input::Piecewise(p) if c.history > 0.0 => {
+                    Input::Piecewise(crate::inputs::from_start(p, exp.grid.start()).map_err(
+                        |e| study_err!("{}: [input] {}: history: {e}", exp.file, c.name),
+                    )?)
+                }
+                other => other.clone(),
+            })
+        })
+        .collect()
 }
 
 /// One simulated record: `y`, and the drawn `τ` and `v`.
@@ -118,25 +129,26 @@ pub struct SimulatedData {
     pub t: Vec<f64>,
     /// Samples.
     pub y: Vec<f64>,
-    /// The input at `t_k`, when the experiment has one.
-    pub u: Option<Vec<f64>>,
+    /// Each input at `t_k`, in order (none when the experiment has no input).
+    pub u: Vec<Vec<f64>>,
     /// Jitter of each sample.
     pub tau: Vec<f64>,
     /// Measurement noise of each sample.
     pub v: Vec<f64>,
-    /// The input realisation (a random binary input's switch times and levels among others).
-    pub input: Option<Input>,
+    /// The input realisations, in order (a random binary input's switch times and levels
+    /// among others).
+    pub inputs: Vec<Input>,
 }
 
 /// Realisation `run` of the experiment's truth under master seed `seed`: the record of Monte
 /// Carlo run `run`.
 pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> StudyResult<SimulatedData> {
     let mut rng = realization_rng(seed, run);
-    let truth = realize_input(exp, &mut rng)?;
-    let signal = signal_of(exp, truth.as_ref())?;
+    let truth = realize_inputs(exp, &mut rng)?;
+    let signal = signal_of(exp, &truth)?;
     let sim = simulate_record(exp, &signal, &mut rng)?;
     // What a measurement records, and what the side file holds: the input from t0 on.
-    let input = seen_input(exp, truth.as_ref())?;
+    let inputs = seen_inputs(exp, &truth)?;
     if let Some(k) = sim.y.iter().position(|y| !y.is_finite()) {
         return Err(study_err!(
             "{}: the simulated sample {k} is {} (not a finite number): the experiment's values are outside the range that can be simulated; nothing was written",
@@ -145,15 +157,16 @@ pub fn simulate_data(exp: &Experiment, seed: u64, run: u64) -> StudyResult<Simul
         ));
     }
     let t: Vec<f64> = exp.grid.times().collect();
-    let u = input
-        .as_ref()
-        .map(|i| t.iter().map(|&t| i.value(t)).collect());
+    let u = inputs
+        .iter()
+        .map(|i| t.iter().map(|&t| i.value(t)).collect())
+        .collect();
     Ok(SimulatedData {
         t,
         y: sim.y,
         u,
         tau: sim.tau,
         v: sim.v,
-        input,
+        inputs,
     })
 }

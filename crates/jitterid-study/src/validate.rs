@@ -35,14 +35,28 @@ pub struct RecordReport {
     pub removed_directions: usize,
     /// Autocorrelation of the standardised residuals.
     pub whiteness: CorrelationTest,
-    /// Cross-correlation of the standardised residuals with the input (`null` without input).
+    /// Cross-correlation of the standardised residuals with the input (`null` without input;
+    /// the first input's for a system with several).
     pub cross_correlation: Option<CorrelationTest>,
+    /// For a system with several inputs: the cross-correlation test with each input, by
+    /// name (absent for one input, whose test is `cross_correlation`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub input_correlations: Vec<InputCorrelation>,
     /// Largest band power of the residual spectrum over the others (`null`: too few bins).
     pub flatness: Option<f64>,
     /// A validation record's own initial state (`initial.*`, re-estimated on it with the system
     /// held); absent for the estimation record and for a model without a free response.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub initial_state: Option<Vec<f64>>,
+}
+
+/// The cross-correlation test of the residuals with one input of a multi-input system.
+#[derive(Debug, Clone, Serialize)]
+pub struct InputCorrelation {
+    /// The input's name.
+    pub input: String,
+    /// The test (`null` for an input that is constant on the record).
+    pub test: Option<CorrelationTest>,
 }
 
 /// The JSON of `validate`, borrowed from a [`Validation`].
@@ -53,6 +67,8 @@ pub struct ValidateJson<'a> {
     fit_percent: FitPercent,
     whiteness: &'a CorrelationTest,
     cross_correlation: Option<&'a CorrelationTest>,
+    #[serde(skip_serializing_if = "<[InputCorrelation]>::is_empty")]
+    input_correlations: &'a [InputCorrelation],
     flatness: Option<f64>,
     estimation: &'a RecordReport,
     validation: Option<&'a RecordReport>,
@@ -179,14 +195,17 @@ fn signal_block(c: Option<&[Vec<Option<f64>>]>, ns: usize) -> Option<Vec<Vec<f64
 }
 
 /// The validation checks of `y` on `grid` under `s` (a fitted structure, noise level
-/// `noise_std`, driven by `input`), with the correlation tests' verdicts at `level`, and the
-/// expected samples `m_k`. `name` names the record in messages.
+/// `noise_std`, driven by `inputs`, named `input_names` when there are several), with the
+/// correlation tests' verdicts at `level`, and the expected samples `m_k`. `name` names the
+/// record in messages.
+#[allow(clippy::too_many_arguments)]
 pub fn check_record(
     s: &Structure,
     grid: &SampleGrid,
     y: &[f64],
     noise_std: f64,
-    input: Option<&Input>,
+    inputs: &[Input],
+    input_names: &[String],
     level: f64,
     name: &str,
 ) -> StudyResult<(RecordReport, Vec<f64>)> {
@@ -198,13 +217,26 @@ pub fn check_record(
     let m = validation::default_max_lag(y.len());
     let whiteness =
         validation::whiteness(&tested.residuals, m, tested.noise_params, level).map_err(e)?;
-    let cross = match input {
-        Some(input) => {
+    let crosses: Vec<Option<CorrelationTest>> = inputs
+        .iter()
+        .map(|input| {
             let u: Vec<f64> = grid.times().map(|t| input.value(t)).collect();
             // A constant input has no cross-correlation to test.
             validation::cross_correlation(&tested.residuals, &u, m, &tested.basis, level).ok()
-        }
-        None => None,
+        })
+        .collect();
+    let cross = crosses.first().cloned().flatten();
+    let input_correlations = if inputs.len() > 1 {
+        input_names
+            .iter()
+            .zip(crosses)
+            .map(|(n, test)| InputCorrelation {
+                input: n.clone(),
+                test,
+            })
+            .collect()
+    } else {
+        Vec::new()
     };
     let flatness = transform(grid, &DirichletWindow, &raw, &FrequencySet::dft(grid))
         .ok()
@@ -216,6 +248,7 @@ pub fn check_record(
         removed_directions: tested.removed,
         whiteness,
         cross_correlation: cross,
+        input_correlations,
         flatness,
         initial_state: None,
     };
@@ -226,15 +259,33 @@ pub fn check_record(
 /// a free response, started from the record's own state, re-estimated on the record with the
 /// system held ([`validation::on_record`]): the state the estimation record started from says
 /// nothing about another record's.
+///
+/// A multi-input model is driven by the record's inputs with its parameters as fitted; a free
+/// response of one of its channels is not re-estimated on another record yet, and is refused.
 fn for_validation_record(
+    exp: &Experiment,
     fitted: &Structure,
     grid: &SampleGrid,
     y: &[f64],
-    input: Option<&Input>,
+    inputs: &[Input],
     name: &str,
 ) -> StudyResult<Structure> {
-    validation::on_record(fitted, grid, y, input)
-        .map_err(|e| study_err!("{name}: the model on the validation record: {e}"))
+    let err =
+        |e: &dyn std::fmt::Display| study_err!("{name}: the model on the validation record: {e}");
+    if exp.multi_input() {
+        if fitted
+            .signal
+            .param_names()
+            .iter()
+            .any(|n| n.contains(&format!(".{}", validation::INITIAL_PREFIX)))
+        {
+            return Err(err(&"a multi-input model's free response (initial = \"estimate\") is not re-estimated on a validation record; validate it on its estimation record"));
+        }
+        let mut s = fitted.clone();
+        s.signal = fit::build_signal(exp, &fitted.signal.spec(), inputs).map_err(|e| err(&e))?;
+        return Ok(s);
+    }
+    validation::on_record(fitted, grid, y, inputs.first()).map_err(|e| err(&e))
 }
 
 /// The free response's coefficients of a signal that has them.
@@ -438,6 +489,7 @@ impl Validation {
             },
             whiteness: &e.whiteness,
             cross_correlation: e.cross_correlation.as_ref(),
+            input_correlations: &e.input_correlations,
             flatness: e.flatness,
             estimation: e,
             validation: v,
@@ -493,8 +545,8 @@ pub struct RecordSamples {
     pub grid: SampleGrid,
     /// Its samples.
     pub y: Vec<f64>,
-    /// Its input (the experiment's known input, or the record's realisation).
-    pub input: Option<Input>,
+    /// Its inputs, in order (the experiment's known inputs, or the record's realisations).
+    pub inputs: Vec<Input>,
 }
 
 /// A fitted model given as the JSON of `jitterid fit --json`, instead of fitted here.
@@ -516,22 +568,22 @@ pub fn validate(
 ) -> StudyResult<Validation> {
     let level = check_level(o.level, "--level")?;
     let table = read_data(exp, data)?;
-    let input = read_input_on(exp, data, o.input, &exp.grid)?;
+    let inputs = read_input_on(exp, data, o.input, &exp.grid)?;
     let estimation = RecordSamples {
         name: table.name,
         grid: exp.grid,
         y: table.y,
-        input,
+        inputs,
     };
     let validation = match o.validation {
         Some(path) => {
             let (grid, y, name) = read_validation(exp, path)?;
-            let input = read_input_on(exp, path, None, &grid)?;
+            let inputs = read_input_on(exp, path, None, &grid)?;
             Some(RecordSamples {
                 name,
                 grid,
                 y,
-                input,
+                inputs,
             })
         }
         None => None,
@@ -560,8 +612,11 @@ pub fn validate_records(
     watch: &Watch,
 ) -> StudyResult<Validation> {
     let level = check_level(level, "level")?;
-    let RecordSamples { name, y, input, .. } = estimation;
-    let signal = fit::signal_of(exp, input.as_ref())?;
+    let RecordSamples {
+        name, y, inputs, ..
+    } = estimation;
+    let signal = fit::signal_of(exp, &inputs)?;
+    let names: Vec<String> = exp.inputs.iter().map(|c| c.name.clone()).collect();
     let (fitted, noise_std, covariance) = match model {
         Some(m) => {
             let s = fit::structure(exp, signal, exp.estimate.method)?;
@@ -574,13 +629,7 @@ pub fn validate_records(
         }
     };
     let (report, expected) = check_record(
-        &fitted,
-        &exp.grid,
-        &y,
-        noise_std,
-        input.as_ref(),
-        level,
-        &name,
+        &fitted, &exp.grid, &y, noise_std, &inputs, &names, level, &name,
     )?;
     let estimation = ValidatedRecord {
         report,
@@ -590,15 +639,9 @@ pub fn validate_records(
     };
     let validation = match validation {
         Some(r) => {
-            let s = for_validation_record(&fitted, &r.grid, &r.y, r.input.as_ref(), &r.name)?;
+            let s = for_validation_record(exp, &fitted, &r.grid, &r.y, &r.inputs, &r.name)?;
             let (mut report, expected) = check_record(
-                &s,
-                &r.grid,
-                &r.y,
-                noise_std,
-                r.input.as_ref(),
-                level,
-                &r.name,
+                &s, &r.grid, &r.y, noise_std, &r.inputs, &names, level, &r.name,
             )?;
             report.initial_state = initial_state(&s.signal);
             Some(ValidatedRecord {

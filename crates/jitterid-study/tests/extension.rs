@@ -202,7 +202,7 @@ fn an_out_of_tree_family_is_fitted_and_studied_through_the_study_layer() {
 
     // One record, simulated and fitted as `jitterid simulate` and `fit` do.
     let data = simulate::simulate_data(&exp, 11, 0).unwrap();
-    let signal = fit::signal_of(&exp, data.input.as_ref()).unwrap();
+    let signal = fit::signal_of(&exp, &data.inputs).unwrap();
     let f = fit::fit_values(&exp, signal, data.y, "record", &Watch::none()).unwrap();
     assert!(f.converged, "{}", f.termination);
     assert_eq!(f.params[0].name, "jitter.a");
@@ -334,7 +334,7 @@ fn an_out_of_tree_likelihood_is_fitted_and_studied_through_the_study_layer() {
 
     // Its gradient in the signal's parameters against central differences of its value.
     let data = simulate::simulate_data(&exp, 5, 0).unwrap();
-    let signal = fit::signal_of(&exp, data.input.as_ref()).unwrap();
+    let signal = fit::signal_of(&exp, &data.inputs).unwrap();
     let structure = fit::structure(&exp, signal.clone(), exp.estimate.method).unwrap();
     let record = jitterid::estimate::Record::new(exp.grid, data.y.clone()).unwrap();
     let prepared = MeanGaussian.prepare(&structure, &record);

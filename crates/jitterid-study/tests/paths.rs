@@ -119,7 +119,7 @@ fn a_path_inside_the_directory_is_read() {
     for p in ["u.csv", "./u.csv", "data/u.csv", "data/./u.csv"] {
         let exp = read(&d, p, Paths::Inside).unwrap_or_else(|e| panic!("{p}: {e}"));
         assert!(matches!(
-            exp.input,
+            exp.inputs[0].spec,
             experiment::InputSpec::Known(jitterid::signal::Input::Piecewise(_))
         ));
     }

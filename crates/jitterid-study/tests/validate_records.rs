@@ -40,7 +40,7 @@ fn in_memory(exp: &Experiment, file: &str, validation: bool) -> RecordSamples {
         read_data(exp, &path).unwrap();
         exp.grid
     };
-    let input = if validation {
+    let inputs = if validation {
         read_input_on(exp, &path, None, &grid).unwrap()
     } else {
         read_input(exp, &path, None).unwrap()
@@ -49,7 +49,7 @@ fn in_memory(exp: &Experiment, file: &str, validation: bool) -> RecordSamples {
         name: table.name,
         grid,
         y,
-        input,
+        inputs,
     }
 }
 
@@ -88,7 +88,7 @@ fn records_in_memory_validate_as_their_files_do() {
 fn a_model_given_as_fit_json_validates_as_its_file_does() {
     let exp = model();
     let record = in_memory(&exp, "estimation.csv", false);
-    let signal = signal_of(&exp, record.input.as_ref()).unwrap();
+    let signal = signal_of(&exp, &record.inputs).unwrap();
     let f = fit_values(&exp, signal, record.y.clone(), "fit", &Watch::none()).unwrap();
     let text = serde_json::to_string(&fit_json(&f)).unwrap();
     let dir = tempfile::tempdir().unwrap();

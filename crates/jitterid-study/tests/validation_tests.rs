@@ -26,15 +26,16 @@ fn checked(
     level: f64,
 ) -> RecordReport {
     let d = simulate_data(truth, seed, run).unwrap();
-    let input = d.input.as_ref();
-    let signal = signal_of(model, input).unwrap();
+    let inputs = &d.inputs;
+    let signal = signal_of(model, inputs).unwrap();
     let f = fit_values(model, signal, d.y.clone(), "record", &Watch::none()).unwrap();
     check_record(
         &f.fitted,
         &model.grid,
         &d.y,
         f.noise_std,
-        input,
+        inputs,
+        &[],
         level,
         "record",
     )

@@ -75,10 +75,10 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     let (name, tau) = (data.name, data.tau);
     // The one copy of the samples: the fit, the start and the figures share it.
     let record = fit::record(&exp.grid, data.y).map_err(|e| study_err!("{name}: {e}"))?;
-    let input = read_input(&exp, data_file, o.input.as_deref())?;
-    let mut signal = fit::signal_of(&exp, input.as_ref())?;
+    let inputs = read_input(&exp, data_file, o.input.as_deref())?;
+    let mut signal = fit::signal_of(&exp, &inputs)?;
     if o.init == InitChoice::Auto {
-        signal = fit::data_start(&exp, &signal, input.as_ref(), record.y(), &name)?;
+        signal = fit::data_start(&exp, &signal, &inputs, record.y(), &name)?;
     }
     let ticker = Ticker::start(&format!("fitting with {}", method.as_str()));
     let watch = Watch {
@@ -87,14 +87,15 @@ pub fn fit(o: &FitRequest) -> StudyResult<Outcome> {
     };
     let f = fit_record(&exp, signal.clone(), &record, &watch)?;
     drop(ticker);
-    let notes = Notes::of(&f, &exp.grid, record.y(), input.as_ref());
+    let notes = Notes::of(&f, &exp.grid, record.y(), &inputs);
 
     if let Some(dir) = &o.plot {
         let data = Samples {
             record: &record,
             tau: tau.as_deref(),
         };
-        write_fit_figures(dir, &exp, &f, &signal, input.as_ref(), &data)?;
+        // The figures draw one input (the first of several).
+        write_fit_figures(dir, &exp, &f, &signal, inputs.first(), &data)?;
     }
 
     report(o, &exp, &f, &notes, &name)

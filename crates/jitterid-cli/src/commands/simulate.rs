@@ -2,11 +2,11 @@
 //! side file.
 
 use crate::output::{self, OutputSet};
-use jitterid::signal::Input;
+use jitterid::signal::{Input, PiecewiseConstant};
 use jitterid_study::csvio::{self, Column};
 use jitterid_study::error::StudyResult;
 use jitterid_study::experiment::{self, InputSpec, Purpose, ReadOptions};
-use jitterid_study::records::input_side_file;
+use jitterid_study::records::{input_side_file, side_column};
 use jitterid_study::simulate::{simulate_data, SimulatedData};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -38,7 +38,7 @@ pub fn simulate(o: &SimulateOptions) -> StudyResult<String> {
         u,
         tau,
         v,
-        input,
+        inputs,
     } = simulate_data(&exp, o.seed, o.run)?;
     let n = exp.grid.len();
     let k: Vec<usize> = (0..n).collect();
@@ -47,8 +47,9 @@ pub fn simulate(o: &SimulateOptions) -> StudyResult<String> {
         Column::Real("t", &t),
         Column::Real("y", &y),
     ];
-    if let Some(u) = &u {
-        cols.push(Column::Real("u", u));
+    // One input is the column `u`; several are named after their inputs.
+    for (c, u) in exp.inputs.iter().zip(&u) {
+        cols.push(Column::Real(side_column(&exp, &c.name), u));
     }
     if o.truth {
         cols.push(Column::Real("tau", &tau));
@@ -66,21 +67,42 @@ pub fn simulate(o: &SimulateOptions) -> StudyResult<String> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    if let (InputSpec::RandomBinary(_), Some(Input::Piecewise(p))) = (&exp.input, &input) {
+    // The realisations of the random-binary inputs, which the experiment cannot rebuild.
+    let (names, drawn): (Vec<&str>, Vec<&PiecewiseConstant>) = exp
+        .inputs
+        .iter()
+        .zip(&inputs)
+        .filter_map(|(c, u)| match (&c.spec, u) {
+            (InputSpec::RandomBinary(_), Input::Piecewise(p)) => {
+                Some((side_column(&exp, &c.name), p))
+            }
+            _ => None,
+        })
+        .unzip();
+    if !drawn.is_empty() {
         if output::writes_through(&o.out) {
             report.push_str(
                 "; the input realisation is not written (a device or FIFO has no side file)",
             );
         } else {
             let side = input_side_file(&o.out);
-            let edges = p.edges();
-            outputs.file(&side, csvio::input_to_csv(p));
-            let _ = write!(
-                report,
-                "; {}: the input's {} switch times and levels",
-                side.display(),
-                edges.len()
-            );
+            if let [p] = drawn.as_slice() {
+                outputs.file(&side, csvio::input_to_csv(p));
+                let _ = write!(
+                    report,
+                    "; {}: the input's {} switch times and levels",
+                    side.display(),
+                    p.edges().len()
+                );
+            } else {
+                outputs.file(&side, csvio::inputs_to_csv(&names, &drawn));
+                let _ = write!(
+                    report,
+                    "; {}: the switch times and levels of the inputs {}",
+                    side.display(),
+                    names.join(", ")
+                );
+            }
         }
     }
     outputs.commit()?;

@@ -154,17 +154,34 @@ fn validate_text(exp: &Experiment, v: &Validation, model: Option<&Path>) -> Stri
     row("whiteness", &|r| verdict(&r.whiteness));
     row("  statistic", &|r| statistic(&r.whiteness));
     row("  lags outside", &|r| lags(&r.whiteness));
-    row("input correlation", &|r| {
-        r.cross_correlation
-            .as_ref()
-            .map_or("– (no input)".into(), verdict)
-    });
-    row("  statistic", &|r| {
-        r.cross_correlation.as_ref().map_or("–".into(), statistic)
-    });
-    row("  lags outside", &|r| {
-        r.cross_correlation.as_ref().map_or("–".into(), lags)
-    });
+    if exp.inputs.len() > 1 {
+        // One block per input of a multi-input system, named by the input.
+        for (i, c) in exp.inputs.iter().enumerate() {
+            let test =
+                move |r: &RecordReport| r.input_correlations.get(i).and_then(|x| x.test.clone());
+            row(&format!("correlation with {}", c.name), &|r| {
+                test(r).map_or("– (constant)".into(), |t| verdict(&t))
+            });
+            row("  statistic", &|r| {
+                test(r).map_or("–".into(), |t| statistic(&t))
+            });
+            row("  lags outside", &|r| {
+                test(r).map_or("–".into(), |t| lags(&t))
+            });
+        }
+    } else {
+        row("input correlation", &|r| {
+            r.cross_correlation
+                .as_ref()
+                .map_or("– (no input)".into(), verdict)
+        });
+        row("  statistic", &|r| {
+            r.cross_correlation.as_ref().map_or("–".into(), statistic)
+        });
+        row("  lags outside", &|r| {
+            r.cross_correlation.as_ref().map_or("–".into(), lags)
+        });
+    }
     row("flatness", &|r| {
         r.flatness.map_or("–".into(), |f| format!("{f:.2}"))
     });

@@ -9,8 +9,8 @@ mod table;
 
 pub use error::{io_reason, CsvError};
 pub use record_io::{
-    input_from_table, input_side_file, input_to_csv, load_record, piecewise, record_from_table,
-    record_to_csv, save_record,
+    input_from_table, input_side_file, input_to_csv, inputs_to_csv, load_record, piecewise,
+    record_from_table, record_to_csv, save_record,
 };
 pub use table::{
     check_regular_file, excerpt, format, open_rows, parse, read, read_as, read_text, Column, Rows,

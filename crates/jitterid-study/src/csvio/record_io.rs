@@ -229,6 +229,22 @@ pub fn input_to_csv(input: &PiecewiseConstant) -> String {
     table::format(&[Column::Real("t", input.edges()), Column::Real("u", &levels)])
 }
 
+/// The input file's text of several piecewise-constant inputs, one column per input named by
+/// `names`: every input's switch times in one column `t`, and each input's level from that time
+/// on (held where the input does not switch), with a last row of levels 0 that ends them.
+pub fn inputs_to_csv(names: &[&str], inputs: &[&PiecewiseConstant]) -> String {
+    let mut t: Vec<f64> = inputs.iter().flat_map(|p| p.edges().to_vec()).collect();
+    t.sort_by(f64::total_cmp);
+    t.dedup();
+    let levels: Vec<Vec<f64>> = inputs
+        .iter()
+        .map(|p| t.iter().map(|&t| p.value(t)).collect())
+        .collect();
+    let mut cols = vec![Column::Real("t", &t)];
+    cols.extend(names.iter().zip(&levels).map(|(n, l)| Column::Real(n, l)));
+    table::format(&cols)
+}
+
 /// Writes a measured record to `data` and, for a piecewise-constant input, its switch times and
 /// levels to the side file [`input_side_file`] (read back exactly by [`load_record`]).
 ///

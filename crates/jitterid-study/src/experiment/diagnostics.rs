@@ -290,8 +290,33 @@ pub(super) fn shape_error(file: &str, text: &str) -> Option<StudyError> {
         Some(l) => study_err!("{file}:{l}: {msg}"),
         None => study_err!("{file}: {msg}"),
     };
+    // A date in a section's table, with its line.
+    let dated = |t: &toml::Table, name: &str| {
+        t.iter().find_map(|(key, v)| {
+            let date = match v {
+                toml::Value::Datetime(d) => Some(d),
+                toml::Value::Array(a) => a.iter().find_map(|x| match x {
+                    toml::Value::Datetime(d) => Some(d),
+                    _ => None,
+                }),
+                _ => None,
+            }?;
+            Some(at(
+                key_line(text, name, key),
+                format!("[{name}] {key}: expected a number or a string, found the date {date}"),
+            ))
+        })
+    };
     for &name in super::raw::SECTIONS.iter().filter(|s| **s != "title") {
         match doc.get(name) {
+            Some(toml::Value::Array(a)) if MANY.contains(&name) => {
+                if let Some(e) = a.iter().find_map(|t| match t {
+                    toml::Value::Table(t) => dated(t, name),
+                    _ => None,
+                }) {
+                    return Some(e);
+                }
+            }
             Some(toml::Value::Array(_)) => {
                 return Some(at(
                     array_header_line(text, name),
@@ -299,23 +324,8 @@ pub(super) fn shape_error(file: &str, text: &str) -> Option<StudyError> {
                 ))
             }
             Some(toml::Value::Table(t)) => {
-                for (key, v) in t {
-                    let date = match v {
-                        toml::Value::Datetime(d) => Some(d),
-                        toml::Value::Array(a) => a.iter().find_map(|x| match x {
-                            toml::Value::Datetime(d) => Some(d),
-                            _ => None,
-                        }),
-                        _ => None,
-                    };
-                    if let Some(d) = date {
-                        return Some(at(
-                            key_line(text, name, key),
-                            format!(
-                                "[{name}] {key}: expected a number or a string, found the date {d}"
-                            ),
-                        ));
-                    }
+                if let Some(e) = dated(t, name) {
+                    return Some(e);
                 }
             }
             _ => {}
@@ -323,3 +333,7 @@ pub(super) fn shape_error(file: &str, text: &str) -> Option<StudyError> {
     }
     None
 }
+
+/// The sections that may be written as an array of tables, one per input of a multi-input
+/// system (`[[input]]`, `[[system]]`).
+const MANY: &[&str] = &["input", "system"];

@@ -5,7 +5,7 @@ use super::diagnostics::Source;
 use super::paths;
 use super::range;
 use super::raw::RawInput;
-use super::spec::{InputSpec, SystemSpec};
+use super::spec::{InputChannel, InputSpec, SystemSpec};
 use crate::csvio;
 use crate::error::StudyResult;
 use crate::inputs::{input_span, piecewise, piecewise_from_table};
@@ -22,14 +22,14 @@ const S: &str = "input";
 const KINDS: &str = "\"random-binary\", \"sine\", \"multisine\", \"piecewise\" or \"csv\"";
 
 /// The input of `system`: none for a kind without one (a sinusoid), required for a kind the
-/// signal registry drives by an input (a rational system); with the input's history before
-/// `t0` in seconds (`[input] history`, 0 unless given).
+/// signal registry drives by an input (a rational system), with its history before `t0` in
+/// seconds (`[input] history`, 0 unless given) and its name (`u` unless given).
 pub(super) fn parse_input_section(
     cx: &Source,
     r: Option<&RawInput>,
     system: &SystemSpec,
     grid: &SampleGrid,
-) -> StudyResult<(InputSpec, f64)> {
+) -> StudyResult<Vec<InputChannel>> {
     let name = system
         .kind
         .get(KIND_KEY)
@@ -42,18 +42,62 @@ pub(super) fn parse_input_section(
         .is_some_and(|k| k.needs_input());
     let why = format!("a {name} system has no input; remove the [input] section");
     match (needs_input, r) {
-        (false, None) => Ok((InputSpec::None, 0.0)),
+        (false, None) => Ok(Vec::new()),
         (false, Some(r)) => Err(cx.err_at(S, "kind", r.kind.as_ref(), why)),
         (true, None) => Err(study_err!(
             "{}: missing section [input]; a {name} system needs an input (kind = {KINDS})",
             cx.file,
         )),
-        (true, Some(r)) => {
-            let history =
-                cx.opt_checked(S, "history", &r.history, 0.0, |h| range::history(h, grid))?;
-            Ok((parse_input(cx, r, grid, history)?, history))
-        }
+        (true, Some(r)) => Ok(vec![parse_channel(cx, r, grid, "u")?]),
     }
+}
+
+/// One input: its name (`default_name` unless given), kind and history.
+pub(super) fn parse_channel(
+    cx: &Source,
+    r: &RawInput,
+    grid: &SampleGrid,
+    default_name: &str,
+) -> StudyResult<InputChannel> {
+    let history = cx.opt_checked(S, "history", &r.history, 0.0, |h| range::history(h, grid))?;
+    let name = match &r.name {
+        None => default_name.to_string(),
+        Some(n) => {
+            let name = n.get_ref();
+            input_name(name).map_err(|m| cx.err(S, "name", &n.span(), m))?;
+            name.clone()
+        }
+    };
+    Ok(InputChannel {
+        name,
+        spec: parse_input(cx, r, grid, history)?,
+        history,
+    })
+}
+
+/// Columns of a record's files that an input's name would collide with, and the name of the
+/// output offset's parameter (an input's name prefixes its channel's parameters).
+const RESERVED: &[&str] = &["k", "t", "y", "tau", "v", "offset"];
+
+/// An input's name: it names the input's column in a record's input file and prefixes its
+/// channel's parameters (`brake.a0`), so it is a word of ASCII letters, digits, `_` and `-`,
+/// starting with a letter, and not a column the files already have.
+fn input_name(name: &str) -> Result<(), String> {
+    let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    if !ok {
+        return Err(format!(
+            "expected a name of ASCII letters, digits, _ and -, starting with a letter, found \"{name}\""
+        ));
+    }
+    if RESERVED.contains(&name) {
+        return Err(format!(
+            "\"{name}\" is a column of the record's files or a parameter's name; expected another name"
+        ));
+    }
+    Ok(())
 }
 
 fn parse_input(
@@ -65,11 +109,11 @@ fn parse_input(
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
     let name = kind.get_ref().as_str();
     let allowed: &[&str] = match name {
-        "random-binary" => &["kind", "mean_dwell", "low", "high", "history"],
-        "sine" => &["kind", "frequency", "amplitude", "phase"],
-        "multisine" => &["kind", "frequencies", "amplitudes", "phases"],
-        "piecewise" => &["kind", "times", "values"],
-        "csv" => &["kind", "path", "time_column", "value_column"],
+        "random-binary" => &["name", "kind", "mean_dwell", "low", "high", "history"],
+        "sine" => &["name", "kind", "frequency", "amplitude", "phase"],
+        "multisine" => &["name", "kind", "frequencies", "amplitudes", "phases"],
+        "piecewise" => &["name", "kind", "times", "values"],
+        "csv" => &["name", "kind", "path", "time_column", "value_column"],
         other => {
             return Err(cx.err(
                 S,

@@ -31,7 +31,11 @@ pub(super) fn check_method(
             cx.err_at("estimate", "method", key, msg)
         }
     };
-    let flag = raw.system.as_ref().and_then(|s| s.estimate.as_ref());
+    let flag = raw
+        .system
+        .as_ref()
+        .and_then(|s| s.first())
+        .and_then(|s| s.estimate.as_ref());
     let at_system = |msg: &str| cx.err_at("system", "estimate", flag, msg);
     if method.is_likelihood_in(&cx.registries.criteria) && !cfg!(feature = "ml") {
         return Err(blame(

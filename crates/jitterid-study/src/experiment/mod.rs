@@ -7,6 +7,7 @@
 //! line and the key, and says what was expected (`diagnostics`). The key names are
 //! documented in `docs/experiments.md`.
 
+mod channels;
 mod checks;
 mod diagnostics;
 mod estimate;
@@ -28,8 +29,8 @@ pub use overrides::Override;
 pub use paths::Paths;
 pub use sampling::MAX_SAMPLES;
 pub use spec::{
-    name_table, EstimateSpec, Experiment, InputSpec, JitterSpec, LikelihoodStart, Method,
-    NoiseSpec, SolverName, SystemSpec,
+    name_table, EstimateSpec, Experiment, InputChannel, InputSpec, JitterSpec, LikelihoodStart,
+    Method, NoiseSpec, SolverName, SystemSpec,
 };
 
 use crate::csvio;
@@ -39,7 +40,7 @@ use crate::Registries;
 use diagnostics::{shape_error, toml_error, Source};
 use jitterid::estimate::{AnyNoise, Frequencies};
 use jitterid::signal::Input;
-use raw::RawExperiment;
+use raw::{OneOrMany, RawExperiment};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -231,25 +232,34 @@ pub fn parse_with(
     let r_sampling = raw.sampling.as_ref().ok_or_else(|| {
         study_err!("{file}: missing section [sampling]; expected keys interval, samples and optionally start")
     })?;
-    let r_system = raw.system.as_ref().ok_or_else(|| {
+    let r_systems = raw.system.as_ref().map(OneOrMany::items).ok_or_else(|| {
         study_err!(
             "{file}: missing section [system]; expected kind = {} and its keys",
             system::kinds(&registries.signal)
         )
     })?;
+    let r_inputs = raw.input.as_ref().map(OneOrMany::items).unwrap_or_default();
     let grid = sampling::parse_sampling(&cx, r_sampling)?;
-    let mut system = system::parse_system(&cx, r_system, &grid)?;
+    let (mut system, inputs) = if r_systems.len() == 1 && r_inputs.len() <= 1 {
+        let r_system = r_systems[0];
+        let system = system::parse_system(&cx, r_system, &grid)?;
+        let inputs = input::parse_input_section(&cx, r_inputs.first().copied(), &system, &grid)?;
+        if let (Some(d), Some(InputSpec::Known(Input::Tones(_)))) =
+            (&r_system.delay, inputs.first().map(|c| &c.spec))
+        {
+            // A tone's delay is a phase: the delayed response needs an input made of steps.
+            return Err(cx.err(
+                "system",
+                "delay",
+                &d.span(),
+                "needs an input made of steps (random-binary, piecewise or csv); a sine or multisine input's delay is a phase",
+            ));
+        }
+        (system, inputs)
+    } else {
+        channels::parse_channels(&cx, &r_systems, &r_inputs, &grid)?
+    };
     system::output_keys(&cx, raw.output.as_ref(), &mut system)?;
-    let (input, history) = input::parse_input_section(&cx, raw.input.as_ref(), &system, &grid)?;
-    if let (Some(d), InputSpec::Known(Input::Tones(_))) = (&r_system.delay, &input) {
-        // A tone's delay is a phase: the delayed response needs an input made of steps.
-        return Err(cx.err(
-            "system",
-            "delay",
-            &d.span(),
-            "needs an input made of steps (random-binary, piecewise or csv); a sine or multisine input's delay is a phase",
-        ));
-    }
     let jitter = match &raw.jitter {
         Some(r) => jitter::parse_jitter(&cx, r, &grid)?,
         None => jitter::no_jitter(),
@@ -299,8 +309,7 @@ pub fn parse_with(
         title: raw.title.clone(),
         registries: Arc::clone(registries),
         grid,
-        input,
-        history,
+        inputs,
         system,
         jitter,
         noise,

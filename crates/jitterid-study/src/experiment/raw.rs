@@ -38,6 +38,7 @@ section!(RawSampling, "table [sampling]" {
 });
 
 section!(RawInput, "table [input]" {
+    name: String,
     kind: String,
     mean_dwell: f64,
     low: f64,
@@ -117,9 +118,9 @@ pub(super) struct RawExperiment {
     #[serde(default)]
     pub(super) sampling: Option<RawSampling>,
     #[serde(default)]
-    pub(super) input: Option<RawInput>,
+    pub(super) input: Option<OneOrMany<RawInput>>,
     #[serde(default)]
-    pub(super) system: Option<RawSystem>,
+    pub(super) system: Option<OneOrMany<RawSystem>>,
     #[serde(default)]
     pub(super) jitter: Option<RawTable>,
     #[serde(default)]
@@ -130,6 +131,62 @@ pub(super) struct RawExperiment {
     pub(super) estimate: Option<RawEstimate>,
     #[serde(default)]
     pub(super) select: Option<RawSelect>,
+}
+
+/// A section written once (`[input]`) or as an array of tables (`[[input]]`, one per input of
+/// a multi-input system). Read by hand rather than as an untagged enum so that an error inside
+/// a table (an unknown key, a wrong type) keeps its own message and place.
+#[derive(Debug)]
+pub(super) enum OneOrMany<T> {
+    /// `[name]`.
+    One(T),
+    /// `[[name]]`, in file order.
+    Many(Vec<T>),
+}
+
+impl<T> OneOrMany<T> {
+    /// The tables, in file order.
+    pub(super) fn items(&self) -> Vec<&T> {
+        match self {
+            OneOrMany::One(t) => vec![t],
+            OneOrMany::Many(v) => v.iter().collect(),
+        }
+    }
+
+    /// The first table (the only one of `[name]`).
+    pub(super) fn first(&self) -> Option<&T> {
+        match self {
+            OneOrMany::One(t) => Some(t),
+            OneOrMany::Many(v) => v.first(),
+        }
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for OneOrMany<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Visit<T> {
+            type Value = OneOrMany<T>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a table or an array of tables")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<Self::Value, A::Error> {
+                T::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(OneOrMany::One)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                seq: A,
+            ) -> Result<Self::Value, A::Error> {
+                Vec::<T>::deserialize(serde::de::value::SeqAccessDeserializer::new(seq))
+                    .map(OneOrMany::Many)
+            }
+        }
+        d.deserialize_any(Visit(std::marker::PhantomData))
+    }
 }
 
 pub(super) const SECTIONS: &[&str] = &[

@@ -11,25 +11,38 @@ use std::fmt;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// How the input is obtained.
+/// How an input is obtained.
 #[derive(Debug, Clone, PartialEq)]
 pub enum InputSpec {
-    /// No input (a sinusoid system).
-    None,
     /// A random binary input, drawn per realisation from the seed.
     RandomBinary(RandomBinary),
     /// A known input.
     Known(Input),
 }
 
-/// The `[system]` section.
+/// One input of the experiment (`[input]`, or one table of `[[input]]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputChannel {
+    /// Its name (`name`; `u` for a single input, `u1`, `u2`, … for several): the prefix of its
+    /// channel's parameters and its column in a record's input file.
+    pub name: String,
+    /// How it is obtained.
+    pub spec: InputSpec,
+    /// How long (s) the true input ran before the record's first instant `t0`: a random
+    /// binary input is drawn from `t0 − history`, and a fit sees it from `t0` on only.
+    pub history: f64,
+}
+
+/// The `[system]` section, or the `[[system]]` tables of a multi-input system.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SystemSpec {
     /// The signal registry's spec table (`kind` and that kind's keys, checked at the door): the
     /// truth in `simulate`/`montecarlo`, the start in `fit`. Built with
-    /// [`crate::fit::signal_of`].
+    /// [`crate::fit::signal_of`]. A multi-input system's is a `superposition` table
+    /// ([`jitterid::signal::superposition`]): the input names, one spec table per input and
+    /// which of them are estimated.
     pub kind: SpecTable,
-    /// Whether its parameters are estimated.
+    /// Whether any of its parameters are estimated.
     pub estimate: bool,
 }
 
@@ -300,11 +313,8 @@ pub struct Experiment {
     pub registries: Arc<Registries>,
     /// The sampling grid.
     pub grid: SampleGrid,
-    /// The input.
-    pub input: InputSpec,
-    /// How long (s) the true input ran before the record's first instant `t0`: a random
-    /// binary input is drawn from `t0 − history`, and a fit sees it from `t0` on only.
-    pub history: f64,
+    /// The inputs, in order (none for a system without one, a sinusoid).
+    pub inputs: Vec<InputChannel>,
     /// The system.
     pub system: SystemSpec,
     /// The jitter.
@@ -318,6 +328,25 @@ pub struct Experiment {
 }
 
 impl Experiment {
+    /// Whether the system has several inputs (a `superposition` of one response per input).
+    pub fn multi_input(&self) -> bool {
+        self.system.kind.get(jitterid::signal::registry::KIND_KEY)
+            == Some(&jitterid::signal::superposition::SUPERPOSITION_KIND.into())
+    }
+
+    /// Whether any input ran before the record's first instant (`history > 0`).
+    pub fn has_history(&self) -> bool {
+        self.inputs.iter().any(|c| c.history > 0.0)
+    }
+
+    /// Whether any input is random binary (drawn per realisation; a record keeps its
+    /// realisation in a side file).
+    pub fn random_input(&self) -> bool {
+        self.inputs
+            .iter()
+            .any(|c| matches!(c.spec, InputSpec::RandomBinary(_)))
+    }
+
     /// The output offset of `[output]`: `(y₀, estimated)`, `None` without one (the system's
     /// spec table holds it as the keys `offset` and `estimate_offset`).
     pub fn output_offset(&self) -> Option<(f64, bool)> {
@@ -334,6 +363,12 @@ impl Experiment {
     ///
     /// One line naming `[output]` when the experiment has an output offset.
     pub fn selectable(&self) -> crate::error::StudyResult<()> {
+        if self.multi_input() {
+            return Err(crate::study_err!(
+                "{}: [[input]]: select ranks the orders of a single-input system; a system with several inputs is fitted with its orders given (jitterid fit), and compared by its fits' criteria",
+                self.file
+            ));
+        }
         match self.output_offset() {
             None => Ok(()),
             Some(_) => Err(crate::study_err!(

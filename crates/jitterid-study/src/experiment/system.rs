@@ -321,11 +321,13 @@ pub(super) fn output_keys(
         .and_then(Value::as_str)
         .unwrap_or_default()
         .to_string();
-    let takes = cx
-        .registries
-        .signal
-        .kind(&name)
-        .is_some_and(|k| k.params().iter().any(|p| p.key == "offset"));
+    // A multi-input system has one offset, added to the sum of its inputs' responses.
+    let takes = name == jitterid::signal::superposition::SUPERPOSITION_KIND
+        || cx
+            .registries
+            .signal
+            .kind(&name)
+            .is_some_and(|k| k.params().iter().any(|p| p.key == "offset"));
     if !takes {
         return Err(cx.err(
             O,

@@ -1,0 +1,216 @@
+//! Several inputs through the binary (`[[input]]`, `[[system]]`): a two-input record simulated
+//! by the tool is fitted by BCLS and ML with every parameter within its standard error's
+//! reach, the files carry one column per input, `validate` tests every input, `fit --json`'s
+//! `model` has one transfer function per input and one state-space model with a column of `B`
+//! per input, a Monte Carlo is unbiased, and bad files exit 2 naming what is wrong.
+
+mod common;
+
+use common::{example, param, run, s, scratch_in, stderr, stdout};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// The truth of `examples/experiments/two-input.toml`, by parameter name.
+const TRUTH: [(&str, f64); 6] = [
+    ("torque.b0", 0.5),
+    ("torque.a0", 0.5),
+    ("brake.gain", 0.2),
+    ("brake.zero0", -0.5),
+    ("brake.pole0.re", -0.25),
+    ("brake.pole0.im", 0.3),
+];
+
+/// Simulates run `run_no` of the two-input example into `dir`: the data file.
+fn simulated(dir: &Path, run_no: &str) -> PathBuf {
+    let data = dir.join("d.csv");
+    let o = run(&[
+        "simulate",
+        &example("two-input.toml"),
+        "--run",
+        run_no,
+        "--out",
+        s(&data),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    data
+}
+
+fn json_of(args: &[&str]) -> Value {
+    let o = run(args);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    serde_json::from_str(&stdout(&o)).unwrap()
+}
+
+#[test]
+fn a_two_input_record_is_fitted_and_exported_per_input() {
+    let dir = scratch_in("jitterid-multi-input", "fit");
+    let exp = example("two-input.toml");
+    let data = simulated(&dir, "3");
+    // One data column per input, and one side file with both realisations.
+    let head = std::fs::read_to_string(&data).unwrap();
+    assert!(head.starts_with("k,t,y,torque,brake\n"), "{}", &head[..40]);
+    let side = std::fs::read_to_string(dir.join("d.input.csv")).unwrap();
+    assert!(side.starts_with("t,torque,brake\n"), "{}", &side[..30]);
+    for method in ["bcls", "ml"] {
+        let fit = json_of(&[
+            "fit",
+            &exp,
+            "--data",
+            s(&data),
+            "--method",
+            method,
+            "--json",
+        ]);
+        assert_eq!(fit["converged"], true, "{method}: {fit}");
+        for (name, truth) in TRUTH {
+            let (e, se) = param(&fit, name);
+            // The reported standard errors are the Monte Carlo spread's within 15 %
+            // (docs/reproduction.md): 4 of them leave a chance of about 6e-5 per parameter.
+            assert!(se > 0.0, "{method} {name}: se {se}");
+            assert!(
+                (e - truth).abs() < 4.0 * se,
+                "{method} {name}: {e} ± {se}, truth {truth}"
+            );
+        }
+        let model = &fit["model"];
+        let inputs = model["inputs"].as_array().unwrap();
+        assert_eq!(inputs.len(), 2, "{model}");
+        assert_eq!(inputs[0]["name"], "torque");
+        assert_eq!(inputs[1]["name"], "brake");
+        // torque → y is b0/(s + a0): its exported tf is the fitted coefficients.
+        let (b0, _) = param(&fit, "torque.b0");
+        assert_eq!(inputs[0]["tf"]["num"][0].as_f64(), Some(b0));
+        // One realisation of both: 3 states, a column of B and D per input, and its
+        // transfer function from each input is that input's.
+        let ss = &model["ss"];
+        assert_eq!(ss["a"].as_array().unwrap().len(), 3);
+        assert!(ss["b"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|r| r.as_array().unwrap().len() == 2));
+        assert_eq!(ss["d"][0].as_array().unwrap().len(), 2);
+    }
+    let v = json_of(&["validate", &exp, "--data", s(&data), "--json"]);
+    let tests = v["estimation"]["input_correlations"]
+        .as_array()
+        .or_else(|| v["input_correlations"].as_array())
+        .unwrap_or_else(|| panic!("no input_correlations in {v}"));
+    let names: Vec<&str> = tests.iter().map(|t| t["input"].as_str().unwrap()).collect();
+    assert_eq!(names, ["torque", "brake"]);
+}
+
+/// A wrong model of one channel is seen by the cross-correlation with that input: the brake
+/// channel fitted as a first-order system leaves its dynamics in the residuals.
+#[test]
+fn validate_names_the_input_whose_channel_is_wrong() {
+    let dir = scratch_in("jitterid-multi-input", "wrong-channel");
+    let data = simulated(&dir, "1");
+    let text = std::fs::read_to_string(example("two-input.toml")).unwrap();
+    let wrong = text.replacen(
+        "kind = \"zpk\"\ngain = 0.2\nzeros = [-0.5]\npoles = [[-0.25, 0.3]]",
+        "kind = \"tf\"\nnum = [0.2]\nden = [1.0, 0.5]",
+        1,
+    );
+    assert_ne!(wrong, text);
+    let exp = dir.join("wrong.toml");
+    std::fs::write(&exp, wrong).unwrap();
+    let v = json_of(&["validate", s(&exp), "--data", s(&data), "--json"]);
+    let tests = v["estimation"]["input_correlations"]
+        .as_array()
+        .or_else(|| v["input_correlations"].as_array())
+        .unwrap_or_else(|| panic!("no input_correlations in {v}"));
+    let p = |i: usize| tests[i]["test"]["p_value"].as_f64().unwrap();
+    assert!(p(1) < 1e-3, "brake's test should reject: {}", tests[1]);
+}
+
+/// A seeded Monte Carlo of 48 records: every parameter's mean within 3 of its Monte Carlo
+/// standard errors of the truth (BCLS is consistent on every channel).
+#[test]
+fn a_two_input_monte_carlo_is_unbiased() {
+    let mc = json_of(&[
+        "montecarlo",
+        &example("two-input.toml"),
+        "--runs",
+        "48",
+        "--seed",
+        "11",
+        "--json",
+    ]);
+    assert_eq!(mc["converged"], 48, "{mc}");
+    for p in mc["parameters"].as_array().unwrap() {
+        let (mean, truth, se) = (
+            p["mean"].as_f64().unwrap(),
+            p["true"].as_f64().unwrap(),
+            p["se"].as_f64().unwrap(),
+        );
+        assert!(
+            (mean - truth).abs() < 3.0 * se,
+            "{}: mean {mean}, truth {truth}, Monte Carlo se {se}",
+            p["name"]
+        );
+    }
+}
+
+/// Runs `jitterid fit` on the two-input example with its text edited by `edit`; the exit
+/// status must be 2 and stderr is returned.
+fn refused(name: &str, edit: impl Fn(&str) -> String) -> String {
+    let dir = scratch_in("jitterid-multi-input", name);
+    let text = std::fs::read_to_string(example("two-input.toml")).unwrap();
+    let edited = edit(&text);
+    assert_ne!(edited, text, "{name}: the edit changed nothing");
+    let exp = dir.join("e.toml");
+    std::fs::write(&exp, edited).unwrap();
+    let o = run(&["simulate", s(&exp), "--out", s(&dir.join("d.csv"))]);
+    assert_eq!(o.status.code(), Some(2), "{name}: {}", stdout(&o));
+    stderr(&o)
+}
+
+#[test]
+fn bad_multi_input_files_exit_2_naming_the_problem() {
+    // One [[system]] too few.
+    let e = refused("counts", |t| {
+        let i = t.rfind("[[system]]").unwrap();
+        let j = t[i..].find("[jitter]").unwrap() + i;
+        format!("{}{}", &t[..i], &t[j..])
+    });
+    assert!(
+        e.contains("2 [[input]] table(s) and 1 [[system]] table(s)"),
+        "{e}"
+    );
+    // Two inputs with one name.
+    let e = refused("names", |t| {
+        t.replacen("name = \"brake\"", "name = \"torque\"", 1)
+    });
+    assert!(
+        e.contains("[input] name") && e.contains("already the name"),
+        "{e}"
+    );
+    // A name that is a column of the files.
+    let e = refused("reserved", |t| {
+        t.replacen("name = \"brake\"", "name = \"tau\"", 1)
+    });
+    assert!(e.contains("[input] name") && e.contains("\"tau\""), "{e}");
+    // A channel without an input.
+    let e = refused("sinusoid", |t| {
+        t.replacen(
+            "kind = \"tf\"\nnum = [0.5]\nden = [1.0, 0.5]",
+            "kind = \"sinusoid\"\namplitude = 1.0\nfrequency = 0.1",
+            1,
+        )
+    });
+    assert!(
+        e.contains("[system] kind") && e.contains("has no input"),
+        "{e}"
+    );
+}
+
+#[test]
+fn select_and_the_initializer_say_they_take_one_input() {
+    let dir = scratch_in("jitterid-multi-input", "refusals");
+    let data = simulated(&dir, "0");
+    let exp = example("two-input.toml");
+    let o = run(&["fit", &exp, "--data", s(&data), "--init", "auto"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stdout(&o));
+    assert!(stderr(&o).contains("several inputs"), "{}", stderr(&o));
+}

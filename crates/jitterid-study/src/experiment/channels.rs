@@ -1,0 +1,98 @@
+//! `[[input]]` and `[[system]]`: a system with several inputs, one model per input in the same
+//! order, read into one `superposition` spec table.
+
+use super::diagnostics::Source;
+use super::input::parse_channel;
+use super::raw::{RawInput, RawSystem};
+use super::spec::{InputChannel, InputSpec, SystemSpec};
+use super::system::parse_system;
+use crate::error::StudyResult;
+use crate::study_err;
+use jitterid::signal::registry::{SpecTable, KIND_KEY};
+use jitterid::signal::superposition::SUPERPOSITION_KIND;
+use jitterid::signal::{Input, SampleGrid};
+use serde_json::{json, Value};
+
+/// The inputs and the systems of a multi-input experiment (more than one `[[input]]` or
+/// `[[system]]` table): as many of each, every system driven by an input, distinct names.
+pub(super) fn parse_channels(
+    cx: &Source,
+    systems: &[&RawSystem],
+    inputs: &[&RawInput],
+    grid: &SampleGrid,
+) -> StudyResult<(SystemSpec, Vec<InputChannel>)> {
+    if systems.len() != inputs.len() {
+        return Err(study_err!(
+            "{}: {} [[input]] table(s) and {} [[system]] table(s); a system with several inputs has one [[system]] table per [[input]] table, in the same order",
+            cx.file,
+            inputs.len(),
+            systems.len()
+        ));
+    }
+    let mut channels: Vec<InputChannel> = Vec::with_capacity(inputs.len());
+    let mut specs = Vec::with_capacity(systems.len());
+    let mut estimated = Vec::with_capacity(systems.len());
+    for (i, (rs, ri)) in systems.iter().zip(inputs).enumerate() {
+        let system = parse_system(cx, rs, grid)?;
+        let kind = system
+            .kind
+            .get(KIND_KEY)
+            .and_then(Value::as_str)
+            .unwrap_or_default()
+            .to_string();
+        if !cx
+            .registries
+            .signal
+            .kind(&kind)
+            .is_some_and(|k| k.needs_input())
+        {
+            return Err(cx.err_at(
+                "system",
+                "kind",
+                rs.kind.as_ref(),
+                format!(
+                    "[[system]] {}: a {kind} system has no input; each [[system]] table of a multi-input system is the response to its [[input]] (kind = \"zpk\", \"tf\" or \"grey-box\")",
+                    i + 1
+                ),
+            ));
+        }
+        let channel = parse_channel(cx, ri, grid, &format!("u{}", i + 1))?;
+        if let Some(other) = channels.iter().find(|c| c.name == channel.name) {
+            return Err(cx.err_at(
+                "input",
+                "name",
+                ri.name.as_ref(),
+                format!(
+                    "[[input]] {}: the name \"{}\" is already the name of another input; expected distinct names",
+                    i + 1,
+                    other.name
+                ),
+            ));
+        }
+        if let (Some(d), InputSpec::Known(Input::Tones(_))) = (&rs.delay, &channel.spec) {
+            return Err(cx.err(
+                "system",
+                "delay",
+                &d.span(),
+                format!(
+                    "[[system]] {}: needs an input made of steps (random-binary, piecewise or csv); input \"{}\" is a sine or multisine, whose delay is a phase",
+                    i + 1,
+                    channel.name
+                ),
+            ));
+        }
+        specs.push(Value::Object(system.kind));
+        estimated.push(system.estimate);
+        channels.push(channel);
+    }
+    let mut kind = SpecTable::new();
+    kind.insert(KIND_KEY.into(), json!(SUPERPOSITION_KIND));
+    kind.insert(
+        "inputs".into(),
+        json!(channels.iter().map(|c| c.name.clone()).collect::<Vec<_>>()),
+    );
+    kind.insert("channels".into(), Value::Array(specs));
+    kind.insert("estimate".into(), json!(estimated));
+    let estimate = estimated.iter().any(|e| *e);
+    Ok((SystemSpec { kind, estimate }, channels))
+}
