@@ -36,12 +36,17 @@ pub struct Channel {
 /// what the rule integrates exactly to its order).
 ///
 /// Parameters: those of each estimated channel in order, named `"{input}.{name}"`
-/// (`u1.b0`, `brake.a1`). The spectrum is the sum of the channels' spectra.
+/// (`u1.b0`, `brake.a1`); or, for channels that are one model's responses to its several
+/// inputs ([`shared`](Self::shared): a grey-box model whose `B` has a column per input), that
+/// model's parameters once, by their own names, each derivative the sum of the channels'. The
+/// spectrum is the sum of the channels' spectra.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Superposition {
     channels: Vec<Channel>,
     /// The start of each channel's parameters in the sum's parameter vector, and the total.
     offsets: Vec<usize>,
+    /// Whether every channel has the same parameters (all start at 0).
+    shared: bool,
     breakpoints: Vec<f64>,
 }
 
@@ -53,6 +58,40 @@ impl Superposition {
     /// [`SignalError::TooFew`] for no channel, [`SignalError::InvalidKey`] (key `inputs`) for
     /// an empty or repeated input name.
     pub fn new(channels: Vec<Channel>) -> Result<Self, SignalError> {
+        Self::build(channels, false)
+    }
+
+    /// The responses of one model to each of its inputs (the channels: the model with only
+    /// column `i` of its `B` and `D`), whose parameters are the model's, once.
+    ///
+    /// # Errors
+    ///
+    /// Those of [`new`](Self::new), and [`SignalError::InvalidKey`] (key `channels`) for
+    /// channels whose parameters' names, values or estimated flags differ.
+    pub fn shared(channels: Vec<Channel>) -> Result<Self, SignalError> {
+        if let Some(first) = channels.first() {
+            let same = |c: &Channel| {
+                c.estimated == first.estimated
+                    && c.signal.param_names() == first.signal.param_names()
+                    && c.signal.params() == first.signal.params()
+            };
+            if !channels.iter().all(same) {
+                return Err(SignalError::InvalidKey {
+                    kind: SUPERPOSITION_KIND.into(),
+                    key: "channels".into(),
+                    message: "channels that share their parameters must have the same parameters, values and estimated flags".into(),
+                });
+            }
+        }
+        Self::build(channels, true)
+    }
+
+    /// Whether the channels share one set of parameters ([`shared`](Self::shared)).
+    pub fn is_shared(&self) -> bool {
+        self.shared
+    }
+
+    fn build(channels: Vec<Channel>, shared: bool) -> Result<Self, SignalError> {
         if channels.is_empty() {
             return Err(SignalError::TooFew {
                 name: "channels",
@@ -79,9 +118,16 @@ impl Superposition {
         let mut offsets = Vec::with_capacity(channels.len() + 1);
         let mut at = 0;
         for c in &channels {
-            offsets.push(at);
-            if c.estimated {
-                at += c.signal.num_params();
+            if shared {
+                offsets.push(0);
+                if c.estimated {
+                    at = c.signal.num_params();
+                }
+            } else {
+                offsets.push(at);
+                if c.estimated {
+                    at += c.signal.num_params();
+                }
             }
         }
         offsets.push(at);
@@ -94,6 +140,7 @@ impl Superposition {
         Ok(Self {
             channels,
             offsets,
+            shared,
             breakpoints,
         })
     }
@@ -172,12 +219,46 @@ impl Superposition {
                 .map(|c| c.estimated)
                 .collect::<Vec<_>>()),
         );
+        if self.shared {
+            spec.insert("shared".into(), json!(true));
+        }
         spec
+    }
+
+    /// Adds each estimated channel's gradient at `t` into its place in `grad` (zeroed first),
+    /// returning `s(t)`: disjoint places for separate channels, the same for shared ones,
+    /// whose derivatives add.
+    fn accumulate_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        let mut own = Vec::new();
+        let mut v = 0.0;
+        for (i, c) in self.channels.iter().enumerate() {
+            let r = self.range(i);
+            if r.is_empty() {
+                v += c.signal.value(t);
+                continue;
+            }
+            own.clear();
+            own.resize(r.len(), 0.0);
+            v += c.signal.value_and_gradient(t, &mut own);
+            for (g, o) in grad[r].iter_mut().zip(&own) {
+                *g += o;
+            }
+        }
+        v
     }
 }
 
 impl Signal for Superposition {
     fn param_names(&self) -> Vec<String> {
+        if self.shared {
+            return self
+                .channels
+                .iter()
+                .find(|c| c.estimated)
+                .map(|c| c.signal.param_names())
+                .unwrap_or_default();
+        }
         self.channels
             .iter()
             .filter(|c| c.estimated)
@@ -191,6 +272,14 @@ impl Signal for Superposition {
     }
 
     fn params(&self) -> Vec<f64> {
+        if self.shared {
+            return self
+                .channels
+                .iter()
+                .find(|c| c.estimated)
+                .map(|c| c.signal.params())
+                .unwrap_or_default();
+        }
         self.channels
             .iter()
             .filter(|c| c.estimated)
@@ -215,6 +304,7 @@ impl Signal for Superposition {
         Ok(Self {
             channels,
             offsets: self.offsets.clone(),
+            shared: self.shared,
             breakpoints: self.breakpoints.clone(),
         })
     }
@@ -224,25 +314,11 @@ impl Signal for Superposition {
     }
 
     fn value_gradient(&self, t: f64, grad: &mut [f64]) {
-        for i in 0..self.channels.len() {
-            let r = self.range(i);
-            if !r.is_empty() {
-                self.channels[i].signal.value_gradient(t, &mut grad[r]);
-            }
-        }
+        self.accumulate_gradient(t, grad);
     }
 
     fn value_and_gradient(&self, t: f64, grad: &mut [f64]) -> f64 {
-        let mut v = 0.0;
-        for (i, c) in self.channels.iter().enumerate() {
-            let r = self.range(i);
-            v += if r.is_empty() {
-                c.signal.value(t)
-            } else {
-                c.signal.value_and_gradient(t, &mut grad[r])
-            };
-        }
-        v
+        self.accumulate_gradient(t, grad)
     }
 
     fn breakpoints(&self) -> Vec<f64> {
@@ -280,11 +356,15 @@ impl Signal for Superposition {
         jitter: &dyn JitterModel,
     ) -> (Vec<f64>, Jacobian) {
         let mut m = vec![0.0; grid.len()];
-        let mut cols = Vec::with_capacity(self.num_params());
-        for c in &self.channels {
+        let mut cols = vec![vec![0.0; grid.len()]; self.num_params()];
+        for (i, c) in self.channels.iter().enumerate() {
             let v = if c.estimated {
                 let (v, g) = c.signal.expected_values_and_gradient(grid, jitter);
-                cols.extend(g);
+                for (col, g) in cols[self.range(i)].iter_mut().zip(g) {
+                    for (a, b) in col.iter_mut().zip(g) {
+                        *a += b;
+                    }
+                }
                 v
             } else {
                 c.signal.expected_values(grid, jitter)
@@ -320,10 +400,17 @@ impl Spectrum for Superposition {
     }
 
     fn density_gradient(&self, f: f64, grad: &mut [Complex64]) {
+        grad.iter_mut().for_each(|g| *g = Complex64::new(0.0, 0.0));
+        let mut own = Vec::new();
         for i in 0..self.channels.len() {
             let r = self.range(i);
             if !r.is_empty() {
-                self.channels[i].signal.density_gradient(f, &mut grad[r]);
+                own.clear();
+                own.resize(r.len(), Complex64::new(0.0, 0.0));
+                self.channels[i].signal.density_gradient(f, &mut own);
+                for (g, o) in grad[r].iter_mut().zip(&own) {
+                    *g += o;
+                }
             }
         }
     }
@@ -370,7 +457,40 @@ pub fn superposition(
     estimate_offset: bool,
 ) -> Result<AnySignal, SignalError> {
     let spectral = channels.iter().all(|c| c.signal.has_spectrum());
-    let model = Offset::new(Superposition::new(channels)?, offset, estimate_offset)?;
+    wrapped(
+        Superposition::new(channels)?,
+        spectral,
+        offset,
+        estimate_offset,
+    )
+}
+
+/// [`superposition`] of channels that share their parameters ([`Superposition::shared`]).
+///
+/// # Errors
+///
+/// Those of [`Superposition::shared`] and [`Offset::new`].
+pub fn shared_superposition(
+    channels: Vec<Channel>,
+    offset: f64,
+    estimate_offset: bool,
+) -> Result<AnySignal, SignalError> {
+    let spectral = channels.iter().all(|c| c.signal.has_spectrum());
+    wrapped(
+        Superposition::shared(channels)?,
+        spectral,
+        offset,
+        estimate_offset,
+    )
+}
+
+fn wrapped(
+    sum: Superposition,
+    spectral: bool,
+    offset: f64,
+    estimate_offset: bool,
+) -> Result<AnySignal, SignalError> {
+    let model = Offset::new(sum, offset, estimate_offset)?;
     let to_spec = |m: &Offset<Superposition>| {
         let mut spec = m.signal().spec();
         spec.remove(KIND_KEY);
@@ -463,6 +583,9 @@ pub fn build(
             .ok_or_else(|| invalid("offset", format!("expected a number, found {v}")))?,
     };
     let estimate_offset = spec.get("estimate_offset") == Some(&Value::Bool(true));
+    if spec.get("shared") == Some(&Value::Bool(true)) {
+        return shared_superposition(channels, offset, estimate_offset);
+    }
     superposition(channels, offset, estimate_offset)
 }
 
@@ -587,5 +710,61 @@ mod tests {
         let e = Superposition::new(channels).unwrap_err();
         assert_eq!(e.key(), Some("inputs"));
         assert!(Superposition::new(Vec::new()).is_err());
+    }
+
+    /// One grey-box model with a column of `B` per input: a room heated by `u1` and cooled
+    /// by the outside temperature `u2`, `ẋ = −x/(RC) + u1/C + u2/(RC)`, its two responses
+    /// sharing `R` and `C`.
+    fn heated_room() -> AnySignal {
+        let registry = SignalRegistry::builtin();
+        let column = |b: &str| {
+            serde_json::json!({"kind": "grey-box", "params": {"R": 2.0, "C": 3.0},
+                "a": [["-1/(R*C)"]], "b": [[b]], "c": [[1]]})
+        };
+        let u1: Input = binary(5, 4.0, -10.0, 60.0).unwrap().into();
+        let u2: Input = binary(6, 9.0, -10.0, 60.0).unwrap().into();
+        let channels = [("heater", "1/C", &u1), ("outside", "1/(R*C)", &u2)]
+            .into_iter()
+            .map(|(name, b, u)| Channel {
+                name: name.into(),
+                signal: registry
+                    .build(column(b).as_object().unwrap(), Some(u))
+                    .unwrap(),
+                estimated: true,
+            })
+            .collect();
+        shared_superposition(channels, 20.0, true).unwrap()
+    }
+
+    #[test]
+    fn shared_channels_have_the_model_s_parameters_once() {
+        let s = heated_room();
+        assert_eq!(s.param_names(), ["C", "R", "offset"]);
+        assert_eq!(s.params(), [3.0, 2.0, 20.0]);
+        let t = s.with_params(&[4.0, 1.0, 19.0]).unwrap();
+        let sum = t.downcast::<Offset<Superposition>>().unwrap().signal();
+        assert!(sum.is_shared());
+        assert!(sum
+            .channels()
+            .iter()
+            .all(|c| c.signal.params() == [4.0, 1.0]));
+        let grid = SampleGrid::new(0.0, 0.5, 100).unwrap();
+        check_contract(&s, &Gaussian::new(0.15).unwrap(), &grid, 9).unwrap();
+        // The spec table says the parameters are shared, and rebuilds the same model.
+        let u1: Input = binary(5, 4.0, -10.0, 60.0).unwrap().into();
+        let u2: Input = binary(6, 9.0, -10.0, 60.0).unwrap().into();
+        let back = build(SignalRegistry::builtin(), &s.spec(), &[u1, u2]).unwrap();
+        assert_eq!(back.param_names(), s.param_names());
+        assert_eq!(back.spec(), s.spec());
+    }
+
+    #[test]
+    fn channels_that_differ_cannot_share() {
+        let s = heated_room();
+        let sum = s.downcast::<Offset<Superposition>>().unwrap().signal();
+        let mut channels = sum.channels().to_vec();
+        channels[1].signal = channels[1].signal.with_params(&[3.0, 2.5]).unwrap();
+        let e = Superposition::shared(channels).unwrap_err();
+        assert_eq!(e.key(), Some("channels"));
     }
 }

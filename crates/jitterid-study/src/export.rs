@@ -154,8 +154,8 @@ pub struct SeveralInputs {
     /// Each input's transfer function in the three forms (with its delay), in input order.
     pub inputs: Vec<InputForms>,
     /// One realisation of them all: the channels' realisations side by side
-    /// (block-diagonal `A`, `B` with one column per input, `C` and `D` one row), without the
-    /// delays.
+    /// (block-diagonal `A`, `B` with one column per input, `C` and `D` one row), or for a
+    /// grey-box model with a column of `B` per input its own `A, B, C, D`; without the delays.
     pub ss: MultiInputStateSpace,
     /// The output offset `y₀` (absent without one).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -186,6 +186,23 @@ pub struct MultiInputStateSpace {
 }
 
 impl MultiInputStateSpace {
+    /// One model's realisation from its single-input parts (the same `A` and `C`, a column of
+    /// `B` and `D` each): a grey-box model whose `B` has a column per input.
+    fn columns(parts: &[&StateSpace]) -> Self {
+        let Some(first) = parts.first() else {
+            return Self::of(parts);
+        };
+        let b = (0..first.order())
+            .map(|i| parts.iter().map(|p| p.b()[i]).collect())
+            .collect();
+        Self {
+            a: first.a().to_vec(),
+            b,
+            c: vec![first.c().to_vec()],
+            d: vec![parts.iter().map(|p| p.d()).collect()],
+        }
+    }
+
     /// The realisations `parts` (one per input) side by side.
     fn of(parts: &[&StateSpace]) -> Self {
         let n: usize = parts.iter().map(|p| p.order()).sum();
@@ -234,7 +251,11 @@ pub fn exported_model(signal: &AnySignal) -> Result<Option<ExportedModel>, Signa
         });
     }
     let parts: Vec<&StateSpace> = inputs.iter().map(|i| &i.forms.ss).collect();
-    let ss = MultiInputStateSpace::of(&parts);
+    let ss = if sum.signal().is_shared() {
+        MultiInputStateSpace::columns(&parts)
+    } else {
+        MultiInputStateSpace::of(&parts)
+    };
     let offset = (sum.offset() != 0.0 || sum.estimated()).then_some(sum.offset());
     Ok(Some(ExportedModel::Several(SeveralInputs {
         inputs,

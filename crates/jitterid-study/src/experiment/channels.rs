@@ -12,6 +12,7 @@ use jitterid::signal::registry::{SpecTable, KIND_KEY};
 use jitterid::signal::superposition::SUPERPOSITION_KIND;
 use jitterid::signal::{Input, SampleGrid};
 use serde_json::{json, Value};
+use toml::Spanned;
 
 /// The inputs and the systems of a multi-input experiment (more than one `[[input]]` or
 /// `[[system]]` table): as many of each, every system driven by an input, distinct names.
@@ -21,6 +22,11 @@ pub(super) fn parse_channels(
     inputs: &[&RawInput],
     grid: &SampleGrid,
 ) -> StudyResult<(SystemSpec, Vec<InputChannel>)> {
+    if let [one] = systems {
+        if one.kind.as_ref().map(|k| k.get_ref().as_str()) == Some("grey-box") && inputs.len() > 1 {
+            return grey_box_inputs(cx, one, inputs, grid);
+        }
+    }
     if systems.len() != inputs.len() {
         return Err(study_err!(
             "{}: {} [[input]] table(s) and {} [[system]] table(s); a system with several inputs has one [[system]] table per [[input]] table, in the same order",
@@ -94,5 +100,103 @@ pub(super) fn parse_channels(
     kind.insert("channels".into(), Value::Array(specs));
     kind.insert("estimate".into(), json!(estimated));
     let estimate = estimated.iter().any(|e| *e);
+    Ok((SystemSpec { kind, estimate }, channels))
+}
+
+/// One grey-box `[system]` whose `B` and `D` have a column per `[[input]]`: one channel per
+/// input, the model with only that column, sharing the model's parameters
+/// ([`jitterid::signal::Superposition::shared`]).
+fn grey_box_inputs(
+    cx: &Source,
+    rs: &RawSystem,
+    inputs: &[&RawInput],
+    grid: &SampleGrid,
+) -> StudyResult<(SystemSpec, Vec<InputChannel>)> {
+    let m = inputs.len();
+    let columns = |key: &str, v: &Spanned<toml::Value>, rows: Option<usize>| {
+        let bad = |msg: String| cx.err("system", key, &v.span(), msg);
+        let toml::Value::Array(r) = v.get_ref() else {
+            return Err(bad(format!(
+                "expected an array of rows with {m} entries each (one per [[input]])"
+            )));
+        };
+        if let Some(n) = rows {
+            if r.len() != n {
+                return Err(bad(format!("expected {n} row(s), found {}", r.len())));
+            }
+        }
+        let mut out = vec![Vec::with_capacity(r.len()); m];
+        for (i, row) in r.iter().enumerate() {
+            let entries = match row {
+                toml::Value::Array(e) if e.len() == m => e,
+                toml::Value::Array(e) => {
+                    return Err(bad(format!(
+                        "row {}: expected {m} entries (one column per [[input]]), found {}",
+                        i + 1,
+                        e.len()
+                    )))
+                }
+                _ => {
+                    return Err(bad(format!(
+                        "row {}: expected an array of {m} entries",
+                        i + 1
+                    )))
+                }
+            };
+            for (j, e) in entries.iter().enumerate() {
+                out[j].push(toml::Value::Array(vec![e.clone()]));
+            }
+        }
+        Ok(out
+            .into_iter()
+            .map(|rows| Spanned::new(v.span(), toml::Value::Array(rows)))
+            .collect::<Vec<_>>())
+    };
+    let b = rs.b.as_ref().ok_or_else(|| {
+        cx.err_section(
+            "system",
+            "b",
+            "kind = \"grey-box\" needs params, a, b and c (and optionally fixed, bounds, d)",
+        )
+    })?;
+    let b = columns("b", b, None)?;
+    let d = match &rs.d {
+        Some(d) => Some(columns("d", d, Some(1))?),
+        None => None,
+    };
+    let mut channels: Vec<InputChannel> = Vec::with_capacity(m);
+    let mut specs = Vec::with_capacity(m);
+    let mut estimate = false;
+    for (j, ri) in inputs.iter().enumerate() {
+        let mut column = rs.clone();
+        column.b = Some(b[j].clone());
+        column.d = d.as_ref().map(|d| d[j].clone());
+        let system = parse_system(cx, &column, grid)?;
+        let channel = parse_channel(cx, ri, grid, &format!("u{}", j + 1))?;
+        if let Some(other) = channels.iter().find(|c| c.name == channel.name) {
+            return Err(cx.err_at(
+                "input",
+                "name",
+                ri.name.as_ref(),
+                format!(
+                    "[[input]] {}: the name \"{}\" is already the name of another input; expected distinct names",
+                    j + 1,
+                    other.name
+                ),
+            ));
+        }
+        estimate = system.estimate;
+        specs.push(Value::Object(system.kind));
+        channels.push(channel);
+    }
+    let mut kind = SpecTable::new();
+    kind.insert(KIND_KEY.into(), json!(SUPERPOSITION_KIND));
+    kind.insert(
+        "inputs".into(),
+        json!(channels.iter().map(|c| c.name.clone()).collect::<Vec<_>>()),
+    );
+    kind.insert("channels".into(), Value::Array(specs));
+    kind.insert("estimate".into(), json!(vec![estimate; m]));
+    kind.insert("shared".into(), json!(true));
     Ok((SystemSpec { kind, estimate }, channels))
 }

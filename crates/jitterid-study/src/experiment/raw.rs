@@ -12,7 +12,7 @@ pub(super) type RawTable = BTreeMap<String, Spanned<toml::Value>>;
 
 macro_rules! section {
     ($name:ident, $title:literal { $($field:ident : $ty:ty),* $(,)? }) => {
-        #[derive(Debug, Deserialize)]
+        #[derive(Debug, Clone, Deserialize)]
         #[serde(deny_unknown_fields, rename = $title)]
         pub(super) struct $name {
             $( #[serde(default)] pub(super) $field: Option<Spanned<$ty>>, )*
