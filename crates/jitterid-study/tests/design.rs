@@ -2,8 +2,8 @@
 //! it, against an independent closed form, against the Cramér–Rao ordering, and the design
 //! search's optimum against a fine scan of its criterion.
 
+use faer::linalg::solvers::DenseSolveCore;
 use jitterid::estimate::ml::delta_method_std;
-use jitterid::jitter::JitterModel;
 use jitterid::signal::Signal;
 use jitterid_study::design::{
     criterion_value, derived_std, design, optimise, predict, Derived, Design, Plan,
@@ -23,7 +23,8 @@ fn example(file: &str) -> Experiment {
 }
 
 fn parse(text: &str) -> Result<Experiment, String> {
-    experiment::parse("exp.toml", text, Path::new("."), Purpose::Simulate).map_err(|e| e.to_string())
+    experiment::parse("exp.toml", text, Path::new("."), Purpose::Simulate)
+        .map_err(|e| e.to_string())
 }
 
 fn plan(text: &str) -> Result<Plan, String> {
@@ -196,8 +197,16 @@ std = 0.02
         for i in 0..np {
             let closed = cov[(i, i)].sqrt();
             let rel = (closed - p.std[i]).abs() / closed;
-            eprintln!("N = {n}, {}: {} against {closed} ({rel:e})", p.names[i], p.std[i]);
-            assert!(rel < 1e-5, "N = {n}, {}: {} against {closed}", p.names[i], p.std[i]);
+            eprintln!(
+                "N = {n}, {}: {} against {closed} ({rel:e})",
+                p.names[i], p.std[i]
+            );
+            assert!(
+                rel < 1e-5,
+                "N = {n}, {}: {} against {closed}",
+                p.names[i],
+                p.std[i]
+            );
         }
     }
 }
@@ -213,7 +222,11 @@ fn ml_prediction_is_below_bcls() {
     assert_eq!(b.names, m.names);
     for i in 0..b.names.len() {
         eprintln!("{}: ML {} BCLS {}", b.names[i], m.std[i], b.std[i]);
-        assert!(m.std[i] > 0.0 && m.std[i] <= b.std[i] * (1.0 + 1e-6), "{}", b.names[i]);
+        assert!(
+            m.std[i] > 0.0 && m.std[i] <= b.std[i] * (1.0 + 1e-6),
+            "{}",
+            b.names[i]
+        );
     }
 }
 
@@ -229,7 +242,10 @@ fn static_gain_std_is_the_delta_method_with_the_closed_form_gradient() {
     let grad = [g0 / k, -k / d, -g0 * 2.0 * re / d, -g0 * 2.0 * im / d];
     let closed = delta_method_std(&p.covariance, &grad).unwrap();
     let derived = derived_std(&p, Derived::StaticGain).unwrap();
-    assert!((derived - closed).abs() <= 1e-6 * closed, "{derived} against {closed}");
+    assert!(
+        (derived - closed).abs() <= 1e-6 * closed,
+        "{derived} against {closed}"
+    );
     // The jitter is known here: its σ has no spread.
     assert_eq!(derived_std(&p, Derived::JitterStd).unwrap(), 0.0);
     let at = derived_std(&p, Derived::Magnitude(0.05)).unwrap();
@@ -262,9 +278,20 @@ fn dwell_search_finds_the_scan_s_minimum() {
         let dwell = 0.5 * (80.0f64).powf(i as f64 / 24.0);
         scan.push((dwell, scan_value(dwell)));
     }
-    let best = scan.iter().cloned().fold((0.0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-    eprintln!("optimum {:?} = {}, scan best {best:?}", opt.design, opt.value);
-    assert!(opt.value <= best.1 + 1e-9, "{} against the scan's {}", opt.value, best.1);
+    let best = scan
+        .iter()
+        .cloned()
+        .fold((0.0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+    eprintln!(
+        "optimum {:?} = {}, scan best {best:?}",
+        opt.design, opt.value
+    );
+    assert!(
+        opt.value <= best.1 + 1e-9,
+        "{} against the scan's {}",
+        opt.value,
+        best.1
+    );
     assert!(opt.value <= scan_value(8.0));
     let again = optimise(&plan, &DesignCriterion::D).unwrap();
     assert_eq!(again.design, opt.design);
@@ -298,16 +325,34 @@ fn interval_search_with_a_held_duration_keeps_the_duration() {
 #[test]
 fn infeasible_designs_are_refused_naming_the_key() {
     let cases = [
-        ("[design]\nmean_dwell = [2.0, 1.0]", "[design] mean_dwell: expected [min, max]"),
-        ("[design]\nmean_dwell = [1e-9, 1e-8]", "[design] mean_dwell: no feasible mean dwell"),
+        (
+            "[design]\nmean_dwell = [2.0, 1.0]",
+            "[design] mean_dwell: expected [min, max]",
+        ),
+        (
+            "[design]\nmean_dwell = [1e-9, 1e-8]",
+            "[design] mean_dwell: no feasible mean dwell",
+        ),
         (
             "[design]\ninterval = [300.0, 400.0]\nhold = \"duration\"",
             "[design] interval: no feasible interval",
         ),
-        ("[design]\ndraws = 4", "[design] mean_dwell: the section names no free variable"),
-        ("[design]\ninterval = [0.5, 1.0]\ncriterion = \"e\"", "[design] criterion: expected"),
-        ("[design]\ninterval = [0.5, 1.0]\nhold = \"time\"", "[design] hold: expected"),
-        ("[design]\ninterval = [0.5, 1.0]\ndraws = 0", "[design] draws: expected a whole number"),
+        (
+            "[design]\ndraws = 4",
+            "[design] mean_dwell: the section names no free variable",
+        ),
+        (
+            "[design]\ninterval = [0.5, 1.0]\ncriterion = \"e\"",
+            "[design] criterion: expected",
+        ),
+        (
+            "[design]\ninterval = [0.5, 1.0]\nhold = \"time\"",
+            "[design] hold: expected",
+        ),
+        (
+            "[design]\ninterval = [0.5, 1.0]\ndraws = 0",
+            "[design] draws: expected a whole number",
+        ),
         ("[design]\ninterval = [0.5, 1.0]\nfoo = 1", "foo"),
     ];
     for (section, want) in cases {
@@ -315,12 +360,24 @@ fn infeasible_designs_are_refused_naming_the_key() {
         assert!(e.contains(want), "{section}: {e}");
     }
     // A dwell range needs a random binary input.
-    let sine = table2("[design]\nmean_dwell = [1.0, 2.0]")
-        .replace("kind = \"random-binary\"\nmean_dwell = 8.0\nlow = 0.0\nhigh = 1.0", "kind = \"sine\"\nfrequency = 0.05\namplitude = 1.0");
+    let sine = table2("[design]\nmean_dwell = [1.0, 2.0]").replace(
+        "kind = \"random-binary\"\nmean_dwell = 8.0\nlow = 0.0\nhigh = 1.0",
+        "kind = \"sine\"\nfrequency = 0.05\namplitude = 1.0",
+    );
     let e = parse(&sine).unwrap_err();
-    assert!(e.contains("[design] mean_dwell: is a design variable of a random binary input"), "{e}");
-    let p = plan(&table2("[design]\ninterval = [0.5, 1.0]\ngrid = 3\ndraws = 1")).unwrap();
-    let e = optimise(&p, &DesignCriterion::Param("nope".into())).unwrap_err().to_string();
+    assert!(
+        e.contains("[design] mean_dwell: is a design variable of a random binary input"),
+        "{e}"
+    );
+    let p = plan(&table2(
+        "[design]\ninterval = [0.5, 1.0]\ngrid = 3\ndraws = 1",
+    ))
+    .unwrap();
+    let e = optimise(&p, &DesignCriterion::Param("nope".into()))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("param:nope") && e.contains("gain"), "{e}");
-    assert!(plan(&table2("")).unwrap_err().contains("no [design] section"));
+    assert!(plan(&table2(""))
+        .unwrap_err()
+        .contains("no [design] section"));
 }

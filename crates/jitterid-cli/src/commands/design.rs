@@ -34,7 +34,12 @@ fn design_text(d: &Design) -> String {
     if let Some(m) = d.mean_dwell {
         let _ = write!(s, "mean_dwell = {} s, ", fmt_num(m));
     }
-    let _ = write!(s, "interval = {} s, samples = {}", fmt_num(d.interval), d.samples);
+    let _ = write!(
+        s,
+        "interval = {} s, samples = {}",
+        fmt_num(d.interval),
+        d.samples
+    );
     s
 }
 

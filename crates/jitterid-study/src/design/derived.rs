@@ -42,10 +42,12 @@ impl Derived {
     fn value(&self, model: &Structure) -> Option<f64> {
         let g = |s: Complex64| -> Option<f64> {
             let tf = tf_of(&model.signal).ok()??;
-            Some(tf.response(s)).filter(|g| g.is_finite()).map(|g| match self {
-                Self::StaticGain => g.re,
-                _ => g.norm(),
-            })
+            Some(tf.response(s))
+                .filter(|g| g.is_finite())
+                .map(|g| match self {
+                    Self::StaticGain => g.re,
+                    _ => g.norm(),
+                })
         };
         match self {
             Self::StaticGain => g(Complex64::new(0.0, 0.0)),
@@ -83,7 +85,10 @@ pub fn derived_std(prediction: &Prediction, quantity: Derived) -> StudyResult<f6
     let mut gradient = vec![0.0; prediction.names.len()];
     for (j, g) in gradient.iter_mut().enumerate().take(theta.len()) {
         let d = central_difference_vec(&theta, j, MOMENT_FD_STEP, at).ok_or_else(|| {
-            study_err!("{name}: no finite difference in {} at the prior model", prediction.names[j])
+            study_err!(
+                "{name}: no finite difference in {} at the prior model",
+                prediction.names[j]
+            )
         })?;
         *g = d[0];
     }

@@ -24,6 +24,7 @@ use jitterid::estimate::ml::{exact_fisher, likelihood_param_names, FisherOptions
 use jitterid::estimate::montecarlo::run as mc_run;
 use jitterid::estimate::support::{reach_beyond, sandwich_covariance};
 use jitterid::estimate::{Bcls, FrequencyData, Record};
+use jitterid::signal::Signal;
 use jitterid::window::DirichletWindow;
 
 /// The predicted precision of one design for one estimator.

@@ -133,9 +133,10 @@ impl Objective for Line<'_, '_> {
     }
     fn cost(&self, u: &[f64]) -> f64 {
         match u.first() {
-            Some(&x) if x >= self.lo && x <= self.hi => self
-                .search
-                .value(&self.search.design(&self.base, &[self.var], &[x])),
+            Some(&x) if x >= self.lo && x <= self.hi => {
+                self.search
+                    .value(&self.search.design(&self.base, &[self.var], &[x]))
+            }
             _ => f64::INFINITY,
         }
     }
@@ -188,7 +189,12 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
             })
             .collect();
         let v = search.value(&search.design(&base, &vars, &u));
-        if let Some(e) = search.fatal.lock().unwrap_or_else(|e| e.into_inner()).take() {
+        if let Some(e) = search
+            .fatal
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take()
+        {
             return Err(e);
         }
         if v < best.as_ref().map_or(f64::INFINITY, |b| b.0) {
@@ -207,7 +213,11 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
     };
     for (k, &var) in vars.iter().enumerate() {
         let (lo, hi) = ranges[k];
-        let step = if g > 1 { (hi - lo) / (g - 1) as f64 } else { 0.0 };
+        let step = if g > 1 {
+            (hi - lo) / (g - 1) as f64
+        } else {
+            0.0
+        };
         if !(step > 0.0) {
             continue;
         }
@@ -243,8 +253,12 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
             }
         }
     }
-    let (design, value, prediction) =
-        chosen.ok_or_else(|| study_err!("{}: [design]: no design could be evaluated", plan.baseline.file))?;
+    let (design, value, prediction) = chosen.ok_or_else(|| {
+        study_err!(
+            "{}: [design]: no design could be evaluated",
+            plan.baseline.file
+        )
+    })?;
     Ok(Optimum {
         design,
         value,

@@ -123,7 +123,9 @@ fn range(cx: &Source, key: &str, v: &Spanned<Vec<f64>>) -> StudyResult<(f64, f64
             S,
             key,
             &v.span(),
-            format!("expected [min, max] of two finite numbers with 0 < min <= max, found {other:?}"),
+            format!(
+                "expected [min, max] of two finite numbers with 0 < min <= max, found {other:?}"
+            ),
         )),
     }
 }
@@ -143,7 +145,10 @@ fn whole(
             S,
             key,
             &s.span(),
-            format!("expected a whole number in [{lo}, {hi}], found {}", s.get_ref()),
+            format!(
+                "expected a whole number in [{lo}, {hi}], found {}",
+                s.get_ref()
+            ),
         )),
     }
 }
@@ -247,7 +252,9 @@ pub(super) fn parse_design(
     }
     let criterion = match &r.criterion {
         None => DesignCriterion::D,
-        Some(c) => DesignCriterion::parse(c.get_ref()).map_err(|e| cx.err(S, "criterion", &c.span(), e))?,
+        Some(c) => {
+            DesignCriterion::parse(c.get_ref()).map_err(|e| cx.err(S, "criterion", &c.span(), e))?
+        }
     };
     let estimator = match &r.estimator {
         None => DesignEstimator::Bcls,
