@@ -109,7 +109,7 @@ fn one_draw(
         DesignEstimator::Bcls => {
             let grid = &exp.grid;
             let m = s.signal.expected_values(grid, &s.jitter);
-            let record = Record::new(grid.clone(), m)
+            let record = Record::new(*grid, m)
                 .map_err(|e| study_err!("{}: the expected record: {e}", exp.file))?;
             let freqs = exp
                 .estimate
@@ -198,8 +198,7 @@ pub fn predict(
             (ss / (k - 1.0) / k).sqrt()
         })
         .collect();
-    let truth = model.params();
-    let mut truth = truth;
+    let mut truth = model.params();
     // ML's σ_v, when estimated, is the last of its parameters.
     truth.resize(p, exp.noise.std);
     Ok(Prediction {
