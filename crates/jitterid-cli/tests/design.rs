@@ -109,7 +109,7 @@ fn bad_designs_exit_2_naming_the_key() {
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(err.contains(want), "{args:?}: expected {want:?} in {err}");
     }
-    let o = run(&["design", &table2]);
+    let o = run(&["design", &example("ls-bias.toml")]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("no [design] section"), "{}", stderr(&o));
 }
