@@ -6,7 +6,8 @@
 //! that excites one mode against one that excites another). A log-spaced grid over every free
 //! variable finds the basin, and Brent's method ([`Brent`], the solvers' own) then refines each
 //! variable in turn between the best grid point's neighbours, on a log scale because the
-//! variables are scales (seconds) whose useful ranges span decades. A design that cannot be
+//! variables are scales (seconds) whose useful ranges span decades; the file's own design, when
+//! inside the ranges, is a candidate beside the refined point. A design that cannot be
 //! evaluated (a dwell with too many switches, a singular information matrix) counts as
 //! infinitely bad; only a range without any evaluable design is an error.
 
@@ -241,6 +242,24 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
     }
     let design = search.design(&base, &vars, &u);
     search.value(&design);
+    // The file's own design, where it lies in the ranges, is a candidate too (not a start of
+    // the refinement: the criterion of a random input is bumpy on a small scale, and the
+    // grid's basin is the better start): the result is then never worse than the baseline it
+    // is compared with, whatever the grid's spacing.
+    let own: Vec<f64> = vars
+        .iter()
+        .map(|v| match v {
+            Var::MeanDwell => base.mean_dwell.unwrap_or(f64::NAN).ln(),
+            Var::Interval => base.interval.ln(),
+        })
+        .collect();
+    if own
+        .iter()
+        .zip(&ranges)
+        .all(|(x, (lo, hi))| x >= lo && x <= hi)
+    {
+        search.value(&search.design(&base, &vars, &own));
+    }
     let memo = search.memo.into_inner().unwrap_or_else(|e| e.into_inner());
     let evaluations = memo.len();
     // The best evaluated design (the refinement's last point is its best, but the memo
