@@ -42,6 +42,29 @@ pub enum Command {
     /// Validate a fitted model on its record (and a validation record): fit percent, residual
     /// whiteness and input cross-correlation, flatness, frequency response with bands.
     Validate(ValidateArgs),
+    /// Design the experiment: the [design] variables (input dwell, sampling interval) that
+    /// minimise the estimate's predicted covariance under jitter, beside the file's own design.
+    Design(DesignArgs),
+}
+
+/// Arguments of `design`.
+#[derive(Debug, Args)]
+pub struct DesignArgs {
+    /// The experiment file (TOML) with a [design] section.
+    pub experiment: PathBuf,
+    /// What the design minimises: d (log det of the covariance), a (its trace) or param:NAME
+    /// (one parameter's variance) [default: [design] criterion, else d].
+    #[arg(long, value_name = "CRITERION")]
+    pub criterion: Option<String>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the JSON to this file instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub experiment_args: ExperimentArgs,
 }
 
 /// Arguments of `validate`.
@@ -349,6 +372,13 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             json: a.json,
             out: a.out,
             time_limit: a.time_limit,
+        }),
+        Command::Design(a) => commands::design(&commands::DesignOptions {
+            read: a.experiment_args.read_options(None)?,
+            experiment: a.experiment,
+            criterion: a.criterion,
+            json: a.json,
+            out: a.out,
         }),
         Command::Merge(a) => commands::merge(
             &a.shards,

@@ -562,6 +562,7 @@ fn help_and_version() {
         &["fit"],
         &["montecarlo"],
         &["merge"],
+        &["design"],
     ] {
         let mut args: Vec<&str> = sub.to_vec();
         args.push("--help");

@@ -48,6 +48,27 @@ where
     sandwich_of(&gram, &meat, held, noise_var)
 }
 
+/// The sandwich covariance of a first-moment criterion's estimate taken to be `model` (its
+/// parameters, nothing held), on `data`: what a fit that stopped at `model` would report,
+/// without the search. Experiment design evaluates it at a prior model on the expected
+/// (noise-free) record of a planned experiment; give `model` its noise level
+/// (`with_noise_std`), since noise-free data hold none to estimate. `None` when `JᵀJ` is
+/// singular, badly conditioned or not finite.
+pub fn sandwich_covariance<S, J, N, C, W>(
+    data: &FrequencyData<W>,
+    model: &ModelStructure<S, J, N>,
+    criterion: &C,
+) -> Option<Vec<Vec<f64>>>
+where
+    S: Signal + Clone,
+    J: JitterModel + Clone,
+    N: NoiseModel,
+    C: Criterion + ?Sized,
+    W: Window,
+{
+    sandwich(data, model, criterion, &[], None).0
+}
+
 /// The bread `JᵀJ`, the meat `Jᵀ Σ_r J` and the noise variance of one record's sandwich: the
 /// parts that sum over the records of a joint fit. `known` are the time-domain sensitivities at
 /// `model`, when already computed.

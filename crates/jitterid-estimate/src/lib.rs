@@ -116,7 +116,7 @@ pub use termination::FitTermination;
 /// Building blocks the likelihood layer (`jitterid-likelihood`) shares with the first-moment
 /// estimators of this crate, so that both judge records, reaches and profiles alike.
 pub mod support {
-    pub use crate::covariance::inverse_gram;
+    pub use crate::covariance::{inverse_gram, sandwich_covariance};
     pub use crate::data::check_samples;
     pub use crate::fit::reach_beyond;
     pub use crate::profile::{best_of, fitted_jitter, Best};

@@ -20,6 +20,8 @@
 //!   shards; [`merge`] combines shards, which carry the experiment's [`fingerprint`].
 //! - [`select`]: order and jitter-family selection and the data-driven start (`init = auto`).
 //! - [`validate`]: fit percent, residual tests, flatness, frequency and step responses.
+//! - [`design`]: the predicted precision of a planned experiment and the design (input
+//!   dwell, sampling interval) that makes it most precise under jitter.
 //! - [`export`]: a fitted system as zpk, tf and state space, with its Bode and step responses.
 //!
 //! Errors are one type, [`StudyError`]: one line of text that names what is wrong. Long work
@@ -27,6 +29,7 @@
 #![warn(missing_docs)]
 
 pub mod csvio;
+pub mod design;
 pub mod error;
 pub mod experiment;
 pub mod export;

@@ -2,6 +2,7 @@
 //! ([`jitterid_study`]), which decides everything about the model, and prints or writes what it
 //! returns.
 
+mod design;
 mod fit;
 mod merge;
 mod montecarlo;
@@ -9,6 +10,7 @@ mod select;
 mod simulate;
 mod validate;
 
+pub use design::{design, DesignOptions};
 pub use fit::{fit, FitRequest};
 pub use merge::merge;
 pub use montecarlo::{emit, montecarlo, MonteCarloOptions};

@@ -9,6 +9,7 @@
 
 mod channels;
 mod checks;
+mod design;
 mod diagnostics;
 mod estimate;
 mod input;
@@ -24,6 +25,7 @@ mod select;
 mod spec;
 mod system;
 
+pub use design::{DesignCriterion, DesignEstimator, DesignSpec, Hold, MAX_DRAWS, MAX_GRID};
 pub use input::MAX_SWITCHES;
 pub use overrides::Override;
 pub use paths::Paths;
@@ -303,6 +305,14 @@ pub fn parse_with(
         Some(r) => Some(select::parse_select(&cx, r, grid.len())?),
         None => None,
     };
+    let design = match &raw.design {
+        Some(r) => {
+            let kind = raw.input.as_ref().and_then(|i| i.kind.as_ref());
+            let kind = kind.map(|k| k.get_ref().as_str());
+            Some(design::parse_design(&cx, r, kind, &grid, history)?)
+        }
+        None => None,
+    };
     Ok(Experiment {
         file: file.to_string(),
         dir: cx.dir.clone(),
@@ -315,5 +325,6 @@ pub fn parse_with(
         noise,
         estimate,
         select,
+        design,
     })
 }

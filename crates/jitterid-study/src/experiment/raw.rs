@@ -110,6 +110,17 @@ section!(RawSelect, "table [select]" {
     families: Vec<String>,
 });
 
+section!(RawDesign, "table [design]" {
+    mean_dwell: Vec<f64>,
+    interval: Vec<f64>,
+    hold: String,
+    criterion: String,
+    estimator: String,
+    draws: i64,
+    grid: i64,
+    seed: i64,
+});
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename = "experiment file")]
 pub(super) struct RawExperiment {
@@ -131,6 +142,8 @@ pub(super) struct RawExperiment {
     pub(super) estimate: Option<RawEstimate>,
     #[serde(default)]
     pub(super) select: Option<RawSelect>,
+    #[serde(default)]
+    pub(super) design: Option<RawDesign>,
 }
 
 /// A section written once (`[input]`) or as an array of tables (`[[input]]`, one per input of
@@ -191,6 +204,7 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for OneOrMany<T> {
 
 pub(super) const SECTIONS: &[&str] = &[
     "title", "sampling", "input", "system", "output", "jitter", "noise", "estimate", "select",
+    "design",
 ];
 
 pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
@@ -202,6 +216,7 @@ pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
         "noise" => RawNoise::KEYS,
         "estimate" => RawEstimate::KEYS,
         "select" => RawSelect::KEYS,
+        "design" => RawDesign::KEYS,
         _ => SECTIONS,
     }
 }

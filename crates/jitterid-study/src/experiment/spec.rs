@@ -325,6 +325,8 @@ pub struct Experiment {
     pub estimate: EstimateSpec,
     /// The `[select]` grid of model orders and jitter families, when the file has one.
     pub select: Option<jitterid::estimate::selection::SelectionGrid>,
+    /// The `[design]` section's free design variables, when the file has one.
+    pub design: Option<super::DesignSpec>,
 }
 
 impl Experiment {

@@ -1,0 +1,36 @@
+//! Experiment design under jitter: how precise will an estimate be, and which experiment makes
+//! it most precise, before any data exist.
+//!
+//! With jitter the usual advice for identification experiments fails: a fast-switching input
+//! excites frequencies where the jitter's characteristic function `γ(f)` damps the signal and
+//! where the jitter adds noise of variance `≈ σ_τ² s′(t)²` right after every switch, while a
+//! slow one leaves the dynamics unexcited. The best dwell and sampling interval therefore
+//! depend on the jitter law, and this module computes them from a prior model (the
+//! experiment's truth).
+//!
+//! - [`predict`]: the expected covariance of BCLS (the fit's own sandwich at the truth on the
+//!   expected record) or of exact ML (the inverse exact Fisher information), averaged over
+//!   seeded draws of a random input; [`derived_std`] for the static gain, a gain at one
+//!   frequency and the jitter's σ by the delta method.
+//! - [`criterion_value`]: D-, A- or one parameter's optimality.
+//! - [`Plan`], [`Design`]: the experiment file as a document that each candidate design edits
+//!   and reads again, so every candidate is validated like a written file.
+//! - [`optimise`], [`design()`]: the seeded, deterministic search over the `[design]` ranges and
+//!   the report that sets the result beside the file's own design.
+
+mod candidate;
+mod criterion;
+mod derived;
+mod plan;
+mod predict;
+mod realization;
+mod report;
+mod search;
+
+pub use candidate::Design;
+pub use criterion::criterion_value;
+pub use derived::{derived_std, Derived};
+pub use plan::Plan;
+pub use predict::{predict, Prediction};
+pub use report::{design, DesignJson, DesignReport, PredictedDesign, PredictedStd};
+pub use search::{optimise, Optimum};

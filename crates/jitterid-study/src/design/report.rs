@@ -1,0 +1,131 @@
+//! What `jitterid design` reports: the designed experiment and the file's own, each with its
+//! predicted standard deviations, as values and as the command's JSON.
+
+use super::candidate::Design;
+use super::criterion::criterion_value;
+use super::plan::Plan;
+use super::predict::{predict, Prediction};
+use super::search::optimise;
+use crate::error::StudyResult;
+use crate::experiment::{DesignCriterion, DesignEstimator};
+use serde::Serialize;
+
+/// One predicted standard deviation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PredictedStd {
+    /// The parameter's name.
+    pub name: String,
+    /// Its predicted standard deviation (`null` where the baseline could not be predicted).
+    pub std: Option<f64>,
+}
+
+/// A design and its predicted standard deviations.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PredictedDesign {
+    /// The design.
+    pub design: Design,
+    /// The predicted standard deviation of each estimated parameter.
+    pub predicted: Vec<PredictedStd>,
+}
+
+/// The JSON of `jitterid design --json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DesignJson {
+    /// The criterion (`d`, `a`, `param:NAME`).
+    pub criterion: String,
+    /// The designed experiment.
+    pub design: Design,
+    /// Its predicted standard deviations.
+    pub predicted: Vec<PredictedStd>,
+    /// The experiment file's own design, for comparison.
+    pub baseline: PredictedDesign,
+}
+
+/// The outcome of a design search, with what the text report adds to the JSON.
+#[derive(Debug, Clone)]
+pub struct DesignReport {
+    /// The criterion.
+    pub criterion: DesignCriterion,
+    /// The estimator predicted for.
+    pub estimator: DesignEstimator,
+    /// Input draws per prediction (1 for a fixed input).
+    pub draws: usize,
+    /// The designed experiment.
+    pub design: Design,
+    /// Its prediction.
+    pub prediction: Prediction,
+    /// Its criterion value.
+    pub value: f64,
+    /// The baseline design.
+    pub baseline: Design,
+    /// The baseline's prediction and criterion value, or why it has none (a singular
+    /// information matrix at the file's own design).
+    pub baseline_prediction: Result<(Prediction, f64), String>,
+    /// Designs evaluated by the search.
+    pub evaluations: usize,
+}
+
+impl DesignReport {
+    /// The command's JSON.
+    pub fn json(&self) -> DesignJson {
+        let stds = |p: &Prediction| -> Vec<PredictedStd> {
+            p.names
+                .iter()
+                .zip(&p.std)
+                .map(|(n, s)| PredictedStd {
+                    name: n.clone(),
+                    std: Some(*s),
+                })
+                .collect()
+        };
+        let baseline = match &self.baseline_prediction {
+            Ok((p, _)) => stds(p),
+            Err(_) => self
+                .prediction
+                .names
+                .iter()
+                .map(|n| PredictedStd {
+                    name: n.clone(),
+                    std: None,
+                })
+                .collect(),
+        };
+        DesignJson {
+            criterion: self.criterion.to_string(),
+            design: self.design,
+            predicted: stds(&self.prediction),
+            baseline: PredictedDesign {
+                design: self.baseline,
+                predicted: baseline,
+            },
+        }
+    }
+}
+
+/// Designs the plan's experiment under `criterion` (the `[design]` section's when `None`) and
+/// predicts the baseline's precision beside it.
+///
+/// # Errors
+///
+/// Those of [`optimise`]: an unknown parameter in the criterion, a range without a feasible
+/// design.
+pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<DesignReport> {
+    let spec = &plan.spec;
+    let criterion = criterion.unwrap_or(&spec.criterion).clone();
+    let optimum = optimise(plan, &criterion)?;
+    let baseline = plan.baseline_design();
+    let baseline_prediction = predict(&plan.baseline, spec.estimator, spec.draws, spec.seed)
+        .and_then(|p| criterion_value(&criterion, &p).map(|v| (p, v)))
+        .map_err(|e| e.to_string());
+    Ok(DesignReport {
+        criterion,
+        estimator: spec.estimator,
+        draws: optimum.prediction.draws,
+        design: optimum.design,
+        value: optimum.value,
+        prediction: optimum.prediction,
+        baseline,
+        baseline_prediction,
+        evaluations: optimum.evaluations,
+    })
+}

@@ -1,0 +1,329 @@
+//! `[design]`: the experiment's free design variables and their ranges, for `jitterid design`.
+//!
+//! The section names what the user may still choose before the experiment is run (the random
+//! binary input's mean dwell, the sampling interval) and how a design is judged. Ranges are
+//! checked here against what the rest of the file fixes, so that a range without one feasible
+//! point is refused at the door, naming its key, rather than found empty by the optimiser.
+
+use super::diagnostics::Source;
+use super::range::{MAX_INTERVAL, MIN_INTERVAL};
+use super::raw::RawDesign;
+use super::sampling::MAX_SAMPLES;
+use crate::error::StudyResult;
+use jitterid::signal::{SampleGrid, MAX_SWITCHES};
+use std::fmt;
+use toml::Spanned;
+
+const S: &str = "design";
+
+/// Largest number of input realisations a prediction averages over.
+pub const MAX_DRAWS: usize = 1024;
+
+/// Largest number of grid points per free variable of the design search.
+pub const MAX_GRID: usize = 64;
+
+/// What a design is judged by: a scalar function of the predicted covariance `C` of the
+/// estimated parameters, smaller is better.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum DesignCriterion {
+    /// D-optimality, `log det C`: the volume of the confidence ellipsoid, invariant to the
+    /// parameters' units.
+    D,
+    /// A-optimality, `trace C`: the summed variances (depends on the parameters' units).
+    A,
+    /// The variance of one named parameter (as the fit names it, `p1.re`, `jitter.a`).
+    Param(String),
+}
+
+impl DesignCriterion {
+    /// `d`, `a` or `param:NAME`.
+    ///
+    /// # Errors
+    ///
+    /// The text that was not understood, with what was expected.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        match text.trim() {
+            "d" | "D" => Ok(Self::D),
+            "a" | "A" => Ok(Self::A),
+            t => match t.strip_prefix("param:").map(str::trim) {
+                Some(name) if !name.is_empty() => Ok(Self::Param(name.to_string())),
+                _ => Err(format!(
+                    "expected \"d\", \"a\" or \"param:NAME\" (a parameter's name), found \"{text}\""
+                )),
+            },
+        }
+    }
+}
+
+impl fmt::Display for DesignCriterion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::D => f.write_str("d"),
+            Self::A => f.write_str("a"),
+            Self::Param(name) => write!(f, "param:{name}"),
+        }
+    }
+}
+
+/// The estimator whose precision a design is predicted for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DesignEstimator {
+    /// Bias-compensated least squares: the sandwich covariance.
+    Bcls,
+    /// Exact maximum likelihood: the inverse exact Fisher information (the Cramér–Rao bound).
+    Ml,
+}
+
+impl DesignEstimator {
+    /// The name in files and on the command line (`bcls`, `ml`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Bcls => "bcls",
+            Self::Ml => "ml",
+        }
+    }
+}
+
+/// What stays fixed when the sampling interval `T` is a design variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hold {
+    /// The number of samples `N`: the record's duration `N T` changes with `T`.
+    Samples,
+    /// The record's duration `N T` (the file's): `N = round(duration / T)`.
+    Duration,
+}
+
+/// The validated `[design]` section.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignSpec {
+    /// The random binary input's mean dwell range `[min, max]` (s), when it is free.
+    pub mean_dwell: Option<(f64, f64)>,
+    /// The sampling interval's range `[min, max]` (s), when it is free; the part of the range
+    /// where the held quantity allows a record (see [`Hold`]).
+    pub interval: Option<(f64, f64)>,
+    /// What stays fixed when the interval changes.
+    pub hold: Hold,
+    /// The criterion (the command line's `--criterion` replaces it).
+    pub criterion: DesignCriterion,
+    /// The estimator whose precision is predicted.
+    pub estimator: DesignEstimator,
+    /// Input realisations averaged over for a random input.
+    pub draws: usize,
+    /// Grid points per free variable before the refinement.
+    pub grid: usize,
+    /// Master seed of the input realisations (realisation `r` is Monte Carlo run `r`'s input).
+    pub seed: u64,
+}
+
+/// `[min, max]` of two finite numbers with `0 < min ≤ max`.
+fn range(cx: &Source, key: &str, v: &Spanned<Vec<f64>>) -> StudyResult<(f64, f64)> {
+    match v.get_ref().as_slice() {
+        &[lo, hi] if lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi => Ok((lo, hi)),
+        other => Err(cx.err(
+            S,
+            key,
+            &v.span(),
+            format!(
+                "expected [min, max] of two finite numbers with 0 < min <= max, found {other:?}"
+            ),
+        )),
+    }
+}
+
+/// A whole number in `[lo, hi]`, or `default` when absent.
+fn whole(
+    cx: &Source,
+    key: &str,
+    v: &Option<Spanned<i64>>,
+    (lo, hi): (i64, i64),
+    default: i64,
+) -> StudyResult<i64> {
+    match v {
+        None => Ok(default),
+        Some(s) if (lo..=hi).contains(s.get_ref()) => Ok(*s.get_ref()),
+        Some(s) => Err(cx.err(
+            S,
+            key,
+            &s.span(),
+            format!(
+                "expected a whole number in [{lo}, {hi}], found {}",
+                s.get_ref()
+            ),
+        )),
+    }
+}
+
+/// The `[design]` section, checked against the file's grid, input kind (`input_kind`, as
+/// written) and input history: every range must hold a feasible point.
+pub(super) fn parse_design(
+    cx: &Source,
+    r: &RawDesign,
+    input_kind: Option<&str>,
+    grid: &SampleGrid,
+    history: f64,
+) -> StudyResult<DesignSpec> {
+    let mean_dwell = match &r.mean_dwell {
+        Some(v) => {
+            if input_kind != Some("random-binary") {
+                return Err(cx.err(
+                    S,
+                    "mean_dwell",
+                    &v.span(),
+                    "is a design variable of a random binary input; expected [input] kind = \"random-binary\"",
+                ));
+            }
+            Some((v, range(cx, "mean_dwell", v)?))
+        }
+        None => None,
+    };
+    let hold = match &r.hold {
+        None => Hold::Samples,
+        Some(h) => match h.get_ref().as_str() {
+            "samples" => Hold::Samples,
+            "duration" => Hold::Duration,
+            other => {
+                return Err(cx.err(
+                    S,
+                    "hold",
+                    &h.span(),
+                    format!("expected \"samples\" or \"duration\", found \"{other}\""),
+                ))
+            }
+        },
+    };
+    let n = grid.len() as f64;
+    let duration = n * grid.interval();
+    let interval = match &r.interval {
+        Some(v) => {
+            let (lo, hi) = range(cx, "interval", v)?;
+            // The feasible part: a representable interval, and under a held duration a whole
+            // number of samples in [1, MAX_SAMPLES].
+            let (mut a, mut b) = (lo.max(MIN_INTERVAL), hi.min(MAX_INTERVAL));
+            if hold == Hold::Duration {
+                a = a.max(duration / MAX_SAMPLES as f64);
+                b = b.min(duration);
+            }
+            if !(a <= b) {
+                return Err(cx.err(
+                    S,
+                    "interval",
+                    &v.span(),
+                    format!(
+                        "no feasible interval in [{lo}, {hi}] s: it must lie in [{MIN_INTERVAL:e}, {MAX_INTERVAL:e}] s{}",
+                        if hold == Hold::Duration {
+                            format!(
+                                " and, with the duration {duration} s held, give 1 to {MAX_SAMPLES} samples"
+                            )
+                        } else {
+                            String::new()
+                        }
+                    ),
+                ));
+            }
+            Some((a, b))
+        }
+        None => None,
+    };
+    if let Some((v, (_, hi))) = &mean_dwell {
+        // The shortest record the design allows, with the longest dwell: the fewest switches.
+        let shortest = match (interval, hold) {
+            (Some((t, _)), Hold::Samples) => n * t,
+            _ => duration,
+        };
+        let switches = (shortest + history) / hi;
+        if !(switches <= MAX_SWITCHES) {
+            return Err(cx.err(
+                S,
+                "mean_dwell",
+                &v.span(),
+                format!(
+                    "no feasible mean dwell: even the longest, {hi} s, gives {switches:e} expected switches over the input's span, more than {MAX_SWITCHES:e}"
+                ),
+            ));
+        }
+    }
+    let mean_dwell = mean_dwell.map(|(_, r)| r);
+    if mean_dwell.is_none() && interval.is_none() {
+        return Err(cx.err_section(
+            S,
+            "mean_dwell",
+            "the section names no free variable; expected mean_dwell = [min, max] or interval = [min, max]",
+        ));
+    }
+    let criterion = match &r.criterion {
+        None => DesignCriterion::D,
+        Some(c) => {
+            DesignCriterion::parse(c.get_ref()).map_err(|e| cx.err(S, "criterion", &c.span(), e))?
+        }
+    };
+    let estimator = match &r.estimator {
+        None => DesignEstimator::Bcls,
+        Some(e) => match e.get_ref().as_str() {
+            "bcls" => DesignEstimator::Bcls,
+            "ml" => DesignEstimator::Ml,
+            other => {
+                return Err(cx.err(
+                    S,
+                    "estimator",
+                    &e.span(),
+                    format!("expected \"bcls\" or \"ml\", found \"{other}\""),
+                ))
+            }
+        },
+    };
+    let draws = whole(cx, "draws", &r.draws, (1, MAX_DRAWS as i64), 16)? as usize;
+    let points = whole(cx, "grid", &r.grid, (3, MAX_GRID as i64), 9)? as usize;
+    let seed = whole(
+        cx,
+        "seed",
+        &r.seed,
+        (0, i64::MAX),
+        crate::montecarlo::DEFAULT_SEED as i64,
+    )? as u64;
+    Ok(DesignSpec {
+        mean_dwell,
+        interval,
+        hold,
+        criterion,
+        estimator,
+        draws,
+        grid: points,
+        seed,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::raw::RawDesign;
+
+    /// The `[design]` table of `docs/experiments.md` lists exactly the keys the reader takes,
+    /// in order: the reference cannot drift from the reader.
+    #[test]
+    fn the_docs_design_table_lists_the_reader_s_keys() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
+        let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
+        let start = text
+            .find("### `[design]`")
+            .expect("docs/experiments.md has a [design] section");
+        let keys: Vec<&str> = text[start..]
+            .lines()
+            .skip_while(|l| !l.starts_with("| key |"))
+            .skip(2)
+            .take_while(|l| l.starts_with('|'))
+            .filter_map(|l| l.split('`').nth(1))
+            .collect();
+        assert_eq!(keys, RawDesign::KEYS);
+    }
+
+    /// Criteria read back as written.
+    #[test]
+    fn criteria_parse_and_print_alike() {
+        use super::DesignCriterion;
+        for text in ["d", "a", "param:pole0.re"] {
+            assert_eq!(DesignCriterion::parse(text).unwrap().to_string(), text);
+        }
+        for bad in ["", "e", "param:", "param: "] {
+            assert!(DesignCriterion::parse(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,383 @@
+//! Experiment design: the predicted precision of a planned experiment against a Monte Carlo of
+//! it, against an independent closed form, against the Cramér–Rao ordering, and the design
+//! search's optimum against a fine scan of its criterion.
+
+use faer::linalg::solvers::DenseSolveCore;
+use jitterid::estimate::ml::delta_method_std;
+use jitterid::signal::Signal;
+use jitterid_study::design::{
+    criterion_value, derived_std, design, optimise, predict, Derived, Design, Plan,
+};
+use jitterid_study::experiment::{
+    self, DesignCriterion, DesignEstimator, Experiment, Purpose, ReadOptions,
+};
+use jitterid_study::montecarlo::{montecarlo_realizations, DEFAULT_SEED};
+use jitterid_study::Registries;
+use std::path::Path;
+
+fn example(file: &str) -> Experiment {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/experiments")
+        .join(file);
+    experiment::read(&path, Purpose::Estimate(None)).unwrap()
+}
+
+fn parse(text: &str) -> Result<Experiment, String> {
+    experiment::parse("exp.toml", text, Path::new("."), Purpose::Simulate)
+        .map_err(|e| e.to_string())
+}
+
+fn plan(text: &str) -> Result<Plan, String> {
+    Plan::parse(
+        &Registries::builtin(),
+        "exp.toml",
+        text.to_string(),
+        Path::new("."),
+        &ReadOptions::default(),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// The Table 2 setup (as `examples/experiments/table2.toml`), with `extra` appended.
+fn table2(extra: &str) -> String {
+    format!(
+        r#"
+[sampling]
+interval = 1.0
+samples = 200
+[input]
+kind = "random-binary"
+mean_dwell = 8.0
+low = 0.0
+high = 1.0
+[system]
+kind = "zpk"
+gain = 0.2
+zeros = [-0.5]
+poles = [[-0.25, 0.3]]
+estimate = true
+[jitter]
+family = "uniform-sum"
+n = 2
+a = 0.28867513459481287
+estimate = false
+[noise]
+std = 0.01
+{extra}
+"#
+    )
+}
+
+/// The predicted BCLS standard deviations of the Table 2 setup agree with a Monte Carlo of 64
+/// realisations. The prediction averages the sandwich over the same 64 input draws the Monte
+/// Carlo runs see (same seed), so what is left is the Monte Carlo's own error, whose standard
+/// error for a standard deviation is about `std/√(2R)`: the test allows 3 of those.
+#[test]
+fn predicted_bcls_std_agrees_with_monte_carlo() {
+    let exp = example("table2.toml");
+    let runs = 64;
+    let p = predict(&exp, DesignEstimator::Bcls, runs, DEFAULT_SEED).unwrap();
+    assert_eq!(p.draws, runs);
+    let mc = montecarlo_realizations(&exp, runs as u64, DEFAULT_SEED, None).unwrap();
+    assert_eq!(mc.names, p.names);
+    for (i, name) in p.names.iter().enumerate() {
+        let v: Vec<f64> = mc
+            .runs
+            .iter()
+            .filter(|r| r.converged)
+            .filter_map(|r| r.values[i])
+            .collect();
+        let r = v.len() as f64;
+        assert!(r >= 60.0, "{name}: only {r} converged runs");
+        let mean = v.iter().sum::<f64>() / r;
+        let std = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (r - 1.0)).sqrt();
+        let se = p.std[i] / (2.0 * r).sqrt();
+        eprintln!(
+            "{name}: predicted {:.5}, Monte Carlo {std:.5} (se {se:.5})",
+            p.std[i]
+        );
+        assert!(
+            (std - p.std[i]).abs() <= 3.0 * se,
+            "{name}: predicted {} against Monte Carlo {std} ± {se}",
+            p.std[i]
+        );
+    }
+}
+
+/// An independent route to the same number: on the half DFT grid `0 ≤ j ≤ N/2` with the
+/// rectangular window, `Σ_j |D_j|² = ½ dᵀ(N I + 11ᵀ + [N even] aaᵀ) d` with `a_k = (−1)^k`, so
+/// BCLS is generalised least squares in time with that weight `Q`, and its covariance is
+/// `(GᵀQG)⁻¹ GᵀQΛQG (GᵀQG)⁻¹` with `G = ∂m/∂θ` (here by central differences of `m_k`, not
+/// the analytic sensitivities) and `Λ = diag(σ_v² + E s² − m²)`. Checked for an odd and an
+/// even `N` on a fixed piecewise input.
+#[test]
+fn bcls_prediction_is_the_time_domain_gls_sandwich() {
+    for n in [61usize, 64] {
+        let text = format!(
+            r#"
+[sampling]
+interval = 0.5
+samples = {n}
+[input]
+kind = "piecewise"
+times = [0.0, 3.1, 7.4, 9.0, 15.2, 21.7, 25.0]
+values = [0.0, 1.0, -1.0, 0.5, 1.0, 0.0, -0.5]
+[system]
+kind = "zpk"
+gain = 0.2
+zeros = [-0.5]
+poles = [[-0.25, 0.3]]
+estimate = true
+[jitter]
+family = "uniform-sum"
+n = 1
+a = 0.4
+estimate = true
+[noise]
+std = 0.02
+"#
+        );
+        let exp = parse(&text).unwrap();
+        let p = predict(&exp, DesignEstimator::Bcls, 8, 1).unwrap();
+        assert_eq!(p.draws, 1, "a fixed input is one draw");
+        let s = p.model();
+        let grid = &exp.grid;
+        let theta = s.params();
+        let np = theta.len();
+        let m_at = |t: &[f64]| {
+            let m = s.with_params(t).unwrap();
+            m.signal.expected_values(grid, &m.jitter)
+        };
+        let g: Vec<Vec<f64>> = (0..np)
+            .map(|j| {
+                let h = 1e-6 * theta[j].abs().max(1e-3);
+                let (mut up, mut dn) = (theta.clone(), theta.clone());
+                up[j] += h;
+                dn[j] -= h;
+                let (a, b) = (m_at(&up), m_at(&dn));
+                a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+            })
+            .collect();
+        let m = s.signal.expected_values(grid, &s.jitter);
+        let sq = s.signal.expected_squares(grid, &s.jitter);
+        let lambda: Vec<f64> = m
+            .iter()
+            .zip(&sq)
+            .map(|(m, q)| 0.02f64.powi(2) + (q - m * m).max(0.0))
+            .collect();
+        // Q g for a column g: N g + 1(1ᵀg) + [N even] a(aᵀg).
+        let q = |v: &[f64]| -> Vec<f64> {
+            let sum: f64 = v.iter().sum();
+            let alt: f64 = v
+                .iter()
+                .enumerate()
+                .map(|(k, x)| if k % 2 == 0 { *x } else { -x })
+                .sum();
+            v.iter()
+                .enumerate()
+                .map(|(k, x)| {
+                    let a = if k % 2 == 0 { 1.0 } else { -1.0 };
+                    n as f64 * x + sum + if n % 2 == 0 { a * alt } else { 0.0 }
+                })
+                .collect()
+        };
+        let qg: Vec<Vec<f64>> = g.iter().map(|c| q(c)).collect();
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let h = faer::Mat::from_fn(np, np, |i, j| dot(&g[i], &qg[j]));
+        let meat = faer::Mat::from_fn(np, np, |i, j| {
+            qg[i]
+                .iter()
+                .zip(&qg[j])
+                .zip(&lambda)
+                .map(|((a, b), l)| a * b * l)
+                .sum::<f64>()
+        });
+        let hinv = h.partial_piv_lu().inverse();
+        let cov = &hinv * &meat * &hinv;
+        for i in 0..np {
+            let closed = cov[(i, i)].sqrt();
+            let rel = (closed - p.std[i]).abs() / closed;
+            eprintln!(
+                "N = {n}, {}: {} against {closed} ({rel:e})",
+                p.names[i], p.std[i]
+            );
+            assert!(
+                rel < 1e-5,
+                "N = {n}, {}: {} against {closed}",
+                p.names[i],
+                p.std[i]
+            );
+        }
+    }
+}
+
+/// Exact ML's predicted covariance is the Cramér–Rao bound, which no consistent estimator's
+/// asymptotic covariance goes below: every parameter's ML std is at most BCLS's, on the same
+/// draws.
+#[test]
+fn ml_prediction_is_below_bcls() {
+    let exp = parse(&table2("").replace("samples = 200", "samples = 100")).unwrap();
+    let b = predict(&exp, DesignEstimator::Bcls, 2, 5).unwrap();
+    let m = predict(&exp, DesignEstimator::Ml, 2, 5).unwrap();
+    assert_eq!(b.names, m.names);
+    for i in 0..b.names.len() {
+        eprintln!("{}: ML {} BCLS {}", b.names[i], m.std[i], b.std[i]);
+        assert!(
+            m.std[i] > 0.0 && m.std[i] <= b.std[i] * (1.0 + 1e-6),
+            "{}",
+            b.names[i]
+        );
+    }
+}
+
+/// The static gain's delta-method std with the gradient in closed form:
+/// `G(0) = k(−z)/(re² + im²)` for `G = k (s − z)/((s − re)² + im²)`.
+#[test]
+fn static_gain_std_is_the_delta_method_with_the_closed_form_gradient() {
+    let exp = parse(&table2("")).unwrap();
+    let p = predict(&exp, DesignEstimator::Bcls, 4, 9).unwrap();
+    let (k, z, re, im) = (0.2, -0.5, -0.25, 0.3);
+    let d = re * re + im * im;
+    let g0 = -k * z / d;
+    let grad = [g0 / k, -k / d, -g0 * 2.0 * re / d, -g0 * 2.0 * im / d];
+    let closed = delta_method_std(&p.covariance, &grad).unwrap();
+    let derived = derived_std(&p, Derived::StaticGain).unwrap();
+    assert!(
+        (derived - closed).abs() <= 1e-6 * closed,
+        "{derived} against {closed}"
+    );
+    // The jitter is known here: its σ has no spread.
+    assert_eq!(derived_std(&p, Derived::JitterStd).unwrap(), 0.0);
+    let at = derived_std(&p, Derived::Magnitude(0.05)).unwrap();
+    assert!(at > 0.0 && at.is_finite());
+    assert!(derived_std(&p, Derived::Magnitude(f64::NAN)).is_err());
+}
+
+/// The design search on the mean dwell: its optimum is no worse than any point of a fine scan
+/// of the same criterion over the range (the grid and refinement found the basin), no worse
+/// than the file's own dwell, deterministic, and reported in the command's JSON shape.
+#[test]
+fn dwell_search_finds_the_scan_s_minimum() {
+    let text = table2(
+        "[design]\nmean_dwell = [0.5, 40.0]\ncriterion = \"d\"\ndraws = 4\ngrid = 7\nseed = 3",
+    )
+    .replace("samples = 200", "samples = 120");
+    let plan = plan(&text).unwrap();
+    let opt = optimise(&plan, &DesignCriterion::D).unwrap();
+    let scan_value = |dwell: f64| {
+        let d = Design {
+            mean_dwell: Some(dwell),
+            ..plan.baseline_design()
+        };
+        let exp = plan.experiment(&d).unwrap();
+        let p = predict(&exp, DesignEstimator::Bcls, 4, 3).unwrap();
+        criterion_value(&DesignCriterion::D, &p).unwrap()
+    };
+    let mut scan = Vec::new();
+    for i in 0..25 {
+        let dwell = 0.5 * (80.0f64).powf(i as f64 / 24.0);
+        scan.push((dwell, scan_value(dwell)));
+    }
+    let best = scan
+        .iter()
+        .cloned()
+        .fold((0.0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+    eprintln!(
+        "optimum {:?} = {}, scan best {best:?}",
+        opt.design, opt.value
+    );
+    assert!(
+        opt.value <= best.1 + 1e-9,
+        "{} against the scan's {}",
+        opt.value,
+        best.1
+    );
+    assert!(opt.value <= scan_value(8.0));
+    let again = optimise(&plan, &DesignCriterion::D).unwrap();
+    assert_eq!(again.design, opt.design);
+    let report = design(&plan, None).unwrap();
+    let json = serde_json::to_value(report.json()).unwrap();
+    let keys: Vec<&String> = json.as_object().unwrap().keys().collect();
+    assert_eq!(keys, ["baseline", "criterion", "design", "predicted"]);
+    assert_eq!(json["criterion"], "d");
+    assert_eq!(json["baseline"]["design"]["mean_dwell"], 8.0);
+    assert_eq!(json["predicted"].as_array().unwrap().len(), 4);
+    assert_eq!(json["predicted"][0]["name"], "gain");
+}
+
+/// A held duration: the interval's search keeps `N T` and its optimum's `N` is
+/// `round(duration / T)`.
+#[test]
+fn interval_search_with_a_held_duration_keeps_the_duration() {
+    let text = table2(
+        "[design]\ninterval = [0.25, 2.0]\nhold = \"duration\"\ndraws = 2\ngrid = 4\ncriterion = \"a\"",
+    )
+    .replace("samples = 200", "samples = 80");
+    let plan = plan(&text).unwrap();
+    let opt = optimise(&plan, &DesignCriterion::A).unwrap();
+    let d = opt.design;
+    assert!((0.25..=2.0).contains(&d.interval), "{d:?}");
+    assert_eq!(d.samples, (80.0 / d.interval).round() as usize, "{d:?}");
+}
+
+/// Bad `[design]` sections are refused at the door, naming the key; a criterion that names no
+/// parameter is refused by the search.
+#[test]
+fn infeasible_designs_are_refused_naming_the_key() {
+    let cases = [
+        (
+            "[design]\nmean_dwell = [2.0, 1.0]",
+            "[design] mean_dwell: expected [min, max]",
+        ),
+        (
+            "[design]\nmean_dwell = [1e-9, 1e-8]",
+            "[design] mean_dwell: no feasible mean dwell",
+        ),
+        (
+            "[design]\ninterval = [300.0, 400.0]\nhold = \"duration\"",
+            "[design] interval: no feasible interval",
+        ),
+        (
+            "[design]\ndraws = 4",
+            "[design] mean_dwell: the section names no free variable",
+        ),
+        (
+            "[design]\ninterval = [0.5, 1.0]\ncriterion = \"e\"",
+            "[design] criterion: expected",
+        ),
+        (
+            "[design]\ninterval = [0.5, 1.0]\nhold = \"time\"",
+            "[design] hold: expected",
+        ),
+        (
+            "[design]\ninterval = [0.5, 1.0]\ndraws = 0",
+            "[design] draws: expected a whole number",
+        ),
+        ("[design]\ninterval = [0.5, 1.0]\nfoo = 1", "foo"),
+    ];
+    for (section, want) in cases {
+        let e = parse(&table2(section)).unwrap_err();
+        assert!(e.contains(want), "{section}: {e}");
+    }
+    // A dwell range needs a random binary input.
+    let sine = table2("[design]\nmean_dwell = [1.0, 2.0]").replace(
+        "kind = \"random-binary\"\nmean_dwell = 8.0\nlow = 0.0\nhigh = 1.0",
+        "kind = \"sine\"\nfrequency = 0.05\namplitude = 1.0",
+    );
+    let e = parse(&sine).unwrap_err();
+    assert!(
+        e.contains("[design] mean_dwell: is a design variable of a random binary input"),
+        "{e}"
+    );
+    let p = plan(&table2(
+        "[design]\ninterval = [0.5, 1.0]\ngrid = 3\ndraws = 1",
+    ))
+    .unwrap();
+    let e = optimise(&p, &DesignCriterion::Param("nope".into()))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("param:nope") && e.contains("gain"), "{e}");
+    assert!(plan(&table2(""))
+        .unwrap_err()
+        .contains("no [design] section"));
+}
