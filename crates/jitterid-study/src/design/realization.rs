@@ -8,29 +8,32 @@
 use crate::error::StudyResult;
 use crate::experiment::{Experiment, InputSpec};
 use crate::fit::signal_of;
-use crate::simulate::{realize_input, seen_input};
+use crate::simulate::{realize_inputs, seen_inputs};
 use jitterid::rand::rngs::StdRng;
 use jitterid::signal::AnySignal;
 
 /// Whether the experiment's input is drawn anew for every realisation (a random binary
 /// input), so that a prediction must average over draws; a fixed input needs one.
 pub(crate) fn input_is_random(exp: &Experiment) -> bool {
-    matches!(exp.input, InputSpec::RandomBinary(_))
+    exp.random_input()
 }
 
 /// The signal a fit of realisation `rng` sees, at the experiment's true system: the input
-/// drawn from `rng` as [`realize_input`] draws it (the first draw of Monte Carlo run `r`'s
-/// stream), cut to what the record sees ([`seen_input`]), driving the `[system]` model.
+/// drawn from `rng` as [`realize_inputs`] draws it (the first draw of Monte Carlo run `r`'s
+/// stream), cut to what the record sees ([`seen_inputs`]), driving the `[system]` model.
 pub(crate) fn realized_signal(exp: &Experiment, rng: &mut StdRng) -> StudyResult<AnySignal> {
-    let truth = realize_input(exp, rng)?;
-    let seen = seen_input(exp, truth.as_ref())?;
-    signal_of(exp, seen.as_ref())
+    let truth = realize_inputs(exp, rng)?;
+    let seen = seen_inputs(exp, &truth)?;
+    signal_of(exp, &seen)
 }
 
-/// The random binary input's mean dwell (s), `None` for another input.
+/// The random binary input's mean dwell (s), `None` for another input or several inputs.
 pub(crate) fn mean_dwell_of(exp: &Experiment) -> Option<f64> {
-    match &exp.input {
-        InputSpec::RandomBinary(rb) => Some(rb.mean_dwell()),
+    match exp.inputs.as_slice() {
+        [c] => match &c.spec {
+            InputSpec::RandomBinary(rb) => Some(rb.mean_dwell()),
+            InputSpec::Known(_) => None,
+        },
         _ => None,
     }
 }

@@ -307,8 +307,13 @@ pub fn parse_with(
     };
     let design = match &raw.design {
         Some(r) => {
-            let kind = raw.input.as_ref().and_then(|i| i.kind.as_ref());
-            let kind = kind.map(|k| k.get_ref().as_str());
+            // A design varies the one input of a single-input experiment.
+            let one = match (&raw.input, inputs.as_slice()) {
+                (Some(OneOrMany::One(i)), [c]) => Some((i, c.history)),
+                _ => None,
+            };
+            let kind = one.and_then(|(i, _)| i.kind.as_ref().map(|k| k.get_ref().as_str()));
+            let history = one.map_or(0.0, |(_, h)| h);
             Some(design::parse_design(&cx, r, kind, &grid, history)?)
         }
         None => None,
