@@ -113,3 +113,13 @@ fn zero_residual_problems_keep_gauss_newton_steps() {
     // Gauss–Newton predicts these steps well, so the secant model is never switched on.
     assert_eq!(same, 10);
 }
+
+#[test]
+fn options_written_without_a_model_read_as_adaptive() {
+    let old = r#"{"max_iters":5,"xtol":1e-10,"ftol":1e-12,"gtol":1e-10,"initial_lambda":0.001,"scaling":"Marquardt"}"#;
+    let options: jitterid_optim::LmOptions = serde_json::from_str(old).expect("reads");
+    assert_eq!(options.model, Model::Adaptive);
+    let plain = old.replace('}', r#","model":"GaussNewton"}"#);
+    let options: jitterid_optim::LmOptions = serde_json::from_str(&plain).expect("reads");
+    assert_eq!(options.model, Model::GaussNewton);
+}
