@@ -99,7 +99,7 @@ pub use bfgs::Bfgs;
 pub use brent::{Brent, BrentOrBfgs};
 pub use error::SolverError;
 pub use gauss_newton::GaussNewtonLineSearch;
-pub use lm::{LevenbergMarquardt, LmOptions, Scaling};
+pub use lm::{LevenbergMarquardt, LmModel, LmOptions, Scaling};
 pub use multistart::MultiStart;
 pub use nelder_mead::NelderMead;
 pub use normal::{dot, gram};

@@ -21,13 +21,31 @@
 //! # Algorithm
 //!
 //! Each iteration solves the damped normal equations `(JᵀJ + μD) h = −Jᵀr` by Cholesky (faer's
-//! LLT) and tries `θ + h`. The step is accepted if the gain ratio
-//! `ρ = (V(θ) − V(θ + h)) / (L(0) − L(h))` of actual to predicted (linear-model) reduction is
+//! LLT; `JᵀJ` may be replaced by a better model of the Hessian, below) and tries `θ + h`. The step is accepted if the gain ratio
+//! `ρ = (V(θ) − V(θ + h)) / (L(0) − L(h))` of actual to predicted (the quadratic model's) reduction is
 //! positive; then `μ ← μ · max(1/3, 1 − (2ρ − 1)³)`, otherwise `μ ← μν`, `ν ← 2ν` and the step is
 //! recomputed within the same iteration (Nielsen's update; Madsen, Nielsen & Tingleff, *Methods
 //! for non-linear least squares problems*, 2004, §3.2). One argmin iteration is therefore one
 //! *accepted* step (except the last, which may end on a stopping test without one). A trial point with non-finite residuals or Jacobian, and a damped matrix that
 //! is not numerically positive definite, are treated as rejections.
+//!
+//! The quadratic model ([`LmModel`]). With [`LmModel::GaussNewton`] the matrix is `JᵀJ`, which
+//! leaves out the second-order term `Σ rᵢ ∇²rᵢ` of the cost's Hessian: right for small
+//! residuals, and for large ones a model that mispredicts every step, so that the damping stays
+//! high and the search creeps (only linearly convergent). [`LmModel::Adaptive`], the default,
+//! is Dennis, Gay & Welsch's adaptive model (NL2SOL; *An adaptive nonlinear least-squares
+//! algorithm*, ACM TOMS 7, 1981) inside the damped iteration: a secant estimate `S` of the
+//! second-order term (zero at the start) gets their sized symmetric update after every accepted
+//! step `s`, with `y = g₊ − g` and `y# = y − ½(JᵀJ + J₊ᵀJ₊) s` (the gradient's change that
+//! Gauss–Newton's matrices, by the trapezoidal rule along the step, do not explain; only the
+//! normal equations are needed). The steps solve `(JᵀJ + S + μD) h = −Jᵀr` instead after three
+//! consecutive accepted steps whose gain ratio Gauss–Newton's model missed by more than ¼ and
+//! whose reduction the secant model predicted better (Madsen, Nielsen & Tingleff's hybrid
+//! method, op. cit. §3.4, also waits for three). They go back to `JᵀJ` after a secant step that
+//! Gauss–Newton's model would have predicted better, and a refused secant step (or an
+//! indefinite `JᵀJ + S + μD`) is retried as Gauss–Newton's at the same damping; only a
+//! Gauss–Newton step is small enough to stop the search. Where Gauss–Newton predicts well (zero
+//! residual) the steps are the plain method's.
 //!
 //! `D` is the identity ([`Scaling::Identity`]) or the running maximum of `diag(JᵀJ)`
 //! ([`Scaling::Marquardt`], Moré's variant, which makes the iteration invariant to rescaling the
@@ -45,7 +63,8 @@
 //! # Observers
 //!
 //! Run the solver through argmin's [`Executor`] and attach any [`Observe`](argmin::core::observers::Observe) implementation; each
-//! iteration's key-value log carries the damping `lambda` (μ).
+//! iteration's key-value log carries the damping `lambda` (μ), the last accepted step's gain
+//! ratio `rho`, and `secant`, whether the next step uses the secant model.
 //!
 //! ```
 //! use argmin::core::observers::{Observe, ObserverMode};
@@ -107,6 +126,15 @@ pub type LmState = IterState<Vec<f64>, Vec<f64>, Mat<f64>, (), Vec<f64>, f64>;
 /// `μ` grows by `2^{k(k+1)/2}` after `k` rejections, so the step is negligible long before this.
 const MAX_REJECTIONS: usize = 100;
 
+/// [`LmModel::Adaptive`] switches models after a step whose gain ratio is off 1 by more than this
+/// (and which the other model predicted better).
+const SWITCH_RHO: f64 = 0.25;
+
+/// [`LmModel::Adaptive`] leaves Gauss–Newton's model after this many consecutive accepted steps
+/// that it predicted poorly and the secant model better (Madsen, Nielsen & Tingleff's hybrid
+/// also waits for three).
+const SWITCH_AFTER: usize = 3;
+
 /// The damping matrix `D` in `(JᵀJ + μD) h = −Jᵀr`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Scaling {
@@ -116,6 +144,18 @@ pub enum Scaling {
     /// `μ` is `initial_lambda`. Invariant to rescaling parameters.
     #[default]
     Marquardt,
+}
+
+/// The quadratic model of the cost whose damped minimiser is each trial step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum LmModel {
+    /// Gauss–Newton's `JᵀJ` only.
+    GaussNewton,
+    /// `JᵀJ`, or `JᵀJ + S` with `S` a secant estimate of the second-order term
+    /// `Σ rᵢ ∇²rᵢ`, whichever predicted the last step's reduction better (Dennis, Gay & Welsch's
+    /// adaptive model; see the [module docs](self)).
+    #[default]
+    Adaptive,
 }
 
 /// Options of [`LevenbergMarquardt`]. Deserialization validates them
@@ -141,6 +181,8 @@ pub struct LmOptions {
     /// iteration boundary (or damping retry) after it is spent. Default 600; `f64::INFINITY`
     /// for none.
     pub max_seconds: f64,
+    /// The quadratic model. Default [`LmModel::Adaptive`].
+    pub model: LmModel,
 }
 
 /// [`LmOptions::max_seconds`] by default: far beyond any fit this crate's criteria need on
@@ -162,6 +204,8 @@ struct RawLmOptions {
     scaling: Scaling,
     #[serde(default = "default_max_seconds")]
     max_seconds: f64,
+    #[serde(default)]
+    model: LmModel,
 }
 
 impl TryFrom<RawLmOptions> for LmOptions {
@@ -176,6 +220,7 @@ impl TryFrom<RawLmOptions> for LmOptions {
             initial_lambda: raw.initial_lambda,
             scaling: raw.scaling,
             max_seconds: raw.max_seconds,
+            model: raw.model,
         };
         options.validate()?;
         Ok(options)
@@ -192,6 +237,7 @@ impl Default for LmOptions {
             initial_lambda: 1e-3,
             scaling: Scaling::Marquardt,
             max_seconds: DEFAULT_MAX_SECONDS,
+            model: LmModel::Adaptive,
         }
     }
 }
@@ -233,10 +279,18 @@ pub struct LevenbergMarquardt {
     mu: f64,
     /// Factor by which `μ` grows on the next rejection.
     nu: f64,
+    /// Gain ratio of the last accepted step (NaN before one).
+    rho: f64,
     /// Diagonal of `D`.
     diag: Vec<f64>,
     /// `JᵀJ` at the current point.
     jtj: Mat<f64>,
+    /// The secant estimate `S` of the second-order term (zero until a step is accepted).
+    secant: Mat<f64>,
+    /// Whether the next trial step uses `JᵀJ + S` ([`LmModel::Adaptive`] only).
+    use_secant: bool,
+    /// Consecutive accepted Gauss–Newton steps that the secant model predicted better.
+    poor_gn: usize,
     /// Why the run stopped, once it has.
     stop: Option<Termination>,
     /// When the run started (set by `init`).
@@ -258,8 +312,12 @@ impl LevenbergMarquardt {
             options,
             mu: f64::NAN,
             nu: 2.0,
+            rho: f64::NAN,
             diag: Vec::new(),
             jtj: Mat::zeros(0, 0),
+            secant: Mat::zeros(0, 0),
+            use_secant: false,
+            poor_gn: 0,
             stop: None,
             started: None,
             progress: None,
@@ -308,6 +366,13 @@ impl LevenbergMarquardt {
         self
     }
 
+    /// Sets [`LmOptions::model`].
+    #[must_use]
+    pub fn with_model(mut self, model: LmModel) -> Self {
+        self.options.model = model;
+        self
+    }
+
     /// Sets [`LmOptions::max_seconds`].
     #[must_use]
     pub fn with_max_seconds(mut self, max_seconds: f64) -> Self {
@@ -352,17 +417,110 @@ impl LevenbergMarquardt {
         self.nu *= 2.0;
     }
 
-    /// Solves `(JᵀJ + μD) h = −g`; `None` if the matrix is not numerically positive definite
-    /// or the solution is not finite.
-    fn damped_step(&self, g: &[f64]) -> Option<Vec<f64>> {
+    /// Rejection of a trial step: a secant model's step is retried as Gauss–Newton's at the
+    /// same damping (the secant estimate is what failed), Gauss–Newton's raises the damping.
+    fn reject(&mut self, used_secant: bool) {
+        if used_secant {
+            self.use_secant = false;
+        } else {
+            self.raise();
+        }
+    }
+
+    /// Solves `(JᵀJ + μD) h = −g`, or `(JᵀJ + S + μD) h = −g` with `secant`; `None` if the
+    /// matrix is not numerically positive definite or the solution is not finite.
+    fn damped_step(&self, g: &[f64], secant: bool) -> Option<Vec<f64>> {
         let n = g.len();
         let m = Mat::from_fn(n, n, |r, c| {
-            self.jtj[(r, c)] + if r == c { self.mu * self.diag[r] } else { 0.0 }
+            self.jtj[(r, c)]
+                + if secant { self.secant[(r, c)] } else { 0.0 }
+                + if r == c { self.mu * self.diag[r] } else { 0.0 }
         });
         let llt = m.llt(Side::Lower).ok()?;
         let h = llt.solve(Mat::from_fn(n, 1, |i, _| -g[i]));
         let h: Vec<f64> = (0..n).map(|i| h[(i, 0)]).collect();
         first_non_finite(&h).is_none().then_some(h)
+    }
+
+    /// After an accepted step `s` (with the model `used_secant`) that reduced the cost by
+    /// `actual`, from gradient `g` to `g_new` and from `self.jtj` to `gram`: chooses the next
+    /// step's model and updates `S`.
+    ///
+    /// The model switches when the one used predicted the reduction poorly (its gain ratio off
+    /// 1 by more than [`SWITCH_RHO`]) and the other one predicted it better. `S` then gets Dennis,
+    /// Gay & Welsch's sized symmetric secant update with `y = g_new − g` and
+    /// `y# = y − ½(JᵀJ + J_newᵀJ_new) s`, the part of the gradient's change that Gauss–Newton's
+    /// matrices (trapezoidal rule along the step) do not explain.
+    fn adapt(
+        &mut self,
+        s: &[f64],
+        g: &[f64],
+        g_new: &[f64],
+        gram: &Mat<f64>,
+        actual: f64,
+        used_secant: bool,
+    ) {
+        let n = s.len();
+        let quad = |a: &Mat<f64>| -> f64 {
+            (0..n)
+                .map(|i| s[i] * (0..n).map(|j| a[(i, j)] * s[j]).sum::<f64>())
+                .sum()
+        };
+        let linear = -dot(g, s);
+        let predicted_gn = linear - 0.5 * quad(&self.jtj);
+        let predicted_secant = predicted_gn - 0.5 * quad(&self.secant);
+        let (used, other) = if used_secant {
+            (predicted_secant, predicted_gn)
+        } else {
+            (predicted_gn, predicted_secant)
+        };
+        let other_better = (actual / used - 1.0).abs() > SWITCH_RHO
+            && other > 0.0
+            && (other - actual).abs() < (used - actual).abs();
+        if used_secant {
+            if other_better {
+                self.use_secant = false;
+            }
+        } else {
+            self.poor_gn = if other_better { self.poor_gn + 1 } else { 0 };
+            if self.poor_gn >= SWITCH_AFTER {
+                self.use_secant = true;
+                self.poor_gn = 0;
+            }
+        }
+
+        let y: Vec<f64> = g_new.iter().zip(g).map(|(a, b)| a - b).collect();
+        let ys = dot(&y, s);
+        if !(ys > 0.0) {
+            return;
+        }
+        let y_sharp: Vec<f64> = (0..n)
+            .map(|i| {
+                y[i] - 0.5
+                    * (0..n)
+                        .map(|j| (self.jtj[(i, j)] + gram[(i, j)]) * s[j])
+                        .sum::<f64>()
+            })
+            .collect();
+        // Sizing (Dennis, Gay & Welsch): shrink S where its curvature along s exceeds what the
+        // step saw.
+        let s_s = quad(&self.secant);
+        let tau = if s_s.abs() > 0.0 {
+            (dot(&y_sharp, s).abs() / s_s.abs()).min(1.0)
+        } else {
+            1.0
+        };
+        let w: Vec<f64> = (0..n)
+            .map(|i| y_sharp[i] - tau * (0..n).map(|j| self.secant[(i, j)] * s[j]).sum::<f64>())
+            .collect();
+        let ws = dot(&w, s);
+        let updated = Mat::from_fn(n, n, |i, j| {
+            tau * self.secant[(i, j)] + (w[i] * y[j] + y[i] * w[j]) / ys
+                - ws * y[i] * y[j] / (ys * ys)
+        });
+        if (0..n).all(|i| (0..n).all(|j| updated[(i, j)].is_finite())) {
+            self.secant = updated;
+        }
     }
 
     /// Stores `JᵀJ` and updates `D` at a new point.
@@ -402,6 +560,8 @@ impl LevenbergMarquardt {
     fn kv(&self) -> Option<KV> {
         let mut kv = KV::new();
         kv.insert("lambda", self.mu.into());
+        kv.insert("rho", self.rho.into());
+        kv.insert("secant", self.use_secant.into());
         Some(kv)
     }
 }
@@ -415,6 +575,10 @@ fn normal_equations<O: NormalEquationsOperator<Param = Vec<f64>>>(
     let ne = problem.problem("normal_equations_count", |p| p.normal_equations(x, r))?;
     ne.check_shape(x.len())?;
     Ok(ne)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -439,6 +603,9 @@ where
         self.started = Some(Instant::now());
         self.diag = Vec::new();
         let x = state.get_param().ok_or(SolverError::MissingStart)?.clone();
+        self.secant = Mat::zeros(x.len(), x.len());
+        self.use_secant = false;
+        self.poor_gn = 0;
         if x.is_empty() {
             return Err(SolverError::NoParameters.into());
         }
@@ -501,7 +668,11 @@ where
         // next, so they are released here.
         let mut state = state;
         let m = state.take_residuals().map_or(0, |r| r.len());
-        if g.len() != x.len() || self.jtj.nrows() != x.len() || self.diag.len() != x.len() {
+        if g.len() != x.len()
+            || self.jtj.nrows() != x.len()
+            || self.diag.len() != x.len()
+            || self.secant.nrows() != x.len()
+        {
             return Err(SolverError::Argmin(
                 "Levenberg-Marquardt: inconsistent state; was `init` skipped?".to_string(),
             )
@@ -527,11 +698,24 @@ where
                 });
                 return Ok((state, self.kv()));
             }
-            let Some(h) = self.damped_step(&g) else {
+            // The secant model's matrix may be indefinite where Gauss–Newton's is not: then this
+            // trial is Gauss–Newton's.
+            let secant_step = if self.use_secant {
+                self.damped_step(&g, true)
+            } else {
+                None
+            };
+            let used_secant = secant_step.is_some();
+            let Some(h) = secant_step.or_else(|| self.damped_step(&g, false)) else {
                 self.raise();
                 continue;
             };
             if norm(&h) <= xtol * (x_norm + xtol) {
+                if used_secant {
+                    // Only Gauss–Newton's step decides that the search has converged.
+                    self.use_secant = false;
+                    continue;
+                }
                 self.stop = Some(if last_rejection_non_finite {
                     Termination::NonFinite
                 } else {
@@ -551,7 +735,7 @@ where
             let cost_new = half_sum_sq(&r_new);
             if !cost_new.is_finite() {
                 last_rejection_non_finite = true;
-                self.raise();
+                self.reject(used_secant);
                 continue;
             }
             // L(0) − L(h) = ½ hᵀ(μDh − g), the reduction predicted by the linear model.
@@ -565,20 +749,24 @@ where
             let rho = actual / predicted;
             if !(predicted > 0.0 && rho > 0.0) {
                 last_rejection_non_finite = false;
-                self.raise();
+                self.reject(used_secant);
                 continue;
             }
             let ne = normal_equations(problem, &x_new, &r_new)?;
             if !ne.is_finite() {
                 last_rejection_non_finite = true;
-                self.raise();
+                self.reject(used_secant);
                 continue;
             }
             let NormalEquations {
                 gram,
                 gradient: g_new,
             } = ne;
+            if self.options.model == LmModel::Adaptive {
+                self.adapt(&h, &g, &g_new, &gram, actual, used_secant);
+            }
             self.set_gram(gram);
+            self.rho = rho;
             self.mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
             self.nu = 2.0;
             let ftol = self.options.ftol;
