@@ -105,6 +105,11 @@ pub fn validate(o: &ValidateOptions) -> StudyResult<Outcome> {
     )?;
     let mut outputs = OutputSet::new();
     if let Some(path) = &o.bode {
+        if exp.multi_input() {
+            return Err(study_err!(
+                "--bode: a system with several inputs has one frequency response per input, which --bode does not write yet; fit --json gives each input's transfer function (model.inputs)"
+            ));
+        }
         let points = frequency_response(&v.fitted, &exp.grid, v.covariance.as_deref(), "--bode")?
             .ok_or_else(|| {
             study_err!("--bode: the system is not a rational transfer function")
