@@ -86,6 +86,12 @@ impl Superposition {
         Self::build(channels, true)
     }
 
+    /// The channel whose parameters are the sum's when they are shared: the first estimated
+    /// one (all have the same), `None` when none is estimated.
+    fn shared_parameters(&self) -> Option<&Channel> {
+        self.channels.iter().find(|c| c.estimated)
+    }
+
     /// Whether the channels share one set of parameters ([`shared`](Self::shared)).
     pub fn is_shared(&self) -> bool {
         self.shared
@@ -192,37 +198,13 @@ impl Superposition {
     /// The spec table that rebuilds this sum with [`build`]: the input names, each channel's
     /// spec table and whether it is estimated.
     pub fn spec(&self) -> SpecTable {
-        let mut spec = SpecTable::new();
-        spec.insert(KIND_KEY.into(), json!(SUPERPOSITION_KIND));
-        spec.insert(
-            "inputs".into(),
-            json!(self
-                .channels
+        spec_table(
+            self.channels
                 .iter()
-                .map(|c| c.name.clone())
-                .collect::<Vec<_>>()),
-        );
-        spec.insert(
-            "channels".into(),
-            Value::Array(
-                self.channels
-                    .iter()
-                    .map(|c| Value::Object(c.signal.spec()))
-                    .collect(),
-            ),
-        );
-        spec.insert(
-            "estimate".into(),
-            json!(self
-                .channels
-                .iter()
-                .map(|c| c.estimated)
-                .collect::<Vec<_>>()),
-        );
-        if self.shared {
-            spec.insert("shared".into(), json!(true));
-        }
-        spec
+                .map(|c| (c.name.clone(), c.signal.spec(), c.estimated))
+                .collect(),
+            self.shared,
+        )
     }
 
     /// Adds each estimated channel's gradient at `t` into its place in `grad` (zeroed first),
@@ -253,9 +235,7 @@ impl Signal for Superposition {
     fn param_names(&self) -> Vec<String> {
         if self.shared {
             return self
-                .channels
-                .iter()
-                .find(|c| c.estimated)
+                .shared_parameters()
                 .map(|c| c.signal.param_names())
                 .unwrap_or_default();
         }
@@ -274,9 +254,7 @@ impl Signal for Superposition {
     fn params(&self) -> Vec<f64> {
         if self.shared {
             return self
-                .channels
-                .iter()
-                .find(|c| c.estimated)
+                .shared_parameters()
                 .map(|c| c.signal.params())
                 .unwrap_or_default();
         }
@@ -442,6 +420,28 @@ impl Spectrum for Superposition {
         }
         rows
     }
+}
+
+/// The spec table of a multi-input system that [`build`] reads: each input's name, its
+/// channel's spec table and whether that channel is estimated, in input order, and whether the
+/// channels share their parameters. The one writer of the table's layout: a model's
+/// [`Superposition::spec`] and a front end's reader of experiment files both call it.
+pub fn spec_table(channels: Vec<(String, SpecTable, bool)>, shared: bool) -> SpecTable {
+    let mut spec = SpecTable::new();
+    spec.insert(KIND_KEY.into(), json!(SUPERPOSITION_KIND));
+    let (mut names, mut specs, mut estimated) = (Vec::new(), Vec::new(), Vec::new());
+    for (name, table, e) in channels {
+        names.push(Value::String(name));
+        specs.push(Value::Object(table));
+        estimated.push(Value::Bool(e));
+    }
+    spec.insert("inputs".into(), Value::Array(names));
+    spec.insert("channels".into(), Value::Array(specs));
+    spec.insert("estimate".into(), Value::Array(estimated));
+    if shared {
+        spec.insert("shared".into(), json!(true));
+    }
+    spec
 }
 
 /// The model of a multi-input system: the sum of `channels` around the output offset `offset`

@@ -8,10 +8,10 @@ use super::spec::{InputChannel, InputSpec, SystemSpec};
 use super::system::parse_system;
 use crate::error::StudyResult;
 use crate::study_err;
-use jitterid::signal::registry::{SpecTable, KIND_KEY};
-use jitterid::signal::superposition::SUPERPOSITION_KIND;
+use jitterid::signal::registry::KIND_KEY;
+use jitterid::signal::superposition::spec_table;
 use jitterid::signal::{Input, SampleGrid};
-use serde_json::{json, Value};
+use serde_json::Value;
 use toml::Spanned;
 
 /// The inputs and the systems of a multi-input experiment (more than one `[[input]]` or
@@ -36,8 +36,7 @@ pub(super) fn parse_channels(
         ));
     }
     let mut channels: Vec<InputChannel> = Vec::with_capacity(inputs.len());
-    let mut specs = Vec::with_capacity(systems.len());
-    let mut estimated = Vec::with_capacity(systems.len());
+    let mut parts = Vec::with_capacity(systems.len());
     for (i, (rs, ri)) in systems.iter().zip(inputs).enumerate() {
         let system = parse_system(cx, rs, grid)?;
         let kind = system
@@ -63,18 +62,7 @@ pub(super) fn parse_channels(
             ));
         }
         let channel = parse_channel(cx, ri, grid, &format!("u{}", i + 1))?;
-        if let Some(other) = channels.iter().find(|c| c.name == channel.name) {
-            return Err(cx.err_at(
-                "input",
-                "name",
-                ri.name.as_ref(),
-                format!(
-                    "[[input]] {}: the name \"{}\" is already the name of another input; expected distinct names",
-                    i + 1,
-                    other.name
-                ),
-            ));
-        }
+        distinct(cx, &channels, &channel, ri, i)?;
         if let (Some(d), InputSpec::Known(Input::Tones(_))) = (&rs.delay, &channel.spec) {
             return Err(cx.err(
                 "system",
@@ -87,20 +75,36 @@ pub(super) fn parse_channels(
                 ),
             ));
         }
-        specs.push(Value::Object(system.kind));
-        estimated.push(system.estimate);
+        parts.push((channel.name.clone(), system.kind, system.estimate));
         channels.push(channel);
     }
-    let mut kind = SpecTable::new();
-    kind.insert(KIND_KEY.into(), json!(SUPERPOSITION_KIND));
-    kind.insert(
-        "inputs".into(),
-        json!(channels.iter().map(|c| c.name.clone()).collect::<Vec<_>>()),
-    );
-    kind.insert("channels".into(), Value::Array(specs));
-    kind.insert("estimate".into(), json!(estimated));
-    let estimate = estimated.iter().any(|e| *e);
+    let estimate = parts.iter().any(|p| p.2);
+    let kind = spec_table(parts, false);
     Ok((SystemSpec { kind, estimate }, channels))
+}
+
+/// Refuses `channel` (read from `[[input]]` table `i`, counted from 0) when an input read
+/// before it has its name.
+fn distinct(
+    cx: &Source,
+    before: &[InputChannel],
+    channel: &InputChannel,
+    ri: &RawInput,
+    i: usize,
+) -> StudyResult<()> {
+    match before.iter().find(|c| c.name == channel.name) {
+        None => Ok(()),
+        Some(other) => Err(cx.err_at(
+            "input",
+            "name",
+            ri.name.as_ref(),
+            format!(
+                "[[input]] {}: the name \"{}\" is already the name of another input; expected distinct names",
+                i + 1,
+                other.name
+            ),
+        )),
+    }
 }
 
 /// One grey-box `[system]` whose `B` and `D` have a column per `[[input]]`: one channel per
@@ -165,7 +169,7 @@ fn grey_box_inputs(
         None => None,
     };
     let mut channels: Vec<InputChannel> = Vec::with_capacity(m);
-    let mut specs = Vec::with_capacity(m);
+    let mut parts = Vec::with_capacity(m);
     let mut estimate = false;
     for (j, ri) in inputs.iter().enumerate() {
         let mut column = rs.clone();
@@ -173,30 +177,11 @@ fn grey_box_inputs(
         column.d = d.as_ref().map(|d| d[j].clone());
         let system = parse_system(cx, &column, grid)?;
         let channel = parse_channel(cx, ri, grid, &format!("u{}", j + 1))?;
-        if let Some(other) = channels.iter().find(|c| c.name == channel.name) {
-            return Err(cx.err_at(
-                "input",
-                "name",
-                ri.name.as_ref(),
-                format!(
-                    "[[input]] {}: the name \"{}\" is already the name of another input; expected distinct names",
-                    j + 1,
-                    other.name
-                ),
-            ));
-        }
+        distinct(cx, &channels, &channel, ri, j)?;
         estimate = system.estimate;
-        specs.push(Value::Object(system.kind));
+        parts.push((channel.name.clone(), system.kind, system.estimate));
         channels.push(channel);
     }
-    let mut kind = SpecTable::new();
-    kind.insert(KIND_KEY.into(), json!(SUPERPOSITION_KIND));
-    kind.insert(
-        "inputs".into(),
-        json!(channels.iter().map(|c| c.name.clone()).collect::<Vec<_>>()),
-    );
-    kind.insert("channels".into(), Value::Array(specs));
-    kind.insert("estimate".into(), json!(vec![estimate; m]));
-    kind.insert("shared".into(), json!(true));
+    let kind = spec_table(parts, true);
     Ok((SystemSpec { kind, estimate }, channels))
 }
