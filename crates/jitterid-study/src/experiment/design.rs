@@ -294,25 +294,13 @@ pub(super) fn parse_design(
 
 #[cfg(test)]
 mod tests {
-    use super::super::raw::RawDesign;
+    use super::super::raw::{docs_table_keys, RawDesign};
 
     /// The `[design]` table of `docs/experiments.md` lists exactly the keys the reader takes,
     /// in order: the reference cannot drift from the reader.
     #[test]
     fn the_docs_design_table_lists_the_reader_s_keys() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
-        let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
-        let start = text
-            .find("### `[design]`")
-            .expect("docs/experiments.md has a [design] section");
-        let keys: Vec<&str> = text[start..]
-            .lines()
-            .skip_while(|l| !l.starts_with("| key |"))
-            .skip(2)
-            .take_while(|l| l.starts_with('|'))
-            .filter_map(|l| l.split('`').nth(1))
-            .collect();
-        assert_eq!(keys, RawDesign::KEYS);
+        assert_eq!(docs_table_keys("### `[design]`"), RawDesign::KEYS);
     }
 
     /// Criteria read back as written.

@@ -221,26 +221,34 @@ pub(super) fn keys_of(section: &str) -> &'static [&'static str] {
     }
 }
 
+/// The keys listed in the first column of the key table under `heading` in
+/// `docs/experiments.md`, in order: what the tests that keep the reference beside the reader
+/// compare with a section's `KEYS`.
+#[cfg(test)]
+pub(super) fn docs_table_keys(heading: &str) -> Vec<String> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
+    let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
+    let start = text
+        .find(heading)
+        .unwrap_or_else(|| panic!("docs/experiments.md has no {heading} section"));
+    text[start..]
+        .lines()
+        .skip_while(|l| !l.starts_with("| key |"))
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .filter_map(|l| l.split('`').nth(1))
+        .map(String::from)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
-    use super::RawOutput;
+    use super::{docs_table_keys, RawOutput};
 
     /// The `[output]` table of `docs/experiments.md` lists exactly the keys the reader takes,
     /// in order: the reference cannot drift from the reader.
     #[test]
     fn the_docs_output_table_lists_the_reader_s_keys() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/experiments.md");
-        let text = std::fs::read_to_string(path).expect("docs/experiments.md is readable");
-        let start = text
-            .find("### `[output]`")
-            .expect("docs/experiments.md has an [output] section");
-        let keys: Vec<&str> = text[start..]
-            .lines()
-            .skip_while(|l| !l.starts_with("| key |"))
-            .skip(2)
-            .take_while(|l| l.starts_with('|'))
-            .filter_map(|l| l.split('`').nth(1))
-            .collect();
-        assert_eq!(keys, RawOutput::KEYS);
+        assert_eq!(docs_table_keys("### `[output]`"), RawOutput::KEYS);
     }
 }
