@@ -278,6 +278,74 @@ def _model(system: Any, jitter_model: Any, input: Any) -> None:
         raise TypeError(f"input: expected an Input or None, found {type(input).__name__}")
 
 
+Inputs = Union[Iterable[Input], Mapping[str, Input]]
+
+
+def _driven(system: Any, input: Any, inputs: Optional[Inputs]) -> Tuple[Any, list]:
+    """The system and the inputs that drive it, in its input order: ``(system, [(name,
+    input)])``, the name ``None`` for a system with one input.
+
+    ``system`` may be a list or dict of systems (one per input, ``System.several``); ``inputs``
+    a list (in the system's input order) or a dict by input name. Refuses ``input`` and
+    ``inputs`` together, a count or a name that does not match the system's inputs."""
+    if isinstance(system, (list, tuple, Mapping)):
+        system = System.several(system)
+    if inputs is None:
+        if getattr(system, "inputs", None) is not None:
+            raise ValueError(f"inputs: the system has several inputs ({', '.join(system.inputs)}); give one Input per "
+                             "input as inputs=[...] or a dict by input name")
+        return system, [] if input is None else [(None, input)]
+    if input is not None:
+        raise ValueError("input, inputs: give the one input as input=, or several as inputs=[...], not both")
+    names = getattr(system, "inputs", None)
+    if isinstance(inputs, Mapping):
+        given = {str(k): v for k, v in inputs.items()}
+        if names is None or sorted(given) != sorted(names):
+            expected = "one input (input=)" if names is None else f"the inputs {names}"
+            raise ValueError(f"inputs: the system has {expected}, found inputs named {sorted(given)}")
+        pairs = [(n, given[n]) for n in names]
+    else:
+        try:
+            listed = list(inputs)
+        except TypeError:
+            raise TypeError(f"inputs: expected a list of Inputs or a dict of them by input name, found "
+                            f"{type(inputs).__name__}") from None
+        if names is None:
+            if len(listed) != 1:
+                raise ValueError(f"inputs: the system has one input, found {len(listed)} inputs; a system with several "
+                                 "inputs is System.several([...]) or a grey-box model whose b has a column per input")
+            return system, [(None, listed[0])]
+        if len(listed) != len(names):
+            raise ValueError(f"inputs: the system has {len(names)} inputs ({', '.join(names)}), found {len(listed)}")
+        pairs = list(zip(names, listed))
+    for name, u in pairs:
+        if not isinstance(u, (_jitterid.Input, _Realisation)):
+            raise TypeError(f"inputs[{name!r}]: expected an Input, found {type(u).__name__}")
+    return system, pairs
+
+
+def _system_sections(spec: Mapping[str, Any], inputs: list, estimate: bool) -> Tuple[Any, Any]:
+    """The ``[system]`` and ``[input]`` sections of an experiment for the system ``spec``
+    (without its output offset) driven by ``inputs`` (as ``_driven`` gives them): one table
+    each for one input; for several, an ``[[input]]`` table per input with its ``name``, and a
+    ``[[system]]`` table per input or, for a shared grey-box model, one ``[system]`` whose
+    ``b`` and ``d`` have a column per input."""
+    def section(u: Any) -> dict:
+        return dict(u) if isinstance(u, _Realisation) else json.loads(u.section_json())
+
+    if not inputs or inputs[0][0] is None:
+        return dict(spec, estimate=estimate), None if not inputs else section(inputs[0][1])
+    input_tables = [dict(section(u), name=name) for name, u in inputs]
+    channels = spec["channels"]
+    if not spec.get("shared"):
+        return [dict(c, estimate=estimate) for c in channels], input_tables
+    one = dict(channels[0], estimate=estimate)
+    one["b"] = [[c["b"][i][0] for c in channels] for i in range(len(one["b"]))]
+    if "d" in one:
+        one["d"] = [[c["d"][0][0] for c in channels]]
+    return one, input_tables
+
+
 def _output(system: Any, offset: Any, estimate_offset: Any) -> Tuple[Any, dict, Optional[dict]]:
     """The output offset of a set-up: ``(system, system_keys, output)``.
 
@@ -310,7 +378,7 @@ def _output(system: Any, offset: Any, estimate_offset: Any) -> Tuple[Any, dict, 
     return system, spec, output
 
 
-def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval: Any, start: Any,
+def _in_range(system: Any, jitter_model: Any, inputs: list, samples: Any, interval: Any, start: Any,
               noise_std: Any, what: str, output: Optional[dict] = None) -> None:
     """Refuses what the command line refuses for the same set-up: the arguments are read as
     the sections of an experiment file (``[sampling]``, ``[input]``, ``[system]``, ``[jitter]``,
@@ -319,15 +387,15 @@ def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval
     the argument's key in its ``ValueError``."""
     from ._spec import spec_json
 
-    _model(system, jitter_model, input)
+    _model(system, jitter_model, None)
     samples, interval, start = _grid(samples, interval, start)
     sections: dict = {"sampling": {"interval": interval, "samples": samples, "start": start}}
-    if input is not None:
-        sections["input"] = json.loads(input.section_json())
     spec = dict(system.spec)
     for key in ("offset", "estimate_offset"):
         spec.pop(key, None)
-    sections["system"] = dict(spec, estimate=False)
+    sections["system"], input_section = _system_sections(spec, inputs, False)
+    if input_section is not None:
+        sections["input"] = input_section
     if output is not None:
         # Only the offset's value is checked here: nothing is estimated.
         sections["output"] = {k: v for k, v in output.items() if k == "offset"}
@@ -336,35 +404,81 @@ def _in_range(system: Any, jitter_model: Any, input: Any, samples: Any, interval
     Experiment.from_sections(spec_json(sections), what)
 
 
-def simulate(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
-             interval: float, start: float = 0.0, noise_std: float = 0.0, seed: int = DEFAULT_SEED,
-             truth: bool = False, offset: Optional[float] = None) -> dict:
+def _checked(system: Any, jitter_model: Any, input: Any, inputs: Optional[Inputs]) -> Tuple[Any, list]:
+    """The arguments' types checked and the system with its inputs (``_driven``)."""
+    if not isinstance(system, (list, tuple, Mapping)):
+        _model(system, jitter_model, input)
+    elif input is not None and not isinstance(input, _jitterid.Input):
+        raise TypeError(f"input: expected an Input or None, found {type(input).__name__}")
+    return _driven(system, input, inputs)
+
+
+class _Realisation(dict):
+    """An input realisation a record holds, as its ``[input]`` section (a ``piecewise`` input)."""
+
+
+def _piecewise(t: Any, u: Any, name: str) -> _Realisation:
+    """The input realisation a record holds (switch times ``input_t``, levels ``u``, with or
+    without the side file's closing 0) as a ``piecewise`` ``[input]`` section."""
+    levels = real_array(u, name)
+    times = real_array(t, "input_t")
+    closed = levels.ndim == 1 and len(levels) >= 2 and levels[-1] == 0.0
+    return _Realisation(kind="piecewise", times=times.tolist(), values=(levels[:-1] if closed else levels).tolist())
+
+
+def _record_inputs(system: Any, record: Mapping[str, Any]) -> Optional[Dict[str, _Realisation]]:
+    """A record's input realisations by input name, for a system with several inputs (``None``
+    otherwise, and for a record without them): ``input_t`` the switch times, ``input_u`` a
+    dict of levels by input name, as ``Experiment.simulate`` gives them."""
+    several = isinstance(system, (list, tuple, Mapping)) or getattr(system, "inputs", None) is not None
+    levels = record.get("input_u")
+    if not several or record.get("input_t") is None or not isinstance(levels, Mapping):
+        return None
+    return {str(name): _piecewise(record["input_t"], u, f"input_u[{name!r}]") for name, u in levels.items()}
+
+
+def simulate(system: Union[System, Iterable[System], Mapping[str, System]], jitter: jitter.Jitter,
+             input: Optional[Input] = None, *, samples: int, interval: float, start: float = 0.0,
+             noise_std: float = 0.0, seed: int = DEFAULT_SEED, truth: bool = False,
+             offset: Optional[float] = None, inputs: Optional[Inputs] = None) -> dict:
     """``samples`` jittered samples ``y_k = y₀ + s(t_k + τ_k) + v_k`` of ``system`` driven by
     ``input`` at ``t_k = start + k·interval``, white noise of std ``noise_std``, seeded by
     ``seed``: a dict of arrays ``t``, ``y``, ``u`` (with an input), and with ``truth`` the drawn
     ``tau`` and ``v``. ``offset`` is the output offset ``y₀`` (the operating point, as
     ``[output] offset``; default the system's own, else 0). The GIL is released while it runs.
     The arguments are checked as the command line checks an experiment file (``ValueError``
-    naming the key)."""
-    _model(system, jitter, input)
+    naming the key).
+
+    Several inputs: ``system`` a system with several inputs (``System.several``, a grey-box
+    model with a column of ``b`` per input) or a list or dict of systems, one per input, and
+    ``inputs`` a list of Inputs in the system's input order or a dict by input name; ``u`` is
+    then a dict of arrays by input name."""
+    system, pairs = _checked(system, jitter, input, inputs)
     system, _, output = _output(system, offset, None)
-    _in_range(system, jitter, input, samples, interval, start, noise_std, "simulate arguments", output)
-    return _jitterid.simulate(system, jitter, input, *_grid(samples, interval, start),
+    _in_range(system, jitter, pairs, samples, interval, start, noise_std, "simulate arguments", output)
+    return _jitterid.simulate(system, jitter, [u for _, u in pairs], *_grid(samples, interval, start),
                               real_number(noise_std, "noise_std"), integer(seed, "seed"), bool(truth))
 
 
-def first_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
-                 interval: float, start: float = 0.0) -> np.ndarray:
-    """``m_k = E[s(t_k + τ)]`` at ``t_k = start + k·interval``, exact."""
-    _in_range(system, jitter, input, samples, interval, start, 0.0, "first_moment arguments")
-    return _jitterid.first_moment(system, jitter, input, *_grid(samples, interval, start))
+def first_moment(system: Union[System, Iterable[System], Mapping[str, System]], jitter: jitter.Jitter,
+                 input: Optional[Input] = None, *, samples: int, interval: float, start: float = 0.0,
+                 inputs: Optional[Inputs] = None) -> np.ndarray:
+    """``m_k = E[s(t_k + τ)]`` at ``t_k = start + k·interval``, exact (``inputs`` as
+    ``simulate`` takes them)."""
+    system, pairs = _checked(system, jitter, input, inputs)
+    _in_range(system, jitter, pairs, samples, interval, start, 0.0, "first_moment arguments")
+    return _jitterid.first_moment(system, jitter, [u for _, u in pairs], *_grid(samples, interval, start))
 
 
-def second_moment(system: System, jitter: jitter.Jitter, input: Optional[Input] = None, *, samples: int,
-                  interval: float, start: float = 0.0, noise_std: float = 0.0) -> np.ndarray:
-    """``λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²`` at ``t_k = start + k·interval``, exact."""
-    _in_range(system, jitter, input, samples, interval, start, noise_std, "second_moment arguments")
-    return _jitterid.second_moment(system, jitter, input, *_grid(samples, interval, start),
+def second_moment(system: Union[System, Iterable[System], Mapping[str, System]], jitter: jitter.Jitter,
+                  input: Optional[Input] = None, *, samples: int, interval: float, start: float = 0.0,
+                  noise_std: float = 0.0, inputs: Optional[Inputs] = None) -> np.ndarray:
+    """``λ_k = Var y_k = noise_std² + E[s(t_k + τ)²] − m_k²`` at ``t_k = start + k·interval``,
+    exact (``inputs`` as ``simulate`` takes them; with several inputs ``E[s²]`` holds the
+    inputs' cross terms)."""
+    system, pairs = _checked(system, jitter, input, inputs)
+    _in_range(system, jitter, pairs, samples, interval, start, noise_std, "second_moment arguments")
+    return _jitterid.second_moment(system, jitter, [u for _, u in pairs], *_grid(samples, interval, start),
                                    real_number(noise_std, "noise_std"))
 
 
@@ -373,7 +487,7 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
         options: Optional[Mapping[str, Any]] = None, init: str = "experiment",
         progress: Optional[Callable[[int, float], Any]] = None, offset: Optional[float] = None,
-        estimate_offset: Optional[bool] = None) -> FitResult:
+        estimate_offset: Optional[bool] = None, inputs: Optional[Inputs] = None) -> FitResult:
     """Fits a record's samples with ``method``, starting from ``system`` and ``jitter``.
 
     Arguments:
@@ -392,6 +506,11 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
       part alone may be given as its name).
     * ``interval``, ``start``: the grid (default: the record's ``T``/``t0``, else its ``t``).
     * ``input``: the known input (default: the record's).
+    * ``inputs``: for a system with several inputs (``System.several``, a grey-box model with a
+      column of ``b`` per input, or ``system`` given as a list or dict of systems), the known
+      inputs as a list in the system's input order or a dict by input name (default: the
+      record's ``input_t`` and ``input_u``, ``input_u`` a dict of levels by input name as
+      ``Experiment.simulate`` gives it). Parameters are named by input (``torque.b0``).
     * ``noise_std``: the measurement-noise level (known, or the start when estimated).
     * ``options``: further keys of the experiment file's ``[estimate]`` section
       (``solver``, ``frequencies``, ``max_iterations``, …).
@@ -422,7 +541,10 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         fit.params, fit.std_errors
     """
     record = as_record(record)
-    _model(system, jitter, input)
+    if input is None and inputs is None:
+        inputs = record.get("input") if isinstance(record.get("input"), (list, tuple, Mapping)) else \
+            _record_inputs(system, record)
+    system, pairs = _checked(system, jitter, input, inputs)
     _method(method)
     if isinstance(estimate, str):
         # One part named alone, as `estimate="jitter"`, is that part.
@@ -458,21 +580,19 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         start = record.get("t0", t[0] if t is not None and t.size else 0.0)
     sections: dict = {"sampling": {"interval": real_number(interval, "interval"), "samples": int(y.size),
                                    "start": real_number(start, "start")}}
-    if input is None:
+    if not pairs:
         input = record.get("input")
         if input is not None and not isinstance(input, _jitterid.Input):
             raise TypeError(f"record['input']: expected an Input, found {type(input).__name__}")
-    if input is None and record.get("input_t") is not None:
-        u = real_array(record.get("input_u"), "input_u")
-        t_in = real_array(record["input_t"], "input_t")
-        sections["input"] = {"kind": "piecewise", "times": t_in.tolist(),
-                             "values": (u[:-1] if u.ndim == 1 and len(u) >= 2 and u[-1] == 0.0 else u).tolist()}
-    elif input is not None:
-        sections["input"] = json.loads(input.section_json())
+        if input is None and record.get("input_t") is not None:
+            input = _piecewise(record["input_t"], record.get("input_u"), "input_u")
+        pairs = [] if input is None else [(None, input)]
     if options is not None and not isinstance(options, Mapping):
         raise TypeError(f"options: expected a mapping of [estimate] keys, found {type(options).__name__}")
     _, system_keys, output = _output(system, offset, estimate_offset)
-    sections["system"] = dict(system_keys, estimate="system" in parts)
+    sections["system"], input_section = _system_sections(system_keys, pairs, "system" in parts)
+    if input_section is not None:
+        sections["input"] = input_section
     if output is not None:
         sections["output"] = output
     sections["jitter"] = dict(jitter.spec, estimate="jitter" in parts)

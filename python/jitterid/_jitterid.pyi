@@ -157,6 +157,15 @@ class System:
     def __new__(cls, spec: str) -> System: ...
     @staticmethod
     def from_zpk(zeros: npt.ArrayLike, poles: npt.ArrayLike, gain: float) -> System: ...
+    @staticmethod
+    def several(names: list[str], systems: list[System], shared: bool) -> System:
+        """One system per input, added; ``shared``: the columns of one grey-box model."""
+    @property
+    def inputs(self) -> Optional[list[str]]:
+        """The input names of a system with several inputs, ``None`` for one."""
+    @property
+    def channels(self) -> Optional[list[System]]:
+        """Each input's system, in input order, ``None`` for a system with one input."""
     @property
     def kind(self) -> str: ...
     @property
@@ -210,13 +219,13 @@ class Input:
 
 def system_kinds() -> str: ...
 def simulate(
-    system: System, jitter: Jitter, input: Optional[Input], samples: int, interval: float, start: float,
+    system: System, jitter: Jitter, inputs: list[Input], samples: int, interval: float, start: float,
     noise_std: float, seed: int, truth: bool,
-) -> dict[str, npt.NDArray[np.float64]]: ...
+) -> dict[str, Any]: ...
 def first_moment(
-    system: System, jitter: Jitter, input: Optional[Input], samples: int, interval: float, start: float
+    system: System, jitter: Jitter, inputs: list[Input], samples: int, interval: float, start: float
 ) -> npt.NDArray[np.float64]: ...
 def second_moment(
-    system: System, jitter: Jitter, input: Optional[Input], samples: int, interval: float, start: float,
+    system: System, jitter: Jitter, inputs: list[Input], samples: int, interval: float, start: float,
     noise_std: float,
 ) -> npt.NDArray[np.float64]: ...

@@ -6,12 +6,18 @@ signal registry, with ``frequency_response(f)``, ``step(t)`` and conversions::
     h = System.tf(num=[0.2, 0.1], den=[1.0, 0.5, 0.1525])
     g.frequency_response([0.0, 0.1]), g.step([0.0, 1.0]), g.to_tf(), g.to_ss()
     g.to_control(), g.to_scipy()       # python-control and SciPy objects (optional packages)
+
+A system with several inputs (``y = Σ G_i u_i``) is ``System.several({"torque": g, "brake":
+h})``, or one grey-box model whose ``b`` (and ``d``) have a column per input; ``simulate``,
+``fit``, ``first_moment`` and ``second_moment`` drive it with ``inputs=[…]`` (or a dict by
+input name). Its parameters are named by input (``torque.b0``); a shared grey-box model's are
+the model's own.
 """
 
 from __future__ import annotations
 
 import json
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -43,17 +49,59 @@ class System(SpecTable, _jitterid.System):
         d: Any = None,
         fixed: Optional[Dict[str, float]] = None,
         bounds: Optional[Dict[str, Any]] = None,
+        inputs: Optional[Sequence[str]] = None,
     ) -> "System":
         """``ẋ = A(θ)x + B(θ)u, y = C(θ)x + D(θ)u`` with named physical parameters ``params``
-        (``{"m": 1.0, "damp": 0.4, "k": 2.0}``): ``a`` (n×n), ``b`` (n×1), ``c`` (1×n) and ``d``
-        (1×1, default 0) are rows of expressions (``"-k/m"``) or numbers; ``fixed`` names known
+        (``{"m": 1.0, "damp": 0.4, "k": 2.0}``): ``a`` (n×n), ``b`` (n×m), ``c`` (1×n) and ``d``
+        (1×m, default 0) are rows of expressions (``"-k/m"``) or numbers; ``fixed`` names known
         constants the expressions may use, ``bounds`` gives ``[lo, hi]`` per parameter. A bad
-        expression, shape or value is a ``ValueError`` naming the key and the expression."""
-        keys: Dict[str, Any] = {"params": params, "a": a, "b": b, "c": c}
-        for key, value in (("d", d), ("fixed", fixed), ("bounds", bounds)):
+        expression, shape or value is a ``ValueError`` naming the key and the expression.
+
+        With ``m > 1`` columns of ``b`` the model has ``m`` inputs, named ``inputs`` (default
+        ``u1``, ``u2``, …), that share its parameters: the experiment file's one grey-box
+        ``[system]`` with ``[[input]]`` tables."""
+        keys: Dict[str, Any] = {"params": params, "a": a, "c": c}
+        for key, value in (("fixed", fixed), ("bounds", bounds)):
             if value is not None:
                 keys[key] = value
-        return from_name("grey-box", **keys)
+        columns = _columns(b, "b")
+        if columns is None or columns == 1:
+            if inputs is not None and len(list(inputs)) != 1:
+                raise ValueError(f"inputs: b has one column (one input), found {len(list(inputs))} input names")
+            return from_name("grey-box", b=b, **keys, **({} if d is None else {"d": d}))
+        names = _input_names(inputs, columns, "b")
+        if d is not None and _columns(d, "d") != columns:
+            raise ValueError(f"d: expected one row of {columns} entries (one per column of b)")
+        parts = [from_name("grey-box", b=[[row[j]] for row in b], **keys,
+                           **({} if d is None else {"d": [[d[0][j]]]}))
+                 for j in range(columns)]
+        return System(_jitterid.System.several(names, parts, True).spec_json)
+
+    @staticmethod
+    def several(systems: Union[Sequence["System"], Mapping[str, "System"]]) -> "System":
+        """The system with one input per entry of ``systems``, ``y = Σ G_i u_i``: a mapping
+        from input names to systems (``{"torque": g, "brake": h}``), or a list of systems (inputs
+        named ``u1``, ``u2``, …). Each is a system of one input (``zpk``, ``tf``, ``grey-box``,
+        with its own delay); their parameters are named by input (``torque.b0``)."""
+        if isinstance(systems, Mapping):
+            names, parts = [str(k) for k in systems], list(systems.values())
+        elif isinstance(systems, (list, tuple)):
+            parts = list(systems)
+            names = [f"u{i + 1}" for i in range(len(parts))]
+        else:
+            raise TypeError(f"systems: expected a list of systems or a dict of them by input name, found "
+                            f"{type(systems).__name__}")
+        for i, part in enumerate(parts):
+            if not isinstance(part, _jitterid.System):
+                raise TypeError(f"systems[{names[i]!r}]: expected a System, found {type(part).__name__}")
+        return System(_jitterid.System.several(names, parts, False).spec_json)
+
+    @property
+    def channels(self) -> Optional[List["System"]]:  # type: ignore[override]
+        """A system with several inputs: each input's system, in input order (``None`` for a
+        system with one input)."""
+        parts = _jitterid.System.channels.__get__(self)
+        return None if parts is None else [System(p.spec_json) for p in parts]
 
     @property
     def names(self) -> List[str]:
@@ -114,6 +162,27 @@ class System(SpecTable, _jitterid.System):
 
     def __reduce__(self) -> Any:
         return (System, (self.spec_json,))
+
+
+def _columns(matrix: Any, key: str) -> Optional[int]:
+    """The number of columns of ``matrix`` (rows of entries), ``None`` when it is not a list of
+    equally long rows (the library's reader then names what is wrong)."""
+    if not isinstance(matrix, (list, tuple)) or not matrix:
+        return None
+    widths = {len(row) if isinstance(row, (list, tuple)) else -1 for row in matrix}
+    if len(widths) != 1 or -1 in widths:
+        return None
+    return widths.pop()
+
+
+def _input_names(names: Optional[Sequence[str]], count: int, key: str) -> List[str]:
+    """``names`` checked as ``count`` input names (default ``u1``, ``u2``, …)."""
+    if names is None:
+        return [f"u{i + 1}" for i in range(count)]
+    out = [str(n) for n in names]
+    if len(out) != count:
+        raise ValueError(f"inputs: {key} has {count} columns (one per input), found {len(out)} input names")
+    return out
 
 
 def from_name(kind: str, **keys: Any) -> System:

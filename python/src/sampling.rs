@@ -14,30 +14,33 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// The grid `t_k = start + k·interval`, `k < samples`, and the system driven by `input`.
+/// The grid `t_k = start + k·interval`, `k < samples`, and the system driven by `inputs`
+/// (none, one, or one per input of a system with several).
 fn setup(
     system: &System,
-    input: Option<&Input>,
+    inputs: &[PyRef<'_, Input>],
     samples: usize,
     interval: f64,
     start: f64,
 ) -> PyResult<(SampleGrid, AnySignal)> {
     let grid = SampleGrid::new(start, interval, samples).map_err(value_error)?;
-    let signal = system.driven_by(input.map(|i| &i.input))?;
+    let inputs: Vec<_> = inputs.iter().map(|i| i.input.clone()).collect();
+    let signal = system.driven_by(&inputs)?;
     Ok((grid, signal))
 }
 
-/// `samples` jittered samples of `system` driven by `input` at `start + k·interval`, with
+/// `samples` jittered samples of `system` driven by `inputs` at `start + k·interval`, with
 /// white noise of standard deviation `noise_std`, from a generator seeded with `seed`: a dict
-/// of arrays `t`, `y`, `u` (with an input) and with `truth` the drawn `tau` and `v`.
+/// of arrays `t`, `y`, `u` (with an input; a dict of arrays by input name for a system with
+/// several) and with `truth` the drawn `tau` and `v`.
 #[pyfunction]
-#[pyo3(signature = (system, jitter, input, samples, interval, start, noise_std, seed, truth))]
+#[pyo3(signature = (system, jitter, inputs, samples, interval, start, noise_std, seed, truth))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
     system: &System,
     jitter: &Jitter,
-    input: Option<&Input>,
+    inputs: Vec<PyRef<'py, Input>>,
     samples: usize,
     interval: f64,
     start: f64,
@@ -45,7 +48,7 @@ pub fn simulate<'py>(
     seed: u64,
     truth: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (grid, signal) = setup(system, input, samples, interval, start)?;
+    let (grid, signal) = setup(system, &inputs, samples, interval, start)?;
     let sim = py
         .detach(|| {
             let mut rng = StdRng::seed_from_u64(seed);
@@ -60,9 +63,17 @@ pub fn simulate<'py>(
         .map_err(value_error)?;
     let t: Vec<f64> = grid.times().collect();
     let out = PyDict::new(py);
-    if let Some(i) = input {
-        let u: Vec<f64> = t.iter().map(|&t| i.input.value(t)).collect();
-        out.set_item("u", u.into_pyarray(py))?;
+    let sampled = |i: &Input| -> Vec<f64> { t.iter().map(|&t| i.input.value(t)).collect() };
+    match (system.input_names(), inputs.as_slice()) {
+        (Some(names), _) => {
+            let u = PyDict::new(py);
+            for (name, i) in names.iter().zip(&inputs) {
+                u.set_item(name, sampled(i).into_pyarray(py))?;
+            }
+            out.set_item("u", u)?;
+        }
+        (None, [i]) => out.set_item("u", sampled(i).into_pyarray(py))?,
+        (None, _) => {}
     }
     out.set_item("t", t.into_pyarray(py))?;
     out.set_item("y", sim.y.into_pyarray(py))?;
@@ -79,12 +90,12 @@ pub fn first_moment<'py>(
     py: Python<'py>,
     system: &System,
     jitter: &Jitter,
-    input: Option<&Input>,
+    inputs: Vec<PyRef<'py, Input>>,
     samples: usize,
     interval: f64,
     start: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (grid, signal) = setup(system, input, samples, interval, start)?;
+    let (grid, signal) = setup(system, &inputs, samples, interval, start)?;
     let m = py.detach(|| signal.expected_values(&grid, jitter.model.model()));
     Ok(m.into_pyarray(py))
 }
@@ -97,7 +108,7 @@ pub fn second_moment<'py>(
     py: Python<'py>,
     system: &System,
     jitter: &Jitter,
-    input: Option<&Input>,
+    inputs: Vec<PyRef<'py, Input>>,
     samples: usize,
     interval: f64,
     start: f64,
@@ -108,7 +119,7 @@ pub fn second_moment<'py>(
             "noise_std: expected a finite number >= 0, found {noise_std}"
         )));
     }
-    let (grid, signal) = setup(system, input, samples, interval, start)?;
+    let (grid, signal) = setup(system, &inputs, samples, interval, start)?;
     let moments = py
         .detach(|| second_moments_of(&signal, jitter.model.model(), &grid, noise_std))
         .map_err(value_error)?;

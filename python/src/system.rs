@@ -7,7 +7,8 @@ use crate::errors::{json_text, spec_table, value_error};
 use jitterid::num_complex::Complex64;
 use jitterid::signal::forms::{TfForm, ZpkForm};
 use jitterid::signal::greybox::{ExprModel, GreyBox};
-use jitterid::signal::registry::{SignalRegistry, SpecTable};
+use jitterid::signal::registry::{SignalRegistry, SpecTable, KIND_KEY};
+use jitterid::signal::superposition::{self, SUPERPOSITION_KIND};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
 use jitterid_study::export::{delay_of, tf_of};
 use numpy::ndarray::Array2;
@@ -34,19 +35,54 @@ pub struct System {
 }
 
 impl System {
-    /// The model of `spec`, checked by building it through the registry.
+    /// The model of `spec`, checked by building it through the registry (a system with
+    /// several inputs on a unit step in each).
     pub fn of(spec: SpecTable) -> PyResult<Self> {
-        let model = build(&spec, Some(&unit_step(1.0)?))?;
-        let tf = tf_of(&model).map_err(value_error)?;
+        let step = unit_step(1.0)?;
+        let model = match input_names(&spec) {
+            Some(names) => build_several(&spec, &vec![step; names.len()])?,
+            None => build(&spec, Some(&step))?,
+        };
+        // A system with several inputs has one transfer function per input, not one.
+        let tf = match input_names(&spec) {
+            Some(_) => None,
+            None => tf_of(&model).map_err(value_error)?,
+        };
         Ok(System { spec, model, tf })
     }
 
-    /// The model driven by `input` (`None` for kinds that take none).
-    pub fn driven_by(&self, input: Option<&Input>) -> PyResult<AnySignal> {
-        build(&self.spec, input)
+    /// The input names of a system with several inputs, `None` for one input or none.
+    pub fn input_names(&self) -> Option<Vec<String>> {
+        input_names(&self.spec)
+    }
+
+    /// The model driven by `inputs`: none for kinds that take none, one for a system with
+    /// one input, one per input (in the order of [`input_names`]) for a system with several.
+    pub fn driven_by(&self, inputs: &[Input]) -> PyResult<AnySignal> {
+        match (input_names(&self.spec), inputs) {
+            (Some(names), _) if names.len() != inputs.len() => Err(value_error(format!(
+                "inputs: the system has {} inputs ({}), found {} input(s)",
+                names.len(),
+                names.join(", "),
+                inputs.len()
+            ))),
+            (Some(_), _) => build_several(&self.spec, inputs),
+            (None, []) => build(&self.spec, None),
+            (None, [one]) => build(&self.spec, Some(one)),
+            (None, more) => Err(value_error(format!(
+                "inputs: the system has one input, found {}; a system with several inputs is System.several([...]) or a grey-box model whose b has a column per input",
+                more.len()
+            ))),
+        }
     }
 
     fn rational(&self) -> PyResult<&TfForm> {
+        if let Some(names) = self.input_names() {
+            return Err(value_error(format!(
+                "a system with several inputs ({}) has one transfer function per input: System.channels gives each input's system",
+                names.join(", ")
+            )));
+        }
         self.tf.as_ref().ok_or_else(|| {
             value_error(format!(
                 "a {} system is not rational: it has no transfer function",
@@ -60,6 +96,26 @@ fn build(spec: &SpecTable, input: Option<&Input>) -> PyResult<AnySignal> {
     SignalRegistry::builtin()
         .build(spec, input)
         .map_err(value_error)
+}
+
+fn build_several(spec: &SpecTable, inputs: &[Input]) -> PyResult<AnySignal> {
+    superposition::build(SignalRegistry::builtin(), spec, inputs).map_err(value_error)
+}
+
+/// The input names of a system with several inputs (a `superposition` spec table), `None`
+/// for a system with one input or none.
+fn input_names(spec: &SpecTable) -> Option<Vec<String>> {
+    if spec.get(KIND_KEY).and_then(Value::as_str) != Some(SUPERPOSITION_KIND) {
+        return None;
+    }
+    let names = spec.get("inputs").and_then(Value::as_array);
+    Some(
+        names
+            .into_iter()
+            .flatten()
+            .map(|n| n.as_str().unwrap_or_default().to_string())
+            .collect(),
+    )
 }
 
 /// `u = 1` from 0 to `end`.
@@ -115,6 +171,64 @@ impl System {
         spec.insert("zeros".into(), roots_spec(form.zeros()));
         spec.insert("poles".into(), roots_spec(form.poles()));
         System::of(spec)
+    }
+
+    /// A system with several inputs: `systems[i]` the response to input `names[i]`, added
+    /// (`y = Σ G_i u_i`). With `shared`, the systems are the columns of one grey-box model
+    /// (the same parameters, a column of `B` and `D` each) and share their parameters.
+    #[staticmethod]
+    fn several(
+        names: Vec<String>,
+        systems: Vec<PyRef<'_, System>>,
+        shared: bool,
+    ) -> PyResult<Self> {
+        if names.len() != systems.len() || names.len() < 2 {
+            return Err(value_error(format!(
+                "systems: expected one system per input and at least two inputs, found {} system(s) for {} name(s)",
+                systems.len(),
+                names.len()
+            )));
+        }
+        for (i, s) in systems.iter().enumerate() {
+            if input_names(&s.spec).is_some() {
+                return Err(value_error(format!(
+                    "systems[{i}]: already a system with several inputs; expected one system per input"
+                )));
+            }
+        }
+        let channels = names
+            .into_iter()
+            .zip(&systems)
+            .map(|(n, s)| (n, s.model.spec(), true))
+            .collect();
+        System::of(superposition::spec_table(channels, shared))
+    }
+
+    /// The input names of a system with several inputs, `None` for one input.
+    #[getter]
+    fn inputs(&self) -> Option<Vec<String>> {
+        input_names(&self.spec)
+    }
+
+    /// A system with several inputs: the response to each input, in input order, as the
+    /// systems of one input each (a shared grey-box model's columns each hold the whole
+    /// parameter set); `None` for a system with one input.
+    #[getter]
+    fn channels(&self) -> PyResult<Option<Vec<System>>> {
+        if input_names(&self.spec).is_none() {
+            return Ok(None);
+        }
+        let spec = self.model.spec();
+        let tables = spec.get("channels").and_then(Value::as_array);
+        tables
+            .into_iter()
+            .flatten()
+            .map(|t| {
+                let t = t.as_object().cloned().unwrap_or_default();
+                System::of(t)
+            })
+            .collect::<PyResult<Vec<_>>>()
+            .map(Some)
     }
 
     /// The registry name of the kind.
