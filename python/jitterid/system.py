@@ -17,7 +17,7 @@ the model's own.
 from __future__ import annotations
 
 import json
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -43,13 +43,14 @@ class System(SpecTable, _jitterid.System):
     @staticmethod
     def grey_box(
         params: Dict[str, float],
-        a: Any,
-        b: Any,
-        c: Any,
+        a: Any = None,
+        b: Any = None,
+        c: Any = None,
         d: Any = None,
         fixed: Optional[Dict[str, float]] = None,
         bounds: Optional[Dict[str, Any]] = None,
         inputs: Optional[Sequence[str]] = None,
+        matrices: Optional[Callable[..., Any]] = None,
     ) -> "System":
         """``ẋ = A(θ)x + B(θ)u, y = C(θ)x + D(θ)u`` with named physical parameters ``params``
         (``{"m": 1.0, "damp": 0.4, "k": 2.0}``): ``a`` (n×n), ``b`` (n×m), ``c`` (1×n) and ``d``
@@ -57,9 +58,30 @@ class System(SpecTable, _jitterid.System):
         constants the expressions may use, ``bounds`` gives ``[lo, hi]`` per parameter. A bad
         expression, shape or value is a ``ValueError`` naming the key and the expression.
 
+        ``matrices``, instead of ``a``, ``b``, ``c``, ``d``: a callable that returns NumPy
+        matrices ``(A, B, C)`` or ``(A, B, C, D)`` from the parameters and the fixed constants
+        as keyword arguments (``lambda m, damp, k: (np.array([[0, 1], [-k/m, -damp/m]]),
+        [0, 1/m], [1, 0])``; a vector ``B`` is the column, ``C`` the row). It is called once,
+        with symbols for the parameters, and what it computes (arithmetic and NumPy's ``sqrt``,
+        ``exp``, ``log``, ``sin``, ``cos``, ``tan``, ``abs``) becomes the expressions above,
+        differentiated exactly; a branch on a parameter's value or a function outside that list
+        raises ``ValueError`` saying so.
+
         With ``m > 1`` columns of ``b`` the model has ``m`` inputs, named ``inputs`` (default
         ``u1``, ``u2``, …), that share its parameters: the experiment file's one grey-box
         ``[system]`` with ``[[input]]`` tables."""
+        if matrices is not None:
+            given = [k for k, v in (("a", a), ("b", b), ("c", c), ("d", d)) if v is not None]
+            if given:
+                raise ValueError(f"matrices: give the matrices as a callable or as {', '.join(given)}, not both")
+            from ._trace import matrices_of
+
+            names = [str(n) for n in dict(params)] + [str(n) for n in dict(fixed or {})]
+            traced = matrices_of(matrices, names)
+            a, b, c, d = traced["a"], traced["b"], traced["c"], traced.get("d")
+        for key, value in (("a", a), ("b", b), ("c", c)):
+            if value is None:
+                raise ValueError(f"{key}: a grey-box model needs a, b and c (or matrices, a callable returning them)")
         keys: Dict[str, Any] = {"params": params, "a": a, "c": c}
         for key, value in (("fixed", fixed), ("bounds", bounds)):
             if value is not None:

@@ -10,7 +10,7 @@ use jitterid::signal::greybox::{ExprModel, GreyBox};
 use jitterid::signal::registry::{SignalRegistry, SpecTable, KIND_KEY};
 use jitterid::signal::superposition::{self, SUPERPOSITION_KIND};
 use jitterid::signal::{AnySignal, Input, PiecewiseConstant, Signal};
-use jitterid_study::export::{delay_of, tf_of};
+use jitterid_study::export::{delay_of, grey_box_of, tf_of};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
 use pyo3::prelude::*;
@@ -281,7 +281,11 @@ impl System {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Matrix<'py>, Matrix<'py>, Matrix<'py>, Matrix<'py>)> {
-        let ss = match self.model.downcast::<GreyBox<ExprModel>>() {
+        let grey = grey_box_of(&self.model).map_err(value_error)?;
+        let ss = match grey
+            .as_ref()
+            .and_then(|g| g.downcast::<GreyBox<ExprModel>>())
+        {
             Some(g) => g.state_space(),
             None => self.rational()?.to_state_space(),
         };

@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 
 /// The cases: name, example file, method, what it shows.
-const CASES: [(&str, &str, &str, &str); 8] = [
+const CASES: [(&str, &str, &str, &str); 9] = [
     (
         "offset",
         "offset.toml",
@@ -65,6 +65,12 @@ const CASES: [(&str, &str, &str, &str); 8] = [
         "dc-motor-gaussian.toml",
         "bcls",
         "grey box: the DC motor, Gaussian jitter",
+    ),
+    (
+        "msd-delay-offset",
+        "msd-delay-offset.toml",
+        "bcls",
+        "grey box with a dead time and an operating point: the mass–spring–damper's m, damp, k with its delay D and output offset y0, uniform-sum jitter",
     ),
 ];
 

@@ -7,10 +7,12 @@
 use jitterid::estimate::validation::{BodePoint, StepPoint};
 use jitterid::estimate::{validation, EstimateError};
 use jitterid::signal::forms::{StateSpace, TfForm, ZpkForm};
-use jitterid::signal::greybox::{ExprModel, GreyBox};
+use jitterid::signal::greybox::{ExprModel, GreyBox, GREY_BOX};
 use jitterid::signal::registry::{KindReader, SignalRegistry};
 use jitterid::signal::RationalModel;
-use jitterid::signal::{AnySignal, Offset, SignalError, Superposition, TransferFunction, Zpk};
+use jitterid::signal::{
+    AnySignal, Offset, PiecewiseConstant, SignalError, Superposition, TransferFunction, Zpk,
+};
 use serde::Serialize;
 
 /// The model in the three export forms.
@@ -106,10 +108,36 @@ impl RationalSystem {
 ///
 /// The spec table of a `zpk` or `tf` signal does not rebuild its system.
 pub fn tf_of(signal: &AnySignal) -> Result<Option<TfForm>, SignalError> {
-    if let Some(g) = signal.downcast::<GreyBox<ExprModel>>() {
-        return g.transfer_function().map(Some);
+    if let Some(g) = grey_box_of(signal)? {
+        let g = g.downcast::<GreyBox<ExprModel>>();
+        return g.map(GreyBox::transfer_function).transpose();
     }
     Ok(RationalSystem::of(signal)?.map(|g| g.tf()))
+}
+
+/// A grey-box system's model alone, as a [`GreyBox`] signal on a unit step: the signal
+/// itself, or, for a model with an input delay, a free response or an output offset (which
+/// put it on its transfer function's route), the model rebuilt from its spec table without
+/// them. `None` for other kinds.
+///
+/// # Errors
+///
+/// The spec table does not rebuild the model.
+pub fn grey_box_of(signal: &AnySignal) -> Result<Option<AnySignal>, SignalError> {
+    if signal.kind() != GREY_BOX {
+        return Ok(None);
+    }
+    if signal.downcast::<GreyBox<ExprModel>>().is_some() {
+        return Ok(Some(signal.clone()));
+    }
+    let mut spec = signal.spec();
+    for key in ["delay", "initial", "origin", "offset", "estimate_offset"] {
+        spec.remove(key);
+    }
+    let step = PiecewiseConstant::new(vec![0.0, 1.0], vec![1.0])?;
+    SignalRegistry::builtin()
+        .build(&spec, Some(&step.into()))
+        .map(Some)
 }
 
 /// The fitted model in every export form, `None` for signals that are not rational systems
@@ -124,7 +152,11 @@ pub fn model_forms(signal: &AnySignal) -> Result<Option<ModelForms>, SignalError
         return Ok(None);
     };
     // A grey-box model exports its own realisation (the fitted A, B, C, D).
-    let ss = match signal.downcast::<GreyBox<ExprModel>>() {
+    let grey = grey_box_of(signal)?;
+    let ss = match grey
+        .as_ref()
+        .and_then(|g| g.downcast::<GreyBox<ExprModel>>())
+    {
         Some(g) => g.state_space(),
         None => tf.to_state_space(),
     };

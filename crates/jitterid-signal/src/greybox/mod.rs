@@ -45,7 +45,7 @@
 mod expressions;
 mod rational;
 
-use rational::GreyTf;
+pub use rational::GreyTf;
 
 pub use expressions::{Entry, ExprModel, WrittenMatrices, GREY_BOX};
 
@@ -284,6 +284,25 @@ impl<M: StateSpaceModel> GreyBox<M> {
     /// The eigenvalues of `A` (the poles of the transfer function before any cancellation).
     pub fn poles(&self) -> &[Complex64] {
         &self.poles
+    }
+
+    /// The response through the model's transfer function ([`GreyTf`]): the same response
+    /// and the same parameters, on the route of a `tf` system (modal where the poles are
+    /// distinct, the realisation of the coefficients where they repeat), whose gradient is
+    /// exact by the coefficients' forward-mode derivatives. An input delay and a free response
+    /// are built on it.
+    ///
+    /// # Errors
+    ///
+    /// The coefficients cannot be rooted.
+    pub fn transfer_response(&self) -> Result<LtiResponse<GreyTf<M>>, SignalError> {
+        let tf = GreyTf::new(
+            self.model.clone(),
+            self.theta.clone(),
+            &self.mats,
+            &self.derivs,
+        )?;
+        Ok(LtiResponse::new(tf, self.input.clone()))
     }
 
     /// The realisation `(A, B, C, D)` at the current parameters, for export.

@@ -67,9 +67,13 @@ fn seeded(m: &StateMatrices<f64>, d: &StateMatrices<f64>) -> StateMatrices<Dual>
     }
 }
 
-/// A grey-box model's transfer function, parameterised by its physical parameters.
+/// A grey-box model's transfer function, parameterised by its physical parameters: the
+/// [`RationalModel`] an [`LtiResponse`](crate::LtiResponse) drives, which an input delay
+/// ([`Delayed`](crate::Delayed)) and a free response
+/// ([`WithInitialState`](crate::WithInitialState)) are built on
+/// ([`GreyBox::transfer_response`](super::GreyBox::transfer_response)).
 #[derive(Debug, Clone)]
-pub(super) struct GreyTf<M> {
+pub struct GreyTf<M> {
     model: M,
     theta: Vec<f64>,
     rational: Rational,
@@ -81,7 +85,7 @@ impl<M: StateSpaceModel> GreyTf<M> {
     /// # Errors
     ///
     /// Those of [`Rational::new`]: a pole right of the axis, coefficients it cannot root.
-    pub(super) fn new(
+    pub(crate) fn new(
         model: M,
         theta: Vec<f64>,
         mats: &StateMatrices<f64>,
@@ -104,6 +108,13 @@ impl<M: StateSpaceModel> GreyTf<M> {
             theta,
             rational,
         })
+    }
+}
+
+impl<M> GreyTf<M> {
+    /// The model whose transfer function this is.
+    pub fn model(&self) -> &M {
+        &self.model
     }
 }
 

@@ -236,7 +236,7 @@ fn with_unstable<M: RationalModel>(mut spec: SpecTable, g: &M) -> SpecTable {
 
 /// The keys every LTI kind adds to its model's: an input delay and the free response from an
 /// initial state (each a parameter only when given).
-fn response_keys() -> Vec<ParamSpec> {
+pub(super) fn response_keys() -> Vec<ParamSpec> {
     vec![
         ParamSpec::new(
             "delay",
@@ -310,7 +310,7 @@ fn with_offset(
 
 /// `response`, delayed and given a free response as the spec table asks, with `keys` writing
 /// the model's keys back.
-fn lti_signal<M: RationalModel + Clone + 'static>(
+pub(super) fn lti_signal<M: RationalModel + Clone + 'static>(
     kind: &'static str,
     r: &SpecReader<'_>,
     response: LtiResponse<M>,

@@ -2,15 +2,15 @@
 //! parameters ([`ExprModel`] driven by the input through [`GreyBox`]).
 
 use super::{ParamSpec, SignalKind, SpecReader, SpecTable};
-use crate::greybox::{Entry, ExprModel, GreyBox, WrittenMatrices, GREY_BOX};
+use crate::greybox::{
+    Entry, ExprModel, GreyBox, GreyTf, StateSpaceModel, WrittenMatrices, GREY_BOX,
+};
+use crate::RationalModel;
 use crate::{AnySignal, Input, Signal, SignalError};
 use serde_json::{json, Map, Value};
 
 pub(super) fn kind() -> SignalKind {
-    SignalKind::new(
-        GREY_BOX,
-        "ẋ = A(θ)x + B(θ)u, y = C(θ)x + D(θ)u with named physical parameters θ, driven by the input, exact (the sensitivities by the augmented matrix exponential)",
-        vec![
+    let mut keys = vec![
             ParamSpec::new(
                 "params",
                 "the parameters θ and their values, a table {name = value}; reported in the order of their names",
@@ -38,11 +38,20 @@ pub(super) fn kind() -> SignalKind {
             ParamSpec::new("b", "B, n×1: one row of one entry per state", "", "n rows"),
             ParamSpec::new("c", "C, 1×n: one row", "", "n columns"),
             ParamSpec::new("d", "D, 1×1: [[entry]]", "", "optional; default 0"),
-        ],
+        ];
+    keys.extend(super::builtin::response_keys());
+    SignalKind::new(
+        GREY_BOX,
+        "ẋ = A(θ)x + B(θ)u, y = C(θ)x + D(θ)u with named physical parameters θ, driven by the input, exact (the sensitivities by the augmented matrix exponential)",
+        keys,
         true,
         build,
     )
 }
+
+/// The keys that put the model on its transfer function's route ([`GreyBox::transfer_response`]),
+/// where an input delay, a free response and an output offset are built as for `tf`.
+const RESPONSE_KEYS: [&str; 4] = ["delay", "initial", "offset", "estimate_offset"];
 
 fn build(r: &SpecReader<'_>, input: Option<&Input>) -> Result<AnySignal, SignalError> {
     let params = named_numbers(r, "params")?;
@@ -77,18 +86,32 @@ fn build(r: &SpecReader<'_>, input: Option<&Input>) -> Result<AnySignal, SignalE
         // values the parameters give them.
         other => r.invalid("params", other),
     })?;
-    Ok(AnySignal::with_spectrum(GREY_BOX, g, spec_of))
+    if !RESPONSE_KEYS.iter().any(|k| r.has(k)) {
+        return Ok(AnySignal::with_spectrum(GREY_BOX, g, spec_of));
+    }
+    let response = g.transfer_response().map_err(|e| r.invalid("a", e))?;
+    super::builtin::lti_signal(GREY_BOX, r, response, spec_of_tf)
+}
+
+/// The keys of a grey-box model on its transfer function's route (without the response's
+/// own keys, which the route writes back).
+fn spec_of_tf(g: &GreyTf<ExprModel>) -> SpecTable {
+    model_keys(g.model(), &g.params())
 }
 
 /// The keys of a grey-box model at its current parameters (the texts as written).
 fn spec_of(g: &GreyBox<ExprModel>) -> SpecTable {
-    let model = g.model();
+    model_keys(g.model(), &g.params())
+}
+
+/// The keys of `model` at the parameters `theta`.
+fn model_keys(model: &ExprModel, theta: &[f64]) -> SpecTable {
+    let names = model.param_names();
     let mut spec = SpecTable::new();
-    let params: Map<String, Value> = g
-        .param_names()
-        .into_iter()
-        .zip(g.params())
-        .map(|(n, x)| (n, json!(x)))
+    let params: Map<String, Value> = names
+        .iter()
+        .zip(theta)
+        .map(|(n, x)| (n.clone(), json!(x)))
         .collect();
     spec.insert("params".into(), Value::Object(params));
     if !model.fixed().is_empty() {
@@ -99,9 +122,9 @@ fn spec_of(g: &GreyBox<ExprModel>) -> SpecTable {
             .collect();
         spec.insert("fixed".into(), Value::Object(fixed));
     }
-    let bounds: Map<String, Value> = g
-        .param_names()
-        .into_iter()
+    let bounds: Map<String, Value> = names
+        .iter()
+        .cloned()
         .zip(model.bounds())
         .filter(|(_, (lo, hi))| lo.is_finite() || hi.is_finite())
         // An infinite side is written as null (JSON has no infinity).
@@ -213,6 +236,80 @@ mod tests {
         assert_eq!(moved.spec()["bounds"]["k"], json!([0.0, null]));
         assert!(s.has_spectrum());
         assert!(s.with_params(&[0.4, 2.0, -1.0]).is_err());
+    }
+
+    /// A grey-box model with an input delay, a free response and an output offset (on its
+    /// transfer function's route) against two independent routes: the plain model (the
+    /// augmented realisation where the poles repeat) on the grid moved earlier by the delay,
+    /// and the `tf` system with the same coefficients and keys; and the signal contract.
+    #[test]
+    fn delay_initial_state_and_offset_follow_the_tf_route() {
+        use crate::testing::check_contract;
+        use crate::SampleGrid;
+        use jitterid_jitter::{Gaussian, JitterModel, UniformSum};
+        let input = binary(5, 4.0, 0.0, 60.0).unwrap().into();
+        let reg = SignalRegistry::builtin();
+        let grid = SampleGrid::new(0.0, 0.5, 100).unwrap();
+        let jitters: [Box<dyn JitterModel>; 2] = [
+            Box::new(UniformSum::new(2, 0.25).unwrap()),
+            Box::new(Gaussian::new(0.08).unwrap()),
+        ];
+        // Distinct poles, and a double pole (damp² = 4mk).
+        for (m, damp, k) in [(1.0, 0.4, 2.0), (1.0, 2.0, 1.0)] {
+            let mut plain = msd();
+            plain["params"] = json!({"m": m, "damp": damp, "k": k});
+            let mut delayed = plain.clone();
+            delayed["delay"] = json!(0.7);
+            let g = reg.build(plain.as_object().unwrap(), Some(&input)).unwrap();
+            let d = reg
+                .build(delayed.as_object().unwrap(), Some(&input))
+                .unwrap();
+            assert_eq!(d.param_names(), ["damp", "k", "m", "delay"]);
+            let tf = json!({"kind": "tf", "num": [1.0 / m], "den": [1.0, damp / m, k / m],
+                            "delay": 0.7, "initial": [0.3, -0.2], "origin": 0.0,
+                            "offset": 1.5, "estimate_offset": true});
+            let tf = reg.build(tf.as_object().unwrap(), Some(&input)).unwrap();
+            let mut full = delayed.clone();
+            full["initial"] = json!([0.3, -0.2]);
+            full["origin"] = json!(0.0);
+            full["offset"] = json!(1.5);
+            full["estimate_offset"] = json!(true);
+            let full = reg.build(full.as_object().unwrap(), Some(&input)).unwrap();
+            assert_eq!(
+                full.param_names(),
+                [
+                    "damp",
+                    "k",
+                    "m",
+                    "delay",
+                    "initial.0",
+                    "initial.1",
+                    "offset"
+                ]
+            );
+            // The spec table rebuilds the same signal.
+            let again = reg.build(&full.spec(), Some(&input)).unwrap();
+            assert_eq!(again.params(), full.params());
+            for jitter in &jitters {
+                let j = jitter.as_ref();
+                let shifted = g.expected_values(&grid.earlier(0.7), j);
+                let ours = d.expected_values(&grid, j);
+                let (m_full, m_tf) = (full.expected_values(&grid, j), tf.expected_values(&grid, j));
+                let (s_full, s_tf) = (
+                    full.expected_squares(&grid, j),
+                    tf.expected_squares(&grid, j),
+                );
+                for k in 0..grid.len() {
+                    assert!((ours[k] - shifted[k]).abs() < 1e-10, "k = {k}");
+                    assert!((m_full[k] - m_tf[k]).abs() < 1e-10, "k = {k}");
+                    assert!(
+                        (s_full[k] - s_tf[k]).abs() < 1e-9 * (1.0 + s_tf[k]),
+                        "k = {k}"
+                    );
+                }
+                check_contract(&full, j, &grid, 3).unwrap();
+            }
+        }
     }
 
     #[test]

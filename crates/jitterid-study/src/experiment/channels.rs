@@ -117,6 +117,15 @@ fn grey_box_inputs(
     grid: &SampleGrid,
 ) -> StudyResult<(SystemSpec, Vec<InputChannel>)> {
     let m = inputs.len();
+    if let Some(i) = rs.initial.as_ref().filter(|i| i.get_ref() == "estimate") {
+        // The channels share every parameter, so each would add the same free response.
+        return Err(cx.err(
+            "system",
+            "initial",
+            &i.span(),
+            "a grey-box model with a column of b per input has one state, shared by its inputs, and its free response would be added once per input; write one [[system]] per input to estimate each response's free part, or start the record at rest".to_string(),
+        ));
+    }
     let columns = |key: &str, v: &Spanned<toml::Value>, rows: Option<usize>| {
         let bad = |msg: String| cx.err("system", key, &v.span(), msg);
         let toml::Value::Array(r) = v.get_ref() else {

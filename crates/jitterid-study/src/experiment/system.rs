@@ -274,10 +274,11 @@ fn response_keys(
         "estimate" => {
             let order = match kind.get("poles").zip(kind.get("zeros")) {
                 Some(_) => zpk_order(&kind),
-                None => kind
-                    .get("den")
-                    .and_then(Value::as_array)
-                    .map_or(0, |d| d.len().saturating_sub(1)),
+                None => match kind.get("den").and_then(Value::as_array) {
+                    Some(den) => den.len().saturating_sub(1),
+                    // A grey-box model: one state per row of A.
+                    None => kind.get("a").and_then(Value::as_array).map_or(0, Vec::len),
+                },
             };
             kind.insert("initial".into(), json!(vec![0.0; order]));
             kind.insert("origin".into(), json!(grid.start()));
@@ -333,7 +334,7 @@ pub(super) fn output_keys(
             O,
             key,
             &span,
-            format!("the system kind \"{name}\" takes no output offset; expected kind = \"zpk\" or \"tf\""),
+            format!("the system kind \"{name}\" takes no output offset; expected kind = \"zpk\", \"tf\" or \"grey-box\""),
         ));
     }
     let y0 = match offset {
