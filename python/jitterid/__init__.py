@@ -177,12 +177,19 @@ def _write_record(path: str, record: Dict[str, Any], name: str) -> None:
         out.write("".join(",".join(repr(v) for v in row) + "\n" for row in zip(*rows)))
     if record.get("input_t") is not None:
         t = real_array(record["input_t"], f"{name}['input_t']").ravel()
-        u = real_array(record.get("input_u"), f"{name}['input_u']").ravel()
-        if t.size != u.size:
-            raise ValueError(f"{name}['input_t'] and {name}['input_u']: expected equal lengths, found {t.size} and "
-                             f"{u.size}")
+        levels = record.get("input_u")
+        # Several inputs: one column of levels per input, by name, as `simulate` writes them.
+        columns = dict(levels) if isinstance(levels, Mapping) else {"u": levels}
+        rows = [t.tolist()]
+        for column, u in columns.items():
+            u = real_array(u, f"{name}['input_u']" + ("" if column == "u" else f"[{column!r}]")).ravel()
+            if t.size != u.size:
+                raise ValueError(f"{name}['input_t'] and {name}['input_u']: expected equal lengths, found {t.size} "
+                                 f"and {u.size}")
+            rows.append(u.tolist())
         with open(path[: -len(".csv")] + ".input.csv", "w") as out:
-            out.write("t,u\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), u.tolist())))
+            out.write(",".join(["t", *map(str, columns)]) + "\n")
+            out.write("".join(",".join(repr(v) for v in row) + "\n" for row in zip(*rows)))
 
 
 def select(experiment: Experiment, record: Record, *, validation: Optional[Record] = None,
