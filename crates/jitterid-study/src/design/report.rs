@@ -1,6 +1,7 @@
 //! What `jitterid design` reports: the designed experiment and the file's own, each with its
 //! predicted standard deviations, as values and as the command's JSON.
 
+use super::blind::JitterBlind;
 use super::candidate::Design;
 use super::criterion::criterion_value;
 use super::plan::Plan;
@@ -39,6 +40,26 @@ pub struct DesignJson {
     pub predicted: Vec<PredictedStd>,
     /// The experiment file's own design, for comparison.
     pub baseline: PredictedDesign,
+    /// The jitter-blind design (`--jitter-blind`), when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jitter_blind: Option<BlindJson>,
+}
+
+/// The jitter-blind design in the JSON: its predicted standard deviations under the true
+/// prior (`predicted`, what a user of it gets) and under the jitter-blind one
+/// (`predicted_blind`, what they expect), with the criterion's value under each.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BlindJson {
+    /// The design.
+    pub design: Design,
+    /// Under the true prior.
+    pub predicted: Vec<PredictedStd>,
+    /// The criterion under the true prior (compare with the designed experiment's).
+    pub criterion_value: f64,
+    /// Under the jitter-blind prior.
+    pub predicted_blind: Vec<PredictedStd>,
+    /// The criterion under the jitter-blind prior.
+    pub criterion_value_blind: f64,
 }
 
 /// The outcome of a design search, with what the text report adds to the JSON.
@@ -63,21 +84,25 @@ pub struct DesignReport {
     pub baseline_prediction: Result<(Prediction, f64), String>,
     /// Designs evaluated by the search.
     pub evaluations: usize,
+    /// The jitter-blind design, when asked for ([`jitter_blind`](super::jitter_blind)).
+    pub jitter_blind: Option<JitterBlind>,
+}
+
+/// The predicted standard deviation of every parameter of `p`, named.
+fn stds(p: &Prediction) -> Vec<PredictedStd> {
+    p.names
+        .iter()
+        .zip(&p.std)
+        .map(|(n, s)| PredictedStd {
+            name: n.clone(),
+            std: Some(*s),
+        })
+        .collect()
 }
 
 impl DesignReport {
     /// The command's JSON.
     pub fn json(&self) -> DesignJson {
-        let stds = |p: &Prediction| -> Vec<PredictedStd> {
-            p.names
-                .iter()
-                .zip(&p.std)
-                .map(|(n, s)| PredictedStd {
-                    name: n.clone(),
-                    std: Some(*s),
-                })
-                .collect()
-        };
         let baseline = match &self.baseline_prediction {
             Ok((p, _)) => stds(p),
             Err(_) => self
@@ -98,6 +123,13 @@ impl DesignReport {
                 design: self.baseline,
                 predicted: baseline,
             },
+            jitter_blind: self.jitter_blind.as_ref().map(|b| BlindJson {
+                design: b.design,
+                predicted: stds(&b.prediction),
+                criterion_value: b.value,
+                predicted_blind: stds(&b.blind_prediction),
+                criterion_value_blind: b.blind_value,
+            }),
         }
     }
 }
@@ -127,5 +159,6 @@ pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<D
         baseline,
         baseline_prediction,
         evaluations: optimum.evaluations,
+        jitter_blind: None,
     })
 }
