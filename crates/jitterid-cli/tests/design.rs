@@ -57,8 +57,17 @@ fn design_json_has_the_contract_s_keys_and_improves_on_the_baseline() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
-    assert_eq!(keys, ["baseline", "criterion", "design", "predicted"]);
+    assert_eq!(
+        keys,
+        ["baseline", "criterion", "derived", "design", "predicted"]
+    );
     assert_eq!(v["criterion"], "param:zero0");
+    // The static gain's std by the delta method, for both designs (the jitter is known: no σ).
+    for d in [&v["derived"], &v["baseline"]["derived"]] {
+        assert_eq!(d.as_array().unwrap().len(), 1, "{d}");
+        assert_eq!(d[0]["name"], "static_gain");
+        assert!(d[0]["std"].as_f64().unwrap() > 0.0, "{d}");
+    }
     assert_eq!(v["baseline"]["design"]["mean_dwell"], 8.0);
     assert_eq!(v["design"]["interval"], 1.0);
     assert_eq!(v["design"]["samples"], 200);
@@ -81,7 +90,9 @@ fn design_json_has_the_contract_s_keys_and_improves_on_the_baseline() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let text = stdout(&o);
     assert!(
-        text.contains("designed: mean_dwell") && text.contains("baseline: mean_dwell = 8"),
+        text.contains("designed: mean_dwell")
+            && text.contains("baseline: mean_dwell = 8")
+            && text.contains("static_gain"),
         "{text}"
     );
 }

@@ -299,7 +299,10 @@ fn dwell_search_finds_the_scan_s_minimum() {
     let report = design(&plan, None).unwrap();
     let json = serde_json::to_value(report.json()).unwrap();
     let keys: Vec<&String> = json.as_object().unwrap().keys().collect();
-    assert_eq!(keys, ["baseline", "criterion", "design", "predicted"]);
+    assert_eq!(
+        keys,
+        ["baseline", "criterion", "derived", "design", "predicted"]
+    );
     assert_eq!(json["criterion"], "d");
     assert_eq!(json["baseline"]["design"]["mean_dwell"], 8.0);
     assert_eq!(json["predicted"].as_array().unwrap().len(), 4);

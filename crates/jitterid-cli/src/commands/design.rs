@@ -8,7 +8,7 @@ use crate::commands::{fmt_num, name_width};
 use crate::exit::Outcome;
 use crate::output::OutputSet;
 use jitterid_study::design::{
-    design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
+    derived_stds, design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
 };
 use jitterid_study::error::StudyResult;
 use jitterid_study::experiment::{budget_edit, DesignCriterion, ReadOptions};
@@ -139,7 +139,8 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
             design_text(&b.design)
         );
     }
-    let w = name_width(p.names.iter().map(String::as_str));
+    let derived_names: Vec<String> = derived_stds(p).into_iter().map(|d| d.name).collect();
+    let w = name_width(p.names.iter().chain(&derived_names).map(String::as_str));
     let blind_head = if blind.is_some() {
         format!("  {:>14}", "jitter-blind")
     } else {
@@ -160,6 +161,24 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
             out,
             "{name:<w$}  {:>14}  {:>14}{}",
             fmt_num(p.std[i]),
+            cell(b),
+            blind_cell(j)
+        );
+    }
+    // Derived quantities by the delta method, each design's own.
+    let named = |list: Vec<jitterid_study::design::PredictedStd>, name: &str| {
+        list.into_iter()
+            .find(|d| d.name == name)
+            .and_then(|d| d.std)
+    };
+    for d in derived_stds(p) {
+        let b = base.and_then(|(bp, _)| named(derived_stds(bp), &d.name));
+        let j = blind.and_then(|bl| named(derived_stds(&bl.prediction), &d.name));
+        let _ = writeln!(
+            out,
+            "{:<w$}  {:>14}  {:>14}{}",
+            d.name,
+            cell(d.std),
             cell(b),
             blind_cell(j)
         );

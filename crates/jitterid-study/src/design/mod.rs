@@ -43,6 +43,8 @@ pub use criterion::{covariance_criterion, criterion_value};
 pub use derived::{derived_std, Derived};
 pub use plan::Plan;
 pub use predict::{predict, Prediction};
-pub use report::{design, BlindJson, DesignJson, DesignReport, PredictedDesign, PredictedStd};
+pub use report::{
+    derived_stds, design, BlindJson, DesignJson, DesignReport, PredictedDesign, PredictedStd,
+};
 pub use search::{optimise, Optimum};
 pub use written::{designed_input, DesignedInput};

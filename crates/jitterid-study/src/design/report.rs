@@ -4,6 +4,7 @@
 use super::blind::JitterBlind;
 use super::candidate::Design;
 use super::criterion::criterion_value;
+use super::derived::{derived_std, Derived};
 use super::plan::Plan;
 use super::predict::{predict, Prediction};
 use super::search::optimise;
@@ -27,6 +28,9 @@ pub struct PredictedDesign {
     pub design: Design,
     /// The predicted standard deviation of each estimated parameter.
     pub predicted: Vec<PredictedStd>,
+    /// Derived quantities' predicted standard deviations (see [`derived_stds`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derived: Vec<PredictedStd>,
 }
 
 /// The JSON of `jitterid design --json`.
@@ -38,6 +42,9 @@ pub struct DesignJson {
     pub design: Design,
     /// Its predicted standard deviations.
     pub predicted: Vec<PredictedStd>,
+    /// Derived quantities' predicted standard deviations (see [`derived_stds`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derived: Vec<PredictedStd>,
     /// The experiment file's own design, for comparison.
     pub baseline: PredictedDesign,
     /// The jitter-blind design (`--jitter-blind`), when asked for.
@@ -88,6 +95,22 @@ pub struct DesignReport {
     pub jitter_blind: Option<JitterBlind>,
 }
 
+/// The derived quantities a design report gives beside the parameters, by the delta method:
+/// the static gain where the model has one, and the jitter's σ where it is estimated (a known
+/// jitter's is exactly 0 and is left out).
+pub fn derived_stds(p: &Prediction) -> Vec<PredictedStd> {
+    [Derived::StaticGain, Derived::JitterStd]
+        .into_iter()
+        .filter_map(|q| {
+            let s = derived_std(p, q).ok()?;
+            (q != Derived::JitterStd || s > 0.0).then(|| PredictedStd {
+                name: q.name(),
+                std: Some(s),
+            })
+        })
+        .collect()
+}
+
 /// The predicted standard deviation of every parameter of `p`, named.
 fn stds(p: &Prediction) -> Vec<PredictedStd> {
     p.names
@@ -103,6 +126,10 @@ fn stds(p: &Prediction) -> Vec<PredictedStd> {
 impl DesignReport {
     /// The command's JSON.
     pub fn json(&self) -> DesignJson {
+        let baseline_derived = match &self.baseline_prediction {
+            Ok((p, _)) => derived_stds(p),
+            Err(_) => Vec::new(),
+        };
         let baseline = match &self.baseline_prediction {
             Ok((p, _)) => stds(p),
             Err(_) => self
@@ -119,9 +146,11 @@ impl DesignReport {
             criterion: self.criterion.to_string(),
             design: self.design,
             predicted: stds(&self.prediction),
+            derived: derived_stds(&self.prediction),
             baseline: PredictedDesign {
                 design: self.baseline,
                 predicted: baseline,
+                derived: baseline_derived,
             },
             jitter_blind: self.jitter_blind.as_ref().map(|b| BlindJson {
                 design: b.design,
