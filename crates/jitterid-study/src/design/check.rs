@@ -98,9 +98,12 @@ pub fn monte_carlo(
     let p = s.names.len();
     if rows.len() < p + 2 {
         return Err(study_err!(
-            "{}: only {} of {runs} realisations converged at {design:?}: too few for a covariance",
+            "{}: only {} of {runs} realisations converged at the design (mean dwell {}, interval {} s, {} samples): too few for a covariance of {p} parameters",
             exp.file,
-            rows.len()
+            rows.len(),
+            design.mean_dwell.map_or("fixed".into(), |m| format!("{m} s")),
+            design.interval,
+            design.samples
         ));
     }
     let all: Vec<&Vec<f64>> = rows.iter().collect();
