@@ -82,6 +82,8 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "models" => crate::reproduce_models::models(o),
         "select" => crate::reproduce_select::select_case(o),
         "validate" => crate::reproduce_validate::validate_case(o),
+        "design" => crate::reproduce_design::design(o),
+        "design-bcls" => crate::reproduce_design::design_bcls(o),
         "all" => {
             for c in [
                 "table2",
@@ -95,13 +97,14 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
                 "models",
                 "select",
                 "validate",
+                "design",
             ] {
                 run(c, &Options { json: None, ..o.clone() })?;
             }
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate, design, design-bcls or all)"
         )),
     }
 }

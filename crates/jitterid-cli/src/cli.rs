@@ -56,6 +56,20 @@ pub struct DesignArgs {
     /// (one parameter's variance) [default: [design] criterion, else d].
     #[arg(long, value_name = "CRITERION")]
     pub criterion: Option<String>,
+    /// The record every design has: duration=SECONDS (N T held, N = round(duration / T)) or
+    /// samples=N (N held), replacing the file's own N [default: [design] duration or samples,
+    /// else the file's N].
+    #[arg(long, value_name = "duration=SECONDS|samples=N")]
+    pub budget: Option<String>,
+    /// Write the designed experiment's input (a random binary input's realisation 0 of the
+    /// [design] seed, columns t,u) to FILE.csv and the experiment file that reads it, with the
+    /// designed sampling, to FILE.toml, ready for simulate and fit.
+    #[arg(long, value_name = "FILE.csv")]
+    pub write_input: Option<PathBuf>,
+    /// Also design with the jitter ignored (γ ≡ 1, no jitter noise) and report that design's
+    /// precision under the true, jittered prior beside the jitter-aware one.
+    #[arg(long)]
+    pub jitter_blind: bool,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -377,6 +391,9 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             read: a.experiment_args.read_options(None)?,
             experiment: a.experiment,
             criterion: a.criterion,
+            budget: a.budget,
+            jitter_blind: a.jitter_blind,
+            write_input: a.write_input,
             json: a.json,
             out: a.out,
         }),

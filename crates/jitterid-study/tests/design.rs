@@ -6,7 +6,8 @@ use faer::linalg::solvers::DenseSolveCore;
 use jitterid::estimate::ml::delta_method_std;
 use jitterid::signal::Signal;
 use jitterid_study::design::{
-    criterion_value, derived_std, design, optimise, predict, Derived, Design, Plan,
+    criterion_value, derived_std, design, evaluate, jitter_blind, monte_carlo, optimise, predict,
+    Derived, Design, Plan,
 };
 use jitterid_study::experiment::{
     self, DesignCriterion, DesignEstimator, Experiment, Purpose, ReadOptions,
@@ -298,7 +299,10 @@ fn dwell_search_finds_the_scan_s_minimum() {
     let report = design(&plan, None).unwrap();
     let json = serde_json::to_value(report.json()).unwrap();
     let keys: Vec<&String> = json.as_object().unwrap().keys().collect();
-    assert_eq!(keys, ["baseline", "criterion", "design", "predicted"]);
+    assert_eq!(
+        keys,
+        ["baseline", "criterion", "derived", "design", "predicted"]
+    );
     assert_eq!(json["criterion"], "d");
     assert_eq!(json["baseline"]["design"]["mean_dwell"], 8.0);
     assert_eq!(json["predicted"].as_array().unwrap().len(), 4);
@@ -380,4 +384,179 @@ fn infeasible_designs_are_refused_naming_the_key() {
     assert!(plan(&table2(""))
         .unwrap_err()
         .contains("no [design] section"));
+}
+
+/// The jitter-blind plan is the prior with its jitter replaced by none: for BCLS and ML its
+/// prediction at a design equals that of the same file written with `family = "none"`, and
+/// the true plan's is larger (the jitter adds noise after every switch).
+#[test]
+fn jitter_blind_plan_is_the_file_without_jitter() {
+    for estimator in ["bcls", "ml"] {
+        let text = table2(&format!(
+            "[design]\nmean_dwell = [1.0, 40.0]\ndraws = 2\nestimator = \"{estimator}\""
+        ))
+        .replace("samples = 200", "samples = 100");
+        let none = text.replace(
+            "family = \"uniform-sum\"\nn = 2\na = 0.28867513459481287",
+            "family = \"none\"",
+        );
+        assert_ne!(none, text);
+        let jittered = plan(&text).unwrap();
+        let blind = jittered.jitter_blind().unwrap();
+        assert!(blind.is_jitter_blind() && !jittered.is_jitter_blind());
+        let d = Design {
+            mean_dwell: Some(3.0),
+            ..jittered.baseline_design()
+        };
+        let b = blind.predict(&d).unwrap();
+        let w = plan(&none).unwrap().predict(&d).unwrap();
+        let t = jittered.predict(&d).unwrap();
+        assert_eq!(b.names, w.names);
+        for i in 0..b.names.len() {
+            eprintln!(
+                "{estimator} {}: blind {} written {} jittered {}",
+                b.names[i], b.std[i], w.std[i], t.std[i]
+            );
+            assert!(
+                (b.std[i] - w.std[i]).abs() <= 1e-9 * w.std[i],
+                "{estimator} {}",
+                b.names[i]
+            );
+            assert!(t.std[i] > b.std[i], "{estimator} {}", b.names[i]);
+        }
+    }
+}
+
+/// The resonant example: the jitter-blind design switches more often than the jitter-aware
+/// one, and on jittered data it is worse. Predicted (under the true prior) and by a small
+/// seeded Monte Carlo of both designs: the Monte Carlo's difference of `log det C` agrees with
+/// the predicted one within three of its standard errors (jackknife), and the predicted
+/// margin is beyond them.
+#[test]
+fn jitter_blind_design_is_worse_on_jittered_data() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/experiments/design-resonant.toml");
+    let read = ReadOptions {
+        overrides: vec![
+            experiment::Override::parse("design.draws=4").unwrap(),
+            experiment::Override::parse("design.grid=5").unwrap(),
+        ],
+        ..ReadOptions::default()
+    };
+    let plan = Plan::read(&path, &read).unwrap();
+    let crit = DesignCriterion::D;
+    let aware = optimise(&plan, &crit).unwrap();
+    let blind = jitter_blind(&plan, &crit).unwrap();
+    let (a, b) = (
+        aware.design.mean_dwell.unwrap(),
+        blind.design.mean_dwell.unwrap(),
+    );
+    eprintln!(
+        "aware dwell {a}: {}; blind dwell {b}: {} (promised {})",
+        aware.value, blind.value, blind.blind_value
+    );
+    assert!(b < a, "blind {b} against aware {a}");
+    assert!(blind.value > aware.value && blind.blind_value < blind.value);
+    // The Monte Carlo, with the predictions on its own draws.
+    let runs = 256;
+    let seed = 11;
+    let matched = plan.with_draws(runs, seed);
+    let mc_a = monte_carlo(&plan, &aware.design, &crit, runs as u64, seed).unwrap();
+    let mc_b = monte_carlo(&plan, &blind.design, &crit, runs as u64, seed).unwrap();
+    let (_, pa) = evaluate(&matched, &aware.design, &crit).unwrap();
+    let (_, pb) = evaluate(&matched, &blind.design, &crit).unwrap();
+    let mc_diff = mc_b.criterion - mc_a.criterion;
+    let se = (mc_a.criterion_se.powi(2) + mc_b.criterion_se.powi(2)).sqrt();
+    eprintln!(
+        "log det: aware {pa} (MC {} ± {}), blind {pb} (MC {} ± {}); difference {} against MC {mc_diff} ± {se}",
+        mc_a.criterion, mc_a.criterion_se, mc_b.criterion, mc_b.criterion_se, pb - pa
+    );
+    assert!(mc_a.used >= runs - 2 && mc_b.used >= runs - 2);
+    assert!(
+        (mc_diff - (pb - pa)).abs() <= 3.0 * se,
+        "{mc_diff} ± {se} against {}",
+        pb - pa
+    );
+    assert!(
+        pb - pa > 3.0 * se,
+        "predicted margin {} within the error {se}",
+        pb - pa
+    );
+}
+
+/// The predicted standard deviations at a design agree with a Monte Carlo there, for BCLS and
+/// exact ML, within three of the Monte Carlo's standard errors (the prediction averaged over
+/// the runs' own input draws).
+#[test]
+fn predicted_std_agrees_with_monte_carlo_for_both_estimators() {
+    for estimator in ["bcls", "ml"] {
+        let text = table2(&format!(
+            "[design]\nmean_dwell = [1.0, 40.0]\nestimator = \"{estimator}\""
+        ));
+        let plan = plan(&text).unwrap();
+        let d = Design {
+            mean_dwell: Some(4.0),
+            ..plan.baseline_design()
+        };
+        let runs = 40;
+        let seed = 5;
+        let p = plan.with_draws(runs, seed).predict(&d).unwrap();
+        let mc = monte_carlo(&plan, &d, &DesignCriterion::D, runs as u64, seed).unwrap();
+        assert_eq!(p.names, mc.names);
+        for i in 0..p.names.len() {
+            eprintln!(
+                "{estimator} {}: predicted {} MC {} ± {}",
+                p.names[i], p.std[i], mc.std[i], mc.std_se[i]
+            );
+            assert!(
+                (mc.std[i] - p.std[i]).abs() <= 3.0 * mc.std_se[i],
+                "{estimator} {}",
+                p.names[i]
+            );
+        }
+    }
+}
+
+/// A budget: `[design] samples` gives every design that many samples; `[design] duration`
+/// with the interval free keeps `N T` at the duration; budgets that cannot be met, and a
+/// budget against `hold`, are refused naming the key.
+#[test]
+fn budgets_set_every_design_s_record() {
+    let p = plan(&table2(
+        "[design]\nmean_dwell = [2.0, 20.0]\nsamples = 120\ndraws = 1\ngrid = 3",
+    ))
+    .unwrap();
+    assert_eq!(p.budget_design().samples, 120);
+    assert_eq!(p.baseline_design().samples, 200);
+    assert_eq!(
+        optimise(&p, &DesignCriterion::D).unwrap().design.samples,
+        120
+    );
+    let p = plan(&table2(
+        "[design]\ninterval = [0.5, 2.0]\nduration = 150.0\ndraws = 1\ngrid = 3",
+    ))
+    .unwrap();
+    let d = optimise(&p, &DesignCriterion::D).unwrap().design;
+    assert_eq!(d.samples, (150.0 / d.interval).round() as usize, "{d:?}");
+    for (section, want) in [
+        (
+            "[design]\nmean_dwell = [2.0, 20.0]\nsamples = 0",
+            "[design] samples: a budget that cannot be met",
+        ),
+        (
+            "[design]\nmean_dwell = [2.0, 20.0]\nduration = 0.2",
+            "[design] duration: a budget that cannot be met",
+        ),
+        (
+            "[design]\nmean_dwell = [2.0, 20.0]\nduration = 100.0\nsamples = 10",
+            "[design] samples: a budget that cannot be met: give either",
+        ),
+        (
+            "[design]\ninterval = [0.5, 2.0]\nduration = 100.0\nhold = \"samples\"",
+            "[design] hold: \"samples\" contradicts the budget",
+        ),
+    ] {
+        let e = parse(&table2(section)).unwrap_err();
+        assert!(e.contains(want), "{section}: {e}");
+    }
 }

@@ -7,9 +7,11 @@
 use crate::commands::{fmt_num, name_width};
 use crate::exit::Outcome;
 use crate::output::OutputSet;
-use jitterid_study::design::{design as run_design, Design, Plan};
+use jitterid_study::design::{
+    derived_stds, design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
+};
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{DesignCriterion, ReadOptions};
+use jitterid_study::experiment::{budget_edit, DesignCriterion, ReadOptions};
 use jitterid_study::study_err;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -23,6 +25,13 @@ pub struct DesignOptions {
     pub read: ReadOptions,
     /// The criterion (`d`, `a`, `param:NAME`), replacing `[design] criterion`.
     pub criterion: Option<String>,
+    /// The budget (`duration=SECONDS` or `samples=N`), replacing `[design] duration`/`samples`.
+    pub budget: Option<String>,
+    /// Also design with the jitter ignored, evaluated under the true prior.
+    pub jitter_blind: bool,
+    /// Write the designed input (CSV) to this file and the experiment reading it beside it
+    /// (the same name with `.toml`).
+    pub write_input: Option<PathBuf>,
     /// Print JSON instead of a table.
     pub json: bool,
     /// Write the JSON to this file instead of standard output.
@@ -51,20 +60,65 @@ pub fn design(o: &DesignOptions) -> StudyResult<Outcome> {
         .map(DesignCriterion::parse)
         .transpose()
         .map_err(|e| study_err!("--criterion: {e}"))?;
-    let plan = Plan::read(&o.experiment, &o.read)?;
-    let report = run_design(&plan, criterion.as_ref())?;
-    if o.json || o.out.is_some() {
-        let text = serde_json::to_string_pretty(&report.json())
-            .map_err(|e| study_err!("JSON: {e}"))?
-            + "\n";
-        if let Some(path) = &o.out {
-            let mut outputs = OutputSet::new();
-            outputs.file(path, text);
-            outputs.commit()?;
-            return Ok(Outcome::success(format!("wrote {}\n", path.display())));
+    // The input file's name and the experiment's path, checked before the search.
+    let written_names = match &o.write_input {
+        None => None,
+        Some(path) => {
+            let experiment = path.with_extension("toml");
+            match path.file_name().and_then(|n| n.to_str()) {
+                Some(n) if experiment != *path => Some((n.to_string(), experiment)),
+                _ => {
+                    return Err(study_err!(
+                        "--write-input {}: expected a CSV file name (the experiment is written beside it with the extension .toml)",
+                        path.display()
+                    ))
+                }
+            }
         }
-        return Ok(Outcome::success(text));
+    };
+    let mut read = o.read.clone();
+    if let Some(b) = &o.budget {
+        read.overrides.push(budget_edit(b)?);
     }
+    let plan = Plan::read(&o.experiment, &read)?;
+    let mut report = run_design(&plan, criterion.as_ref())?;
+    if o.jitter_blind {
+        report.jitter_blind = Some(jitter_blind(&plan, &report.criterion)?);
+    }
+    let mut outputs = OutputSet::new();
+    let mut wrote = Vec::new();
+    if let (Some(path), Some((name, experiment))) = (&o.write_input, &written_names) {
+        let written = designed_input(&plan, &report.design, name)?;
+        outputs.file(path, written.csv);
+        outputs.file(experiment, written.experiment);
+        wrote.push(path.display().to_string());
+        wrote.push(experiment.display().to_string());
+    }
+    let text = if o.json || o.out.is_some() {
+        serde_json::to_string_pretty(&report.json()).map_err(|e| study_err!("JSON: {e}"))? + "\n"
+    } else {
+        table(&plan, &report)
+    };
+    let text = match &o.out {
+        Some(path) => {
+            outputs.file(path, text);
+            wrote.insert(0, path.display().to_string());
+            String::new()
+        }
+        None => text,
+    };
+    outputs.commit()?;
+    // Stdout holds the JSON alone when it is printed; what was written goes after a table.
+    let notes = if wrote.is_empty() || (o.json && o.out.is_none()) {
+        String::new()
+    } else {
+        format!("wrote {}\n", wrote.join(", "))
+    };
+    Ok(Outcome::success(text + &notes))
+}
+
+/// The table of a design report.
+fn table(plan: &Plan, report: &DesignReport) -> String {
     let p = &report.prediction;
     let mut out = format!(
         "design of {} for {} (criterion {}, {} input draw{} per design, {} designs evaluated)\n",
@@ -77,31 +131,68 @@ pub fn design(o: &DesignOptions) -> StudyResult<Outcome> {
     );
     let _ = writeln!(out, "designed: {}", design_text(&report.design));
     let _ = writeln!(out, "baseline: {}", design_text(&report.baseline));
-    let w = name_width(p.names.iter().map(String::as_str));
+    let blind = report.jitter_blind.as_ref();
+    if let Some(b) = blind {
+        let _ = writeln!(
+            out,
+            "jitter-blind: {} (its stds under the true, jittered prior)",
+            design_text(&b.design)
+        );
+    }
+    let derived_names: Vec<String> = derived_stds(p).into_iter().map(|d| d.name).collect();
+    let w = name_width(p.names.iter().chain(&derived_names).map(String::as_str));
+    let blind_head = if blind.is_some() {
+        format!("  {:>14}", "jitter-blind")
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         out,
-        "{:<w$}  {:>14}  {:>14}",
+        "{:<w$}  {:>14}  {:>14}{blind_head}",
         "parameter", "designed std", "baseline std"
     );
     let base = report.baseline_prediction.as_ref().ok();
+    let cell = |x: Option<f64>| x.map_or("–".into(), fmt_num);
+    let blind_cell = |x: Option<f64>| blind.map_or(String::new(), |_| format!("  {:>14}", cell(x)));
     for (i, name) in p.names.iter().enumerate() {
         let b = base.and_then(|(bp, _)| bp.std.get(i).copied());
+        let j = blind.and_then(|b| b.prediction.std_of(name));
         let _ = writeln!(
             out,
-            "{name:<w$}  {:>14}  {:>14}",
+            "{name:<w$}  {:>14}  {:>14}{}",
             fmt_num(p.std[i]),
-            b.map_or("–".into(), fmt_num)
+            cell(b),
+            blind_cell(j)
+        );
+    }
+    // Derived quantities by the delta method, each design's own.
+    let named = |list: Vec<jitterid_study::design::PredictedStd>, name: &str| {
+        list.into_iter()
+            .find(|d| d.name == name)
+            .and_then(|d| d.std)
+    };
+    for d in derived_stds(p) {
+        let b = base.and_then(|(bp, _)| named(derived_stds(bp), &d.name));
+        let j = blind.and_then(|bl| named(derived_stds(&bl.prediction), &d.name));
+        let _ = writeln!(
+            out,
+            "{:<w$}  {:>14}  {:>14}{}",
+            d.name,
+            cell(d.std),
+            cell(b),
+            blind_cell(j)
         );
     }
     let _ = writeln!(
         out,
-        "{:<w$}  {:>14}  {:>14}",
+        "{:<w$}  {:>14}  {:>14}{}",
         "criterion",
         fmt_num(report.value),
-        base.map_or("–".into(), |(_, v)| fmt_num(*v))
+        cell(base.map(|(_, v)| *v)),
+        blind_cell(blind.map(|b| b.value))
     );
     if let Err(why) = &report.baseline_prediction {
         let _ = writeln!(out, "baseline not predicted: {why}");
     }
-    Ok(Outcome::success(out))
+    out
 }

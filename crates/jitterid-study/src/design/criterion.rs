@@ -19,7 +19,20 @@ use faer::{Mat, Side};
 /// A `param:NAME` criterion whose name is not among the predicted parameters (the message
 /// lists them).
 pub fn criterion_value(criterion: &DesignCriterion, prediction: &Prediction) -> StudyResult<f64> {
-    let c = &prediction.covariance;
+    covariance_criterion(criterion, &prediction.names, &prediction.covariance)
+}
+
+/// The criterion's value at any covariance `c` of the parameters `names` (a prediction's, or
+/// a Monte Carlo's sample covariance, so that the two are judged by one formula).
+///
+/// # Errors
+///
+/// As [`criterion_value`].
+pub fn covariance_criterion(
+    criterion: &DesignCriterion,
+    names: &[String],
+    c: &[Vec<f64>],
+) -> StudyResult<f64> {
     let p = c.len();
     Ok(match criterion {
         DesignCriterion::D => {
@@ -34,10 +47,10 @@ pub fn criterion_value(criterion: &DesignCriterion, prediction: &Prediction) -> 
         }
         DesignCriterion::A => (0..p).map(|i| c[i][i]).sum(),
         DesignCriterion::Param(name) => {
-            let i = prediction.names.iter().position(|n| n == name).ok_or_else(|| {
+            let i = names.iter().position(|n| n == name).ok_or_else(|| {
                 study_err!(
                     "criterion param:{name}: no estimated parameter of that name; expected one of {}",
-                    prediction.names.join(", ")
+                    names.join(", ")
                 )
             })?;
             c[i][i]

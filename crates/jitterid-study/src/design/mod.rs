@@ -15,10 +15,18 @@
 //! - [`criterion_value`]: D-, A- or one parameter's optimality.
 //! - [`Plan`], [`Design`]: the experiment file as a document that each candidate design edits
 //!   and reads again, so every candidate is validated like a written file.
+//! - [`jitter_blind`]: the same search with the jitter ignored (`γ ≡ 1`), and [`evaluate`]:
+//!   any design under the true prior, so the two can be compared on jittered data.
+//! - [`monte_carlo`]: a design checked by realisations on jittered data, with the Monte
+//!   Carlo's standard errors.
+//! - [`designed_input`]: a design's input realisation as a CSV input file and the experiment
+//!   file that reads it, ready for `simulate` and `fit`.
 //! - [`optimise`], [`design()`]: the seeded, deterministic search over the `[design]` ranges and
 //!   the report that sets the result beside the file's own design.
 
+mod blind;
 mod candidate;
+mod check;
 mod criterion;
 mod derived;
 mod plan;
@@ -26,11 +34,17 @@ mod predict;
 mod realization;
 mod report;
 mod search;
+mod written;
 
+pub use blind::{evaluate, jitter_blind, JitterBlind};
 pub use candidate::Design;
-pub use criterion::criterion_value;
+pub use check::{monte_carlo, MonteCarloCheck};
+pub use criterion::{covariance_criterion, criterion_value};
 pub use derived::{derived_std, Derived};
 pub use plan::Plan;
 pub use predict::{predict, Prediction};
-pub use report::{design, DesignJson, DesignReport, PredictedDesign, PredictedStd};
+pub use report::{
+    derived_stds, design, BlindJson, DesignJson, DesignReport, PredictedDesign, PredictedStd,
+};
 pub use search::{optimise, Optimum};
+pub use written::{designed_input, DesignedInput};

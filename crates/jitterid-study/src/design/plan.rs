@@ -1,7 +1,9 @@
 //! The experiment as a document that designs edit: its text, where it came from, the user's
 //! own edits, and its `[design]` section.
 
+use super::blind::without_jitter;
 use super::candidate::Design;
+use super::predict::{predict, Prediction};
 use crate::error::StudyResult;
 use crate::experiment::{
     directory_of, parse_edited, read_text, DesignSpec, Experiment, Purpose, ReadOptions,
@@ -24,6 +26,8 @@ pub struct Plan {
     pub baseline: Experiment,
     /// Its `[design]` section.
     pub spec: DesignSpec,
+    /// Whether the prior's jitter is replaced by none (see [`Plan::jitter_blind`]).
+    blind: bool,
 }
 
 impl Plan {
@@ -62,7 +66,7 @@ impl Plan {
                 "{file}: no [design] section; expected one naming the free design variables (mean_dwell = [min, max], interval = [min, max])"
             )
         })?;
-        Ok(Plan {
+        let plan = Plan {
             registries: Arc::clone(registries),
             file: file.to_string(),
             text,
@@ -70,7 +74,74 @@ impl Plan {
             options: options.clone(),
             baseline,
             spec,
+            blind: false,
+        };
+        // A budget on a fixed interval is one record: it must be one the experiment allows
+        // (the jitter's reach within it, the input's switches), or no design can meet it.
+        if let (Some(key), None) = (plan.spec.budget_key, plan.spec.interval) {
+            plan.experiment(&plan.budget_design()).map_err(|e| {
+                study_err!("{file}: [design] {key}: a budget that cannot be met: {e}")
+            })?;
+        }
+        Ok(plan)
+    }
+
+    /// The baseline's design on the budget's record (`[design] duration` or `samples`): where
+    /// the search starts, and every candidate's record.
+    pub fn budget_design(&self) -> Design {
+        let mut d = self.baseline_design();
+        d.samples = self.spec.budget.samples_at(d.interval);
+        d
+    }
+
+    /// The same plan on the jitter-blind prior: every experiment it reads has its jitter
+    /// replaced by none (`γ ≡ 1`, no jitter noise, nothing of the jitter estimated), so that a
+    /// search on it is the design of a user who ignores the jitter.
+    ///
+    /// # Errors
+    ///
+    /// The registry has no family `none`.
+    pub fn jitter_blind(&self) -> StudyResult<Plan> {
+        Ok(Plan {
+            baseline: without_jitter(self.baseline.clone())?,
+            blind: true,
+            ..self.clone()
         })
+    }
+
+    /// The same plan with its predictions averaged over `draws` input draws of master seed
+    /// `seed` (a Monte Carlo of `draws` runs with that seed sees the same inputs).
+    pub fn with_draws(&self, draws: usize, seed: u64) -> Plan {
+        let mut plan = self.clone();
+        plan.spec.draws = draws;
+        plan.spec.seed = seed;
+        plan
+    }
+
+    /// Whether this is the jitter-blind plan.
+    pub fn is_jitter_blind(&self) -> bool {
+        self.blind
+    }
+
+    /// The predicted precision of `design` under this plan's prior, with the `[design]`
+    /// section's estimator, draws and seed.
+    ///
+    /// # Errors
+    ///
+    /// Those of [`Plan::experiment`] and [`predict`].
+    pub fn predict(&self, design: &Design) -> StudyResult<Prediction> {
+        let exp = self.experiment(design)?;
+        predict(&exp, self.spec.estimator, self.spec.draws, self.spec.seed)
+    }
+
+    /// The edits the plan was read with (the user's `--set`), in order.
+    pub(crate) fn edits(&self) -> &[crate::experiment::Override] {
+        &self.options.overrides
+    }
+
+    /// The experiment's text as written.
+    pub(crate) fn text(&self) -> &str {
+        &self.text
     }
 
     /// The baseline's design.
@@ -86,13 +157,18 @@ impl Plan {
     pub fn experiment(&self, design: &Design) -> StudyResult<Experiment> {
         let mut options = self.options.clone();
         options.overrides.extend(design.edits());
-        parse_edited(
+        let exp = parse_edited(
             &self.registries,
             &self.file,
             &self.text,
             &self.dir,
             Purpose::Simulate,
             &options,
-        )
+        )?;
+        if self.blind {
+            without_jitter(exp)
+        } else {
+            Ok(exp)
+        }
     }
 }

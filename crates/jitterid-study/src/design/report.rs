@@ -1,8 +1,10 @@
 //! What `jitterid design` reports: the designed experiment and the file's own, each with its
 //! predicted standard deviations, as values and as the command's JSON.
 
+use super::blind::JitterBlind;
 use super::candidate::Design;
 use super::criterion::criterion_value;
+use super::derived::{derived_std, Derived};
 use super::plan::Plan;
 use super::predict::{predict, Prediction};
 use super::search::optimise;
@@ -26,6 +28,9 @@ pub struct PredictedDesign {
     pub design: Design,
     /// The predicted standard deviation of each estimated parameter.
     pub predicted: Vec<PredictedStd>,
+    /// Derived quantities' predicted standard deviations (see [`derived_stds`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derived: Vec<PredictedStd>,
 }
 
 /// The JSON of `jitterid design --json`.
@@ -37,8 +42,31 @@ pub struct DesignJson {
     pub design: Design,
     /// Its predicted standard deviations.
     pub predicted: Vec<PredictedStd>,
+    /// Derived quantities' predicted standard deviations (see [`derived_stds`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derived: Vec<PredictedStd>,
     /// The experiment file's own design, for comparison.
     pub baseline: PredictedDesign,
+    /// The jitter-blind design (`--jitter-blind`), when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jitter_blind: Option<BlindJson>,
+}
+
+/// The jitter-blind design in the JSON: its predicted standard deviations under the true
+/// prior (`predicted`, what a user of it gets) and under the jitter-blind one
+/// (`predicted_blind`, what they expect), with the criterion's value under each.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BlindJson {
+    /// The design.
+    pub design: Design,
+    /// Under the true prior.
+    pub predicted: Vec<PredictedStd>,
+    /// The criterion under the true prior (compare with the designed experiment's).
+    pub criterion_value: f64,
+    /// Under the jitter-blind prior.
+    pub predicted_blind: Vec<PredictedStd>,
+    /// The criterion under the jitter-blind prior.
+    pub criterion_value_blind: f64,
 }
 
 /// The outcome of a design search, with what the text report adds to the JSON.
@@ -63,20 +91,44 @@ pub struct DesignReport {
     pub baseline_prediction: Result<(Prediction, f64), String>,
     /// Designs evaluated by the search.
     pub evaluations: usize,
+    /// The jitter-blind design, when asked for ([`jitter_blind`](super::jitter_blind)).
+    pub jitter_blind: Option<JitterBlind>,
+}
+
+/// The derived quantities a design report gives beside the parameters, by the delta method:
+/// the static gain where the model has one, and the jitter's σ where it is estimated (a known
+/// jitter's is exactly 0 and is left out).
+pub fn derived_stds(p: &Prediction) -> Vec<PredictedStd> {
+    [Derived::StaticGain, Derived::JitterStd]
+        .into_iter()
+        .filter_map(|q| {
+            let s = derived_std(p, q).ok()?;
+            (q != Derived::JitterStd || s > 0.0).then(|| PredictedStd {
+                name: q.name(),
+                std: Some(s),
+            })
+        })
+        .collect()
+}
+
+/// The predicted standard deviation of every parameter of `p`, named.
+fn stds(p: &Prediction) -> Vec<PredictedStd> {
+    p.names
+        .iter()
+        .zip(&p.std)
+        .map(|(n, s)| PredictedStd {
+            name: n.clone(),
+            std: Some(*s),
+        })
+        .collect()
 }
 
 impl DesignReport {
     /// The command's JSON.
     pub fn json(&self) -> DesignJson {
-        let stds = |p: &Prediction| -> Vec<PredictedStd> {
-            p.names
-                .iter()
-                .zip(&p.std)
-                .map(|(n, s)| PredictedStd {
-                    name: n.clone(),
-                    std: Some(*s),
-                })
-                .collect()
+        let baseline_derived = match &self.baseline_prediction {
+            Ok((p, _)) => derived_stds(p),
+            Err(_) => Vec::new(),
         };
         let baseline = match &self.baseline_prediction {
             Ok((p, _)) => stds(p),
@@ -94,10 +146,19 @@ impl DesignReport {
             criterion: self.criterion.to_string(),
             design: self.design,
             predicted: stds(&self.prediction),
+            derived: derived_stds(&self.prediction),
             baseline: PredictedDesign {
                 design: self.baseline,
                 predicted: baseline,
+                derived: baseline_derived,
             },
+            jitter_blind: self.jitter_blind.as_ref().map(|b| BlindJson {
+                design: b.design,
+                predicted: stds(&b.prediction),
+                criterion_value: b.value,
+                predicted_blind: stds(&b.blind_prediction),
+                criterion_value_blind: b.blind_value,
+            }),
         }
     }
 }
@@ -127,5 +188,6 @@ pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<D
         baseline,
         baseline_prediction,
         evaluations: optimum.evaluations,
+        jitter_blind: None,
     })
 }

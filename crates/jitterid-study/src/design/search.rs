@@ -14,9 +14,9 @@
 use super::candidate::Design;
 use super::criterion::criterion_value;
 use super::plan::Plan;
-use super::predict::{predict, Prediction};
+use super::predict::Prediction;
 use crate::error::{StudyError, StudyResult};
-use crate::experiment::{DesignCriterion, Hold};
+use crate::experiment::DesignCriterion;
 use crate::study_err;
 use jitterid::estimate::solver::{Brent, Objective, Solver};
 use std::sync::Mutex;
@@ -53,7 +53,6 @@ type Evaluated = Result<(f64, Prediction), StudyError>;
 struct Search<'a> {
     plan: &'a Plan,
     criterion: &'a DesignCriterion,
-    base: Design,
     /// Every design evaluated, in order (the search is short: a linear memo suffices).
     memo: Mutex<Vec<(Design, Evaluated)>>,
     /// A criterion that cannot be evaluated at all (an unknown parameter's name).
@@ -69,10 +68,7 @@ impl Search<'_> {
                 Var::MeanDwell => d.mean_dwell = Some(x.exp()),
                 Var::Interval => {
                     d.interval = x.exp();
-                    if self.plan.spec.hold == Hold::Duration {
-                        let duration = self.base.samples as f64 * self.base.interval;
-                        d.samples = ((duration / d.interval).round() as usize).max(1);
-                    }
+                    d.samples = self.plan.spec.budget.samples_at(d.interval);
                 }
             }
         }
@@ -84,10 +80,7 @@ impl Search<'_> {
         if let Some(v) = self.lookup(d) {
             return v;
         }
-        let out = self.plan.experiment(d).and_then(|exp| {
-            let spec = &self.plan.spec;
-            predict(&exp, spec.estimator, spec.draws, spec.seed)
-        });
+        let out = self.plan.predict(d);
         let out = match out {
             Ok(p) => match criterion_value(self.criterion, &p) {
                 Ok(v) => Ok((v, p)),
@@ -161,11 +154,10 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
         vars.push(Var::Interval);
         ranges.push((lo.ln(), hi.ln()));
     }
-    let base = plan.baseline_design();
+    let base = plan.budget_design();
     let search = Search {
         plan,
         criterion,
-        base,
         memo: Mutex::new(Vec::new()),
         fatal: Mutex::new(None),
     };
@@ -288,13 +280,15 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
 
 /// The error of a search without one feasible design: the first reason, and the keys.
 fn infeasible(search: &Search, vars: &[Var]) -> StudyError {
-    let keys: Vec<&str> = vars
+    let mut keys: Vec<&str> = vars
         .iter()
         .map(|v| match v {
             Var::MeanDwell => "mean_dwell",
             Var::Interval => "interval",
         })
         .collect();
+    // A budget narrows every design's record: it may be why none is feasible.
+    keys.extend(search.plan.spec.budget_key);
     let memo = search.memo.lock().unwrap_or_else(|e| e.into_inner());
     let why = memo
         .iter()

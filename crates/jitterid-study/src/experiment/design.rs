@@ -93,6 +93,54 @@ pub enum Hold {
     Duration,
 }
 
+/// The record a design may use: a fixed duration `N T` (then `N = round(duration / T)`) or a
+/// fixed number of samples `N`, whatever `T` the design chooses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Budget {
+    /// The record's duration (s).
+    Duration(f64),
+    /// The number of samples.
+    Samples(usize),
+}
+
+impl Budget {
+    /// The number of samples at sampling interval `interval`.
+    pub fn samples_at(&self, interval: f64) -> usize {
+        match *self {
+            Budget::Duration(d) => ((d / interval).round() as usize).max(1),
+            Budget::Samples(n) => n,
+        }
+    }
+}
+
+/// The edit of the command line's `--budget duration=SECONDS` or `--budget samples=N`: the
+/// `[design]` key of that name, named `--budget …` in messages, so that a budget is checked
+/// exactly as the key written in the file is.
+///
+/// # Errors
+///
+/// Text that is not `duration=NUMBER` or `samples=WHOLE NUMBER`.
+pub fn budget_edit(text: &str) -> StudyResult<super::Override> {
+    let origin = format!("--budget {text}");
+    let bad = || {
+        crate::study_err!(
+            "{origin}: expected duration=SECONDS (the record's duration held) or samples=N (the number of samples held)"
+        )
+    };
+    let (key, value) = text.split_once('=').ok_or_else(bad)?;
+    let value = value.trim();
+    let value: toml_edit::Value = match key.trim() {
+        "duration" => value.parse::<f64>().map_err(|_| bad())?.into(),
+        "samples" => value.parse::<i64>().map_err(|_| bad())?.into(),
+        _ => return Err(bad()),
+    };
+    Ok(super::Override::from_source(
+        &[S, key.trim()],
+        value,
+        origin,
+    ))
+}
+
 /// The validated `[design]` section.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DesignSpec {
@@ -103,6 +151,11 @@ pub struct DesignSpec {
     pub interval: Option<(f64, f64)>,
     /// What stays fixed when the interval changes.
     pub hold: Hold,
+    /// The record every design has: `[design] duration` or `samples` when given (the budget),
+    /// else the file's `N` or `N T`, as `hold` says.
+    pub budget: Budget,
+    /// The key that gave the budget (`duration`, `samples`), `None` for the file's record.
+    pub budget_key: Option<&'static str>,
     /// The criterion (the command line's `--criterion` replaces it).
     pub criterion: DesignCriterion,
     /// The estimator whose precision is predicted.
@@ -153,6 +206,61 @@ fn whole(
     }
 }
 
+/// The budget: `[design] duration` or `samples` (not both), each a record that can be
+/// sampled; without either, the file's `N`. Returns the key that gave it.
+fn parse_budget(
+    cx: &Source,
+    r: &RawDesign,
+    grid: &SampleGrid,
+) -> StudyResult<(Budget, Option<&'static str>)> {
+    let unmet = |key: &str, span: std::ops::Range<usize>, why: String| {
+        cx.err(S, key, &span, format!("a budget that cannot be met: {why}"))
+    };
+    match (&r.duration, &r.samples) {
+        (Some(_), Some(k)) => Err(unmet(
+            "samples",
+            k.span(),
+            "give either duration or samples, not both".into(),
+        )),
+        (Some(d), None) => {
+            let d_value = *d.get_ref();
+            let longest = MAX_INTERVAL * MAX_SAMPLES as f64;
+            if !(d_value.is_finite() && (MIN_INTERVAL..=longest).contains(&d_value)) {
+                return Err(unmet(
+                    "duration",
+                    d.span(),
+                    format!("expected a record duration in [{MIN_INTERVAL:e}, {longest:e}] s, found {d_value}"),
+                ));
+            }
+            if r.interval.is_none() {
+                // T is fixed: the duration must hold a whole number of its intervals.
+                let t = grid.interval();
+                let k = (d_value / t).round();
+                if !(1.0..=MAX_SAMPLES as f64).contains(&k) {
+                    return Err(unmet(
+                        "duration",
+                        d.span(),
+                        format!("{d_value} s holds {k} samples of the interval {t} s; expected 1 to {MAX_SAMPLES}"),
+                    ));
+                }
+            }
+            Ok((Budget::Duration(d_value), Some("duration")))
+        }
+        (None, Some(k)) => {
+            let n = *k.get_ref();
+            if !(1..=MAX_SAMPLES).contains(&n) {
+                return Err(unmet(
+                    "samples",
+                    k.span(),
+                    format!("expected a number of samples in [1, {MAX_SAMPLES}], found {n}"),
+                ));
+            }
+            Ok((Budget::Samples(n as usize), Some("samples")))
+        }
+        (None, None) => Ok((Budget::Samples(grid.len()), None)),
+    }
+}
+
 /// The `[design]` section, checked against the file's grid, input kind (`input_kind`, as
 /// written) and input history: every range must hold a feasible point.
 pub(super) fn parse_design(
@@ -176,41 +284,74 @@ pub(super) fn parse_design(
         }
         None => None,
     };
-    let hold = match &r.hold {
-        None => Hold::Samples,
-        Some(h) => match h.get_ref().as_str() {
-            "samples" => Hold::Samples,
-            "duration" => Hold::Duration,
-            other => {
-                return Err(cx.err(
-                    S,
-                    "hold",
-                    &h.span(),
-                    format!("expected \"samples\" or \"duration\", found \"{other}\""),
-                ))
-            }
-        },
-    };
     let n = grid.len() as f64;
-    let duration = n * grid.interval();
+    let (budget, budget_key) = parse_budget(cx, r, grid)?;
+    let hold = match (&r.hold, budget) {
+        (None, Budget::Duration(_)) => Hold::Duration,
+        (None, Budget::Samples(_)) => Hold::Samples,
+        (Some(h), _) => {
+            let hold = match h.get_ref().as_str() {
+                "samples" => Hold::Samples,
+                "duration" => Hold::Duration,
+                other => {
+                    return Err(cx.err(
+                        S,
+                        "hold",
+                        &h.span(),
+                        format!("expected \"samples\" or \"duration\", found \"{other}\""),
+                    ))
+                }
+            };
+            match (hold, budget_key) {
+                (Hold::Samples, Some("duration")) | (Hold::Duration, Some("samples")) => {
+                    return Err(cx.err(
+                        S,
+                        "hold",
+                        &h.span(),
+                        format!(
+                            "\"{}\" contradicts the budget [design] {}; leave hold out (the budget says what is held)",
+                            h.get_ref(),
+                            budget_key.unwrap_or_default()
+                        ),
+                    ))
+                }
+                _ => {}
+            }
+            hold
+        }
+    };
+    // Without a budget, `hold` says which of the file's N and N T is kept.
+    let budget = match (budget_key, hold) {
+        (None, Hold::Duration) => Budget::Duration(n * grid.interval()),
+        _ => budget,
+    };
     let interval = match &r.interval {
         Some(v) => {
             let (lo, hi) = range(cx, "interval", v)?;
             // The feasible part: a representable interval, and under a held duration a whole
             // number of samples in [1, MAX_SAMPLES].
             let (mut a, mut b) = (lo.max(MIN_INTERVAL), hi.min(MAX_INTERVAL));
-            if hold == Hold::Duration {
+            if let Budget::Duration(duration) = budget {
                 a = a.max(duration / MAX_SAMPLES as f64);
                 b = b.min(duration);
             }
             if !(a <= b) {
+                if let (Some(key), Some(span)) = (budget_key, r.duration.as_ref().map(|d| d.span()))
+                {
+                    return Err(cx.err(
+                        S,
+                        key,
+                        &span,
+                        format!("a budget that cannot be met: no interval in [{lo}, {hi}] s gives a record of 1 to {MAX_SAMPLES} samples in this duration"),
+                    ));
+                }
                 return Err(cx.err(
                     S,
                     "interval",
                     &v.span(),
                     format!(
                         "no feasible interval in [{lo}, {hi}] s: it must lie in [{MIN_INTERVAL:e}, {MAX_INTERVAL:e}] s{}",
-                        if hold == Hold::Duration {
+                        if let Budget::Duration(duration) = budget {
                             format!(
                                 " and, with the duration {duration} s held, give 1 to {MAX_SAMPLES} samples"
                             )
@@ -226,9 +367,10 @@ pub(super) fn parse_design(
     };
     if let Some((v, (_, hi))) = &mean_dwell {
         // The shortest record the design allows, with the longest dwell: the fewest switches.
-        let shortest = match (interval, hold) {
-            (Some((t, _)), Hold::Samples) => n * t,
-            _ => duration,
+        let shortest = match (interval, budget) {
+            (_, Budget::Duration(d)) => d,
+            (Some((t, _)), Budget::Samples(k)) => k as f64 * t,
+            (None, Budget::Samples(k)) => k as f64 * grid.interval(),
         };
         let switches = (shortest + history) / hi;
         if !(switches <= MAX_SWITCHES) {
@@ -284,6 +426,8 @@ pub(super) fn parse_design(
         mean_dwell,
         interval,
         hold,
+        budget,
+        budget_key,
         criterion,
         estimator,
         draws,

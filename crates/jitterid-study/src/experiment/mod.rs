@@ -25,7 +25,9 @@ mod select;
 mod spec;
 mod system;
 
-pub use design::{DesignCriterion, DesignEstimator, DesignSpec, Hold, MAX_DRAWS, MAX_GRID};
+pub use design::{
+    budget_edit, Budget, DesignCriterion, DesignEstimator, DesignSpec, Hold, MAX_DRAWS, MAX_GRID,
+};
 pub use input::MAX_SWITCHES;
 pub use overrides::Override;
 pub use paths::Paths;
@@ -131,6 +133,19 @@ pub fn parse_edited(
                 "{file}: the document cannot be edited (it is read as TOML, but not by the editor)"
             ))
         }),
+    }
+}
+
+/// The text of `text` after `edits`, as [`parse_edited`] would read it (the document's own
+/// spacing and comments kept).
+///
+/// # Errors
+///
+/// An edit's path leads through a value or names a table; `file` is not a TOML document.
+pub(crate) fn edited_text(file: &str, text: &str, edits: &[Override]) -> StudyResult<String> {
+    match overrides::apply(text, edits, None)? {
+        Some(edited) => Ok(edited.text),
+        None => Err(study_err!("{file}: the document cannot be edited")),
     }
 }
 

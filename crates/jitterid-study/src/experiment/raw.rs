@@ -114,6 +114,8 @@ section!(RawDesign, "table [design]" {
     mean_dwell: Vec<f64>,
     interval: Vec<f64>,
     hold: String,
+    duration: f64,
+    samples: i64,
     criterion: String,
     estimator: String,
     draws: i64,

@@ -1,0 +1,91 @@
+//! A designed experiment ready to apply: the input of a design written as the CSV input file
+//! that experiment files read, and the experiment file that reads it.
+//!
+//! A random binary input is a law, not a signal; what a test rig applies is one realisation
+//! of it. The realisation written is draw 0 of the `[design]` seed (the input Monte Carlo run
+//! 0 sees), and the experiment written beside it is the planned one with the design's sampling
+//! and `[input] kind = "csv"` reading that file, so `jitterid simulate` and `jitterid fit` take
+//! the designed experiment as they take any other.
+
+use super::candidate::Design;
+use super::plan::Plan;
+use crate::csvio::input_to_csv;
+use crate::error::StudyResult;
+use crate::experiment::{edited_text, Override};
+use crate::simulate::realize_inputs;
+use crate::study_err;
+use jitterid::estimate::montecarlo::realization_rng;
+use jitterid::signal::Input;
+
+/// The files of a designed experiment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignedInput {
+    /// The input file: columns `t,u`, each row a switch time and the level from it on, a last
+    /// row of level 0 ending the input.
+    pub csv: String,
+    /// The experiment file reading it (the planned file with the design's keys, the input
+    /// replaced and the `[design]` section left out, since nothing in it is free any more).
+    pub experiment: String,
+}
+
+/// The designed experiment of `design` under `plan`, its input file named `csv_name` (a file
+/// name beside the experiment file to be written).
+///
+/// # Errors
+///
+/// The experiment has several inputs or an input that is not random binary (its input is
+/// already a signal the file fixes); the design's experiment is invalid; the document cannot
+/// be edited.
+pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResult<DesignedInput> {
+    let exp = plan.experiment(design)?;
+    if exp.inputs.len() != 1 || !exp.random_input() {
+        return Err(study_err!(
+            "{}: [input]: only a single random binary input is written as a designed input (the file already fixes any other input)",
+            exp.file
+        ));
+    }
+    let seed = plan.spec.seed;
+    let inputs = realize_inputs(&exp, &mut realization_rng(seed, 0))?;
+    let Some(Input::Piecewise(u)) = inputs.first() else {
+        return Err(study_err!(
+            "{}: [input]: the realisation is not piecewise constant",
+            exp.file
+        ));
+    };
+    let origin = |what: &str| format!("[design] {what}");
+    let mut edits = plan.edits().to_vec();
+    // The design's sampling; its dwell lives on in the realisation, not as a key.
+    edits.extend(
+        design
+            .edits()
+            .into_iter()
+            .filter(|e| e.key() != "input.mean_dwell"),
+    );
+    edits.push(Override::from_source(
+        &["input", "kind"],
+        "csv".into(),
+        origin("input"),
+    ));
+    edits.push(Override::from_source(
+        &["input", "path"],
+        csv_name.into(),
+        origin("input"),
+    ));
+    let text = edited_text(&exp.file, plan.text(), &edits)?;
+    let mut doc: toml_edit::DocumentMut = text
+        .parse()
+        .map_err(|e| study_err!("{}: the edited document: {e}", exp.file))?;
+    doc.remove("design");
+    let dwell = design
+        .mean_dwell
+        .map_or(String::new(), |m| format!(" with mean dwell {m} s"));
+    let header = format!(
+        "# Designed by `jitterid design` from {}: the input is realisation 0 of seed {seed} of the\n\
+         # random binary input{dwell}, in {csv_name}.\n",
+        exp.file
+    );
+    Ok(DesignedInput {
+        csv: input_to_csv(u),
+        experiment: header + &doc.to_string(),
+    })
+}
