@@ -32,7 +32,7 @@ from ._spec import integer, real_array, real_number
 from .inputs import Input
 from .system import System
 from ._records import as_record
-from .results import FitResult, MonteCarloResult, SelectionResult, ValidationResult
+from .results import DesignResult, FitResult, MonteCarloResult, SelectionResult, ValidationResult
 
 #: What the functions take as a record: a mapping of arrays (as ``simulate`` returns), a pandas
 #: DataFrame or Series, or an xarray Dataset or DataArray.
@@ -42,6 +42,7 @@ __version__: str = _jitterid.__version__
 DEFAULT_SEED = 20_051_205
 
 __all__ = [
+    "DesignResult",
     "Experiment",
     "FitResult",
     "MonteCarloResult",
@@ -50,6 +51,7 @@ __all__ = [
     "DEFAULT_SEED",
     "Input",
     "System",
+    "design",
     "first_moment",
     "fit",
     "inputs",
@@ -227,6 +229,41 @@ def select(experiment: Experiment, record: Record, *, validation: Optional[Recor
                 message = message.replace(path, name)
             raise ValueError(message) from None
     return SelectionResult(json.loads(text))
+
+
+def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: Optional[str] = None,
+           jitter_blind: bool = False, write_input: Optional[Union[str, os.PathLike]] = None) -> DesignResult:
+    """The experiment that makes ``experiment``'s estimate most precise, over the free
+    variables of its ``[design]`` section (see ``docs/experiments.md``), as ``jitterid design
+    --json [--criterion] [--budget] [--jitter-blind] [--write-input]``.
+
+    * ``criterion``: ``"d"`` (log det of the predicted covariance), ``"a"`` (its trace) or
+      ``"param:NAME"`` (one parameter's variance); the section's by default.
+    * ``budget``: ``"duration=SECONDS"`` or ``"samples=N"``, the record every design has,
+      replacing the section's.
+    * ``jitter_blind``: also the design that ignores the jitter, predicted under the true prior.
+    * ``write_input``: a path ``FILE.csv``: writes the designed input there and the experiment
+      that reads it to ``FILE.toml``, ready for ``Experiment.from_toml`` and ``simulate``.
+
+    The search runs without the GIL. A ``[design]`` without a feasible point, a budget that
+    cannot be met or an unknown criterion raise ``ValueError`` naming the key."""
+    _experiment(experiment)
+    for name, value in (("criterion", criterion), ("budget", budget)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{name}: expected text such as 'd' or 'samples=400', found {type(value).__name__}")
+    target = None if write_input is None else os.fspath(write_input)
+    if target is not None and not target.endswith(".csv"):
+        raise ValueError(f"write_input: expected a path ending in .csv (the experiment goes beside it as .toml), "
+                         f"found {target!r}")
+    text, written = _jitterid.design(experiment, criterion, bool(jitter_blind), budget,
+                                     None if target is None else os.path.basename(target))
+    if target is not None and written is not None:
+        csv, toml = written
+        with open(target, "w") as out:
+            out.write(csv)
+        with open(target[: -len(".csv")] + ".toml", "w") as out:
+            out.write(toml)
+    return DesignResult(json.loads(text))
 
 
 def montecarlo(

@@ -119,6 +119,11 @@ class Validated:
     @property
     def noise_std(self) -> float: ...
 
+def design(
+    experiment: Experiment, criterion: Optional[str], jitter_blind_design: bool, budget: Optional[str],
+    input_name: Optional[str],
+) -> Tuple[str, Optional[Tuple[str, str]]]:
+    """``design --json``'s text, and with ``input_name`` the designed input's CSV and experiment texts."""
 def validate(
     experiment: Experiment,
     y: npt.ArrayLike,

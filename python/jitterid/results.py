@@ -29,7 +29,7 @@ def _system_of(signal_spec: str) -> Any:
     return System(json.dumps(spec))
 
 
-__all__ = ["FitResult", "MonteCarloResult", "SelectionResult", "ValidationResult"]
+__all__ = ["DesignResult", "FitResult", "MonteCarloResult", "SelectionResult", "ValidationResult"]
 
 
 class FitResult:
@@ -287,7 +287,21 @@ class ValidationResult:
                 f"{'passed' if self.passed else 'failed'} at level {self.level:g})")
 
 
-class SelectionResult:
+class _CommandJson:
+    """A result that is the command line's JSON (``_data``): ``to_dict()`` gives it, and it
+    pickles through it."""
+
+    _data: Dict[str, Any]
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The command line's ``--json`` output."""
+        return copy.deepcopy(self._data)
+
+    def __reduce__(self) -> Any:
+        return (type(self), (self._data,))
+
+
+class SelectionResult(_CommandJson):
     """A selection among model orders and jitter families, equal to ``jitterid select --json``.
 
     ``candidates`` are ranked best first (each a dict: ``poles``, ``zeros``, ``family``,
@@ -304,14 +318,35 @@ class SelectionResult:
         self.best: Optional[Dict[str, Any]] = data["best"]
         self.best_validation: Optional[Dict[str, Any]] = data.get("best_validation")
 
-    def to_dict(self) -> Dict[str, Any]:
-        """The command line's ``select --json`` output."""
-        return copy.deepcopy(self._data)
-
-    def __reduce__(self) -> Any:
-        return (SelectionResult, (self._data,))
 
     def __repr__(self) -> str:
         b = self.best
         best = "none" if b is None else f"{b['poles']} poles, {b['zeros']} zeros, {b['family']}"
         return f"SelectionResult({len(self.candidates)} candidates, best: {best})"
+
+
+class DesignResult(_CommandJson):
+    """An experiment design, equal to ``jitterid design --json``: the designed experiment
+    (``design``: the free variables' values, ``interval``, ``samples``), its predicted standard
+    deviations (``predicted``, a dict by parameter name; ``derived`` for derived quantities such
+    as the static gain), the same for the experiment file's own design (``baseline``,
+    ``baseline_predicted``), and with ``jitter_blind=True`` the design that ignores the jitter
+    (``jitter_blind``: its design and its standard deviations under the true, jittered prior).
+    """
+
+    def __init__(self, data: Dict[str, Any]) -> None:
+        _table(data, "a design")
+        self._data = data
+        self.criterion: str = data["criterion"]
+        self.design: Dict[str, Any] = data["design"]
+        self.predicted: Dict[str, float] = {p["name"]: p["std"] for p in data["predicted"]}
+        self.derived: Dict[str, float] = {p["name"]: p["std"] for p in data.get("derived", [])}
+        base = data.get("baseline") or {}
+        self.baseline: Optional[Dict[str, Any]] = base.get("design")
+        self.baseline_predicted: Dict[str, float] = {p["name"]: p["std"] for p in base.get("predicted", [])}
+        self.jitter_blind: Optional[Dict[str, Any]] = data.get("jitter_blind")
+
+
+    def __repr__(self) -> str:
+        design = ", ".join(f"{k}={v:.6g}" for k, v in self.design.items())
+        return f"DesignResult(criterion {self.criterion}: {design})"

@@ -40,6 +40,17 @@ pub struct Experiment {
 }
 
 impl Experiment {
+    /// Where the files the experiment names may be.
+    pub fn paths(&self) -> Paths {
+        self.paths
+    }
+
+    /// The experiment's file name (as messages name it), its text and the directory its
+    /// relative paths are resolved from.
+    pub fn source(&self) -> (&str, &str, &std::path::Path) {
+        (&self.exp.file, &self.text, &self.dir)
+    }
+
     /// The experiment read for estimation with `method` (the file's own if `None`): the
     /// method is checked against what the file marks as estimated.
     pub fn for_method(&self, method: Option<&str>) -> PyResult<Cow<'_, experiment::Experiment>> {

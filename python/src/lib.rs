@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 mod arrays;
+mod designing;
 mod errors;
 mod experiment;
 mod input;
@@ -40,6 +41,7 @@ fn _jitterid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(validating::validate, m)?)?;
     m.add_function(wrap_pyfunction!(validating::select, m)?)?;
     m.add_function(wrap_pyfunction!(experiment::read_record, m)?)?;
+    m.add_function(wrap_pyfunction!(designing::design, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

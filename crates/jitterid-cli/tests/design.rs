@@ -251,3 +251,18 @@ fn budgets_that_cannot_be_met_exit_2_naming_the_key() {
         refused(&all, want);
     }
 }
+
+/// `--budget` replaces the file's own budget: a file with `[design] duration` designed with
+/// `--budget samples=N` keeps `N` samples.
+#[test]
+fn a_budget_on_the_command_line_replaces_the_file_s() {
+    let d = scratch("design-budget-replaces");
+    let text = std::fs::read_to_string(example("table2.toml")).unwrap()
+        + "\n[design]\nmean_dwell = [1.0, 40.0]\ndraws = 2\ngrid = 3\nduration = 300.0\n";
+    let exp = d.join("e.toml");
+    std::fs::write(&exp, text).unwrap();
+    let o = run(&["design", s(&exp), "--budget", "samples=150", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["design"]["samples"], 150, "{v}");
+}

@@ -13,6 +13,13 @@ use crate::study_err;
 use std::path::Path;
 use toml_edit::{DocumentMut, Item, Table, Value};
 
+/// Keys of one section that exclude each other, `(section, key, other)`: an edit of `key`
+/// removes `other` (a `[design]` budget is a duration or a number of samples).
+const EXCLUSIVE: [(&str, &str, &str); 2] = [
+    ("design", "duration", "samples"),
+    ("design", "samples", "duration"),
+];
+
 /// One `key=value` edit: a dotted path into the document (`jitter.sigma`,
 /// `jitter.terms.1.d` for the second `[[jitter.terms]]` table) and a TOML value.
 #[derive(Debug, Clone)]
@@ -155,6 +162,16 @@ impl Override {
                 for k in owned {
                     table.remove(&k);
                 }
+            }
+        }
+        // Keys that exclude each other: setting one replaces the other unless an edit sets it
+        // too (then the reader refuses both, naming them).
+        if let Some((section, _, other)) = EXCLUSIVE
+            .iter()
+            .find(|(section, key, _)| self.path == [*section, *key])
+        {
+            if !all.iter().any(|e| e.path == [*section, *other]) {
+                table.remove(other);
             }
         }
         match table.get_mut(last) {

@@ -1,0 +1,69 @@
+"""Experiment design from Python: ``jitterid.design`` gives the numbers of ``jitterid design
+--json`` for the same file and options, writes the designed input and the experiment that reads
+it (which simulates and fits), and refuses bad criteria and budgets with ``ValueError``."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+import jitterid
+
+REPO = Path(__file__).resolve().parents[2]
+# A cheap search: two input draws per design, three grid points.
+CHEAP = "\n[design]\nmean_dwell = [1.0, 40.0]\ndraws = 2\ngrid = 3\n"
+
+
+def table2_with_design(tmp_path: Path) -> Path:
+    path = tmp_path / "t2.toml"
+    path.write_text((REPO / "examples/experiments/table2.toml").read_text() + CHEAP)
+    return path
+
+
+def test_design_equals_the_command_line_s(tmp_path):
+    path = table2_with_design(tmp_path)
+    exp = jitterid.Experiment.from_toml(str(path))
+    result = jitterid.design(exp, "param:gain", budget="samples=300", jitter_blind=True)
+    assert result.criterion == "param:gain"
+    assert result.design["samples"] == 300
+    assert set(result.predicted) == {"gain", "zero0", "pole0.re", "pole0.im"}
+    assert result.jitter_blind is not None
+    binary = os.environ.get("JITTERID_BIN")
+    if binary is None:
+        pytest.skip("JITTERID_BIN is not set (the command line to compare with)")
+    out = subprocess.run([binary, "design", str(path), "--criterion", "param:gain", "--budget", "samples=300",
+                          "--jitter-blind", "--json"], capture_output=True, text=True, check=True)
+    assert result.to_dict() == json.loads(out.stdout)
+
+
+def test_the_designed_input_is_written_and_runs(tmp_path):
+    exp = jitterid.Experiment.from_toml(str(table2_with_design(tmp_path)))
+    target = tmp_path / "designed.csv"
+    result = jitterid.design(exp, write_input=target)
+    designed = jitterid.Experiment.from_toml(str(tmp_path / "designed.toml"))
+    assert designed.samples == result.design["samples"]
+    fit = designed.fit(designed.simulate(seed=3))
+    assert fit.converged
+    assert target.read_text().startswith("t,u")
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"criterion": "e"}, "criterion"),
+    ({"budget": "samples=0"}, "a budget that cannot be met"),
+    ({"budget": "time=5"}, "expected duration="),
+    ({"write_input": "designed.txt"}, "ending in .csv"),
+])
+def test_bad_design_arguments_raise_value_error(tmp_path, kwargs, words):
+    exp = jitterid.Experiment.from_toml(str(table2_with_design(tmp_path)))
+    with pytest.raises(ValueError, match=words):
+        jitterid.design(exp, **kwargs)
+
+
+def test_an_experiment_without_a_design_section_is_refused():
+    exp = jitterid.Experiment.from_toml(str(REPO / "examples/experiments/table2.toml"))
+    with pytest.raises(ValueError, match=r"no \[design\] section"):
+        jitterid.design(exp)
