@@ -2,6 +2,9 @@
 //! it, against an independent closed form, against the Cramér–Rao ordering, and the design
 //! search's optimum against a fine scan of its criterion.
 
+mod common;
+
+use common::plan;
 use faer::linalg::solvers::DenseSolveCore;
 use jitterid::estimate::ml::delta_method_std;
 use jitterid::signal::Signal;
@@ -13,7 +16,6 @@ use jitterid_study::experiment::{
     self, DesignCriterion, DesignEstimator, Experiment, Purpose, ReadOptions,
 };
 use jitterid_study::montecarlo::{montecarlo_realizations, DEFAULT_SEED};
-use jitterid_study::Registries;
 use std::path::Path;
 
 fn example(file: &str) -> Experiment {
@@ -26,17 +28,6 @@ fn example(file: &str) -> Experiment {
 fn parse(text: &str) -> Result<Experiment, String> {
     experiment::parse("exp.toml", text, Path::new("."), Purpose::Simulate)
         .map_err(|e| e.to_string())
-}
-
-fn plan(text: &str) -> Result<Plan, String> {
-    Plan::parse(
-        &Registries::builtin(),
-        "exp.toml",
-        text.to_string(),
-        Path::new("."),
-        &ReadOptions::default(),
-    )
-    .map_err(|e| e.to_string())
 }
 
 /// The Table 2 setup (as `examples/experiments/table2.toml`), with `extra` appended.

@@ -191,6 +191,15 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
         cell(base.map(|(_, v)| *v)),
         blind_cell(blind.map(|b| b.value))
     );
+    if let Some(p) = &report.prior {
+        let _ = writeln!(
+            out,
+            "robust: the criterion is the mean over {} prior draws (system parameters ±{} relative, jitter σ ±{} relative); the stds are at the prior's values",
+            p.draws,
+            fmt_num(p.system),
+            fmt_num(p.jitter)
+        );
+    }
     if let Err(why) = &report.baseline_prediction {
         let _ = writeln!(out, "baseline not predicted: {why}");
     }

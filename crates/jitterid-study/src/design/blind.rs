@@ -53,7 +53,8 @@ pub struct JitterBlind {
     pub value: f64,
 }
 
-/// The predicted precision of any `design` under `plan`'s prior, and its `criterion` value.
+/// The predicted precision of any `design` under `plan`'s prior, and its `criterion` value
+/// (for a robust design, averaged over the prior's draws: [`Plan::robust_value`]).
 ///
 /// # Errors
 ///
@@ -66,6 +67,7 @@ pub fn evaluate(
 ) -> StudyResult<(Prediction, f64)> {
     let p = plan.predict(design)?;
     let v = criterion_value(criterion, &p)?;
+    let v = plan.robust_value(design, criterion, v)?;
     Ok((p, v))
 }
 

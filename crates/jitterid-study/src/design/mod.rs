@@ -31,6 +31,7 @@ mod criterion;
 mod derived;
 mod plan;
 mod predict;
+mod prior;
 mod realization;
 mod report;
 mod search;
@@ -43,6 +44,7 @@ pub use criterion::{covariance_criterion, criterion_value};
 pub use derived::{derived_std, Derived};
 pub use plan::Plan;
 pub use predict::{predict, Prediction};
+pub use prior::prior_experiments;
 pub use report::{
     derived_stds, design, BlindJson, DesignJson, DesignReport, PredictedDesign, PredictedStd,
 };

@@ -3,10 +3,13 @@
 
 use super::blind::without_jitter;
 use super::candidate::Design;
+use super::criterion::criterion_value;
 use super::predict::{predict, Prediction};
+use super::prior::prior_experiments;
 use crate::error::StudyResult;
 use crate::experiment::{
-    directory_of, parse_edited, read_text, DesignSpec, Experiment, Purpose, ReadOptions,
+    directory_of, parse_edited, read_text, DesignCriterion, DesignSpec, Experiment, Purpose,
+    ReadOptions,
 };
 use crate::study_err;
 use crate::Registries;
@@ -76,6 +79,11 @@ impl Plan {
             spec,
             blind: false,
         };
+        // A robust design's prior draws move the truth alone, the same at every design: one
+        // that makes the model invalid is refused here, naming its key.
+        if let Some(prior) = &plan.spec.prior {
+            prior_experiments(&plan.baseline, prior, plan.spec.seed)?;
+        }
         // A budget on a fixed interval is one record: it must be one the experiment allows
         // (the jitter's reach within it, the input's switches), or no design can meet it.
         if let (Some(key), None) = (plan.spec.budget_key, plan.spec.interval) {
@@ -132,6 +140,34 @@ impl Plan {
     pub fn predict(&self, design: &Design) -> StudyResult<Prediction> {
         let exp = self.experiment(design)?;
         predict(&exp, self.spec.estimator, self.spec.draws, self.spec.seed)
+    }
+
+    /// The criterion a search minimises at `design`, given its `prediction` at the prior's
+    /// point and that prediction's criterion value `nominal`: `nominal` itself, or for a
+    /// robust design (`[design] prior_spread`, `prior_jitter_spread`) the criterion averaged
+    /// over the prior's draws, each predicted on the same input draws.
+    ///
+    /// # Errors
+    ///
+    /// The design's experiment is invalid; a draw's prediction fails (a singular information
+    /// matrix).
+    pub fn robust_value(
+        &self,
+        design: &Design,
+        criterion: &DesignCriterion,
+        nominal: f64,
+    ) -> StudyResult<f64> {
+        let Some(prior) = &self.spec.prior else {
+            return Ok(nominal);
+        };
+        let exp = self.experiment(design)?;
+        let draws = prior_experiments(&exp, prior, self.spec.seed)?;
+        let mut sum = 0.0;
+        for e in &draws {
+            let p = predict(e, self.spec.estimator, self.spec.draws, self.spec.seed)?;
+            sum += criterion_value(criterion, &p)?;
+        }
+        Ok(sum / draws.len() as f64)
     }
 
     /// The edits the plan was read with (the user's `--set`), in order.

@@ -9,7 +9,7 @@ use super::plan::Plan;
 use super::predict::{predict, Prediction};
 use super::search::optimise;
 use crate::error::StudyResult;
-use crate::experiment::{DesignCriterion, DesignEstimator};
+use crate::experiment::{DesignCriterion, DesignEstimator, PriorSpread};
 use serde::Serialize;
 
 /// One predicted standard deviation.
@@ -50,6 +50,27 @@ pub struct DesignJson {
     /// The jitter-blind design (`--jitter-blind`), when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub jitter_blind: Option<BlindJson>,
+    /// A robust design's prior and the averaged criterion of the designed and the baseline
+    /// design (absent for a design at the prior's point).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robust: Option<RobustJson>,
+}
+
+/// A robust design in the JSON: the prior's spread and the criterion averaged over its draws,
+/// for the designed and the baseline design (`null` where the baseline could not be
+/// predicted). `predicted` and `derived` stay those at the prior's point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RobustJson {
+    /// `[design] prior_spread`.
+    pub prior_spread: f64,
+    /// `[design] prior_jitter_spread`.
+    pub prior_jitter_spread: f64,
+    /// `[design] prior_draws`.
+    pub prior_draws: usize,
+    /// The designed experiment's averaged criterion.
+    pub criterion_designed: f64,
+    /// The baseline's averaged criterion.
+    pub criterion_baseline: Option<f64>,
 }
 
 /// The jitter-blind design in the JSON: its predicted standard deviations under the true
@@ -93,6 +114,9 @@ pub struct DesignReport {
     pub evaluations: usize,
     /// The jitter-blind design, when asked for ([`jitter_blind`](super::jitter_blind)).
     pub jitter_blind: Option<JitterBlind>,
+    /// A robust design's prior spread (`value` and the baseline's are then averaged over its
+    /// draws).
+    pub prior: Option<PriorSpread>,
 }
 
 /// The derived quantities a design report gives beside the parameters, by the delta method:
@@ -159,6 +183,13 @@ impl DesignReport {
                 predicted_blind: stds(&b.blind_prediction),
                 criterion_value_blind: b.blind_value,
             }),
+            robust: self.prior.map(|p| RobustJson {
+                prior_spread: p.system,
+                prior_jitter_spread: p.jitter,
+                prior_draws: p.draws,
+                criterion_designed: self.value,
+                criterion_baseline: self.baseline_prediction.as_ref().ok().map(|(_, v)| *v),
+            }),
         }
     }
 }
@@ -177,6 +208,10 @@ pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<D
     let baseline = plan.baseline_design();
     let baseline_prediction = predict(&plan.baseline, spec.estimator, spec.draws, spec.seed)
         .and_then(|p| criterion_value(&criterion, &p).map(|v| (p, v)))
+        .and_then(|(p, v)| {
+            let v = plan.robust_value(&baseline, &criterion, v)?;
+            Ok((p, v))
+        })
         .map_err(|e| e.to_string());
     Ok(DesignReport {
         criterion,
@@ -189,5 +224,6 @@ pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<D
         baseline_prediction,
         evaluations: optimum.evaluations,
         jitter_blind: None,
+        prior: spec.prior,
     })
 }

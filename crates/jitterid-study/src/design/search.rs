@@ -83,7 +83,8 @@ impl Search<'_> {
         let out = self.plan.predict(d);
         let out = match out {
             Ok(p) => match criterion_value(self.criterion, &p) {
-                Ok(v) => Ok((v, p)),
+                // A robust design's value is the criterion over the prior's draws.
+                Ok(v) => self.plan.robust_value(d, self.criterion, v).map(|v| (v, p)),
                 Err(e) => {
                     let mut fatal = self.fatal.lock().unwrap_or_else(|e| e.into_inner());
                     fatal.get_or_insert(e.clone());

@@ -166,6 +166,73 @@ pub struct DesignSpec {
     pub grid: usize,
     /// Master seed of the input realisations (realisation `r` is Monte Carlo run `r`'s input).
     pub seed: u64,
+    /// The prior spread of a robust design (`prior_spread`, `prior_jitter_spread`,
+    /// `prior_draws`), `None` for a design at the prior's values alone.
+    pub prior: Option<PriorSpread>,
+}
+
+/// Largest number of prior draws a robust design averages over.
+pub const MAX_PRIOR_DRAWS: usize = 256;
+
+/// The spread of the prior a robust design averages its criterion over: each estimated
+/// system parameter `θ_j` is drawn as `θ_j (1 + system z_j)` and the jitter's standard
+/// deviation as `σ (1 + jitter z)`, with `z` standard normal cut at ±3, independently for each
+/// of `draws` prior draws.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PriorSpread {
+    /// Relative standard deviation of each estimated system parameter.
+    pub system: f64,
+    /// Relative standard deviation of the jitter's standard deviation.
+    pub jitter: f64,
+    /// Prior draws averaged over.
+    pub draws: usize,
+}
+
+/// A relative spread in `[0, 1/3)` (so that a draw cut at three spreads keeps its sign), 0
+/// when absent.
+fn spread(cx: &Source, key: &str, v: &Option<Spanned<f64>>) -> StudyResult<f64> {
+    match v {
+        None => Ok(0.0),
+        Some(s) if (0.0..1.0 / 3.0).contains(s.get_ref()) => Ok(*s.get_ref()),
+        Some(s) => Err(cx.err(
+            S,
+            key,
+            &s.span(),
+            format!(
+                "expected a relative spread in [0, 1/3) (a draw is cut at three spreads and must keep its sign), found {}",
+                s.get_ref()
+            ),
+        )),
+    }
+}
+
+/// The robust design's prior: `None` when both spreads are 0 (or absent).
+fn parse_prior(cx: &Source, r: &RawDesign) -> StudyResult<Option<PriorSpread>> {
+    let system = spread(cx, "prior_spread", &r.prior_spread)?;
+    let jitter = spread(cx, "prior_jitter_spread", &r.prior_jitter_spread)?;
+    let draws = whole(
+        cx,
+        "prior_draws",
+        &r.prior_draws,
+        (1, MAX_PRIOR_DRAWS as i64),
+        8,
+    )? as usize;
+    if system == 0.0 && jitter == 0.0 {
+        if let Some(d) = &r.prior_draws {
+            return Err(cx.err(
+                S,
+                "prior_draws",
+                &d.span(),
+                "a robust design's prior draws need a spread; expected prior_spread or prior_jitter_spread above 0",
+            ));
+        }
+        return Ok(None);
+    }
+    Ok(Some(PriorSpread {
+        system,
+        jitter,
+        draws,
+    }))
 }
 
 /// `[min, max]` of two finite numbers with `0 < min ≤ max`.
@@ -422,6 +489,7 @@ pub(super) fn parse_design(
         (0, i64::MAX),
         crate::montecarlo::DEFAULT_SEED as i64,
     )? as u64;
+    let prior = parse_prior(cx, r)?;
     Ok(DesignSpec {
         mean_dwell,
         interval,
@@ -433,6 +501,7 @@ pub(super) fn parse_design(
         draws,
         grid: points,
         seed,
+        prior,
     })
 }
 

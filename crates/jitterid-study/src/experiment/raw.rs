@@ -121,6 +121,9 @@ section!(RawDesign, "table [design]" {
     draws: i64,
     grid: i64,
     seed: i64,
+    prior_spread: f64,
+    prior_jitter_spread: f64,
+    prior_draws: i64,
 });
 
 #[derive(Debug, Deserialize)]
