@@ -358,13 +358,12 @@ def _driven(system: Any, input: Any, inputs: Optional[Inputs]) -> Tuple[Any, lis
             if len(listed) != 1:
                 raise ValueError(f"inputs: the system has one input, found {len(listed)} inputs; a system with several "
                                  "inputs is System.several([...]) or a grey-box model whose b has a column per input")
-            return system, [(None, listed[0])]
-        if len(listed) != len(names):
+        elif len(listed) != len(names):
             raise ValueError(f"inputs: the system has {len(names)} inputs ({', '.join(names)}), found {len(listed)}")
-        pairs = list(zip(names, listed))
-    for name, u in pairs:
+        pairs = list(zip([None] if names is None else names, listed))
+    for i, (name, u) in enumerate(pairs):
         if not isinstance(u, (_jitterid.Input, _Realisation)):
-            raise TypeError(f"inputs[{name!r}]: expected an Input, found {type(u).__name__}")
+            raise TypeError(f"inputs[{i if name is None else repr(name)}]: expected an Input, found {type(u).__name__}")
     return system, pairs
 
 
