@@ -302,7 +302,16 @@ pub fn parse_with(
         }
     }
     let select = match &raw.select {
-        Some(r) => Some(select::parse_select(&cx, r, grid.len())?),
+        Some(r) => {
+            // The inputs whose orders a multi-input grid lists; none for one input.
+            let multi = system.kind.get(jitterid::signal::registry::KIND_KEY)
+                == Some(&jitterid::signal::superposition::SUPERPOSITION_KIND.into());
+            let names: Vec<&str> = match multi {
+                true => inputs.iter().map(|c| c.name.as_str()).collect(),
+                false => Vec::new(),
+            };
+            Some(select::parse_select(&cx, r, grid.len(), &names)?)
+        }
         None => None,
     };
     let design = match &raw.design {
