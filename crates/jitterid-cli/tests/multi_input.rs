@@ -219,19 +219,19 @@ fn with_select(dir: &Path, select: &str) -> String {
 }
 
 /// `select` over each input's order on a seeded two-input record: the joint candidates of
-/// (1 or 2 poles) for torque × (1 pole, 2 poles, 2 poles and a zero) for brake, and the true
-/// pair (torque 1/0, brake 2/1) ranks first.
+/// (1 or 2 poles) for torque × (1 pole, or 2 poles and a zero) for brake, and the true pair
+/// (torque 1/0, brake 2/1) ranks first.
 #[test]
 fn select_recovers_each_input_s_order() {
     let dir = scratch_in("jitterid-multi-input", "select");
     let data = simulated(&dir, "3");
     let exp = with_select(
         &dir,
-        "families = [\"gaussian\"]\norders = { torque = [[1, 0], [2, 0]], brake = [[1, 0], [2, 0], [2, 1]] }",
+        "families = [\"gaussian\"]\norders = { torque = [[1, 0], [2, 0]], brake = [[1, 0], [2, 1]] }",
     );
     let sel = json_of(&["select", &exp, "--data", s(&data), "--json"]);
     let candidates = sel["candidates"].as_array().unwrap();
-    assert_eq!(candidates.len(), 6, "{sel}");
+    assert_eq!(candidates.len(), 4, "{sel}");
     let best = &sel["best"];
     assert_eq!(best["converged"], true, "{best}");
     assert_eq!(
@@ -245,8 +245,12 @@ fn select_recovers_each_input_s_order() {
         (Some(3), Some(1))
     );
     assert!(best["estimates"]["torque.a0"].is_number(), "{best}");
-    // The table names each input's order.
-    let o = run(&["select", &exp, "--data", s(&data)]);
+    // The table names each input's order (one candidate, to keep the test short).
+    let one = with_select(
+        &dir,
+        "families = [\"none\"]\norders = { torque = [[1, 0]], brake = [[2, 1]] }",
+    );
+    let o = run(&["select", &one, "--data", s(&data)]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         stdout(&o).contains("torque 1/0, brake 2/1"),

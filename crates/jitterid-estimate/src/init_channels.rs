@@ -69,8 +69,8 @@ pub fn fit_channels(
                     y[k] - others
                 })
                 .collect();
-            let own = Record::new(grid.clone(), rest)
-                .map_err(|_| InitError::NonFinite { frequency: 0.0 })?;
+            let own =
+                Record::new(*grid, rest).map_err(|_| InitError::NonFinite { frequency: 0.0 })?;
             let fit = fit_rational(&own, c.input, jitter, c.zeros, c.poles, options)?;
             let model = TransferFunction::new(&fit.num, &fit.den)?;
             let m = LtiResponse::new(model, c.input.clone()).expected_values(grid, mean_of);

@@ -40,7 +40,6 @@ fn bench_select(c: &mut Criterion) {
         families: ["none", "gaussian", "periodic", "two-point"]
             .map(String::from)
             .to_vec(),
-        channels: Vec::new(),
     };
     let mut g = c.benchmark_group("select");
     g.sample_size(10);

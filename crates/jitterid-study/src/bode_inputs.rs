@@ -11,6 +11,9 @@ use jitterid::estimate::validation::BodePoint;
 use jitterid::signal::superposition::Superposition;
 use jitterid::signal::{Offset, SampleGrid, Signal};
 
+/// One input's name and frequency response.
+pub type InputResponse = (String, Vec<BodePoint>);
+
 /// Each input's frequency response `G_i(i2πf)` of the multi-input system `s`, with its
 /// delta-method band from the channel's block of the covariance `cov` (of the sum's
 /// parameters; a fixed channel has none); `None` when `s` has one input. `flag` names the
@@ -24,7 +27,7 @@ pub fn channel_responses(
     grid: &SampleGrid,
     cov: Option<&[Vec<f64>]>,
     flag: &str,
-) -> StudyResult<Option<Vec<(String, Vec<BodePoint>)>>> {
+) -> StudyResult<Option<Vec<InputResponse>>> {
     let Some(sum) = s.signal.downcast::<Offset<Superposition>>() else {
         return Ok(None);
     };

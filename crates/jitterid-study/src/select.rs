@@ -164,10 +164,11 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
     let jitters = &exp.registries.jitter;
     let ranked = budget
         .run(|| {
-            if grid.channels.is_empty() {
+            let orders = &exp.select_orders;
+            if orders.is_empty() {
                 run_select(&record, &inputs[0], &grid, jitters, &options)
             } else {
-                select_channels(&record, &inputs, &grid, jitters, &options)
+                select_channels(&record, &inputs, &grid, orders, jitters, &options)
             }
         })
         .map_err(|e| study_err!("{}: {e}", exp.file))?;

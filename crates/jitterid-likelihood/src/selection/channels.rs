@@ -1,12 +1,13 @@
 //! Selection for a system with several inputs: every combination of one order per input
-//! ([`SelectionGrid::channels`]) × jitter family, each candidate the superposition of one
+//! ([`ChannelOrders`]) × jitter family, each candidate the superposition of one
 //! transfer function per input, started by the multi-input initializer
 //! ([`fit_channels`]) and fitted jointly; screened and ranked exactly as one input's
 //! candidates are ([`super::select`]).
 
 use super::{
     bcls_from, check_fractions, fit_candidate, init_options, invalid, jitter_at, rank, with_offset,
-    Candidate, Label, SelectionError, SelectionGrid, SelectionOptions, Structure, MAX_CANDIDATES,
+    Candidate, ChannelOrders, Label, SelectionError, SelectionGrid, SelectionOptions, Structure,
+    MAX_CANDIDATES,
 };
 use jitterid_estimate::{fit_channels, ChannelOrder, Record};
 use jitterid_jitter::registry::JitterRegistry;
@@ -20,8 +21,8 @@ use serde_json::json;
 type Combination = (Vec<(usize, usize)>, String);
 
 impl SelectionGrid {
-    /// The combinations of a multi-input grid, one order per input in input order, for each
-    /// family; rejecting bad input by key: an input without orders, an order without poles or
+    /// The combinations of a multi-input grid, one order of `channels` per input in input
+    /// order, for each of the grid's families; rejecting bad input by key: an input without orders, an order without poles or
     /// with more zeros than poles (`orders`), an unknown family, more parameters than the
     /// record of `len` samples supports (`orders`), more than [`MAX_CANDIDATES`].
     ///
@@ -31,13 +32,14 @@ impl SelectionGrid {
     /// [`SelectionError::TooManyCandidates`].
     pub fn channel_candidates(
         &self,
+        channels: &[ChannelOrders],
         registry: &JitterRegistry,
         len: usize,
     ) -> Result<Vec<Combination>, SelectionError> {
-        if self.channels.is_empty() {
+        if channels.is_empty() {
             return Err(invalid("orders", "no input has candidate orders"));
         }
-        for c in &self.channels {
+        for c in channels {
             if c.orders.is_empty() {
                 return Err(invalid(
                     "orders",
@@ -55,8 +57,7 @@ impl SelectionGrid {
             }
         }
         self.check_families(registry)?;
-        let count = self
-            .channels
+        let count = channels
             .iter()
             .map(|c| c.orders.len())
             .try_fold(self.families.len(), usize::checked_mul)
@@ -65,7 +66,7 @@ impl SelectionGrid {
             return Err(SelectionError::TooManyCandidates { candidates: count });
         }
         // Each channel's linear fit needs 2n + m + 1 real equations from bins below N/2.
-        for c in &self.channels {
+        for c in channels {
             let needed = c
                 .orders
                 .iter()
@@ -83,7 +84,7 @@ impl SelectionGrid {
             }
         }
         let mut combos: Vec<Vec<(usize, usize)>> = vec![Vec::new()];
-        for c in &self.channels {
+        for c in channels {
             combos = combos
                 .into_iter()
                 .flat_map(|head| {
@@ -155,8 +156,8 @@ fn fit_from(
 }
 
 /// [`select`](super::select) for a system with several inputs: fits every combination of
-/// [`SelectionGrid::channel_candidates`] on `record`, driven by `inputs` (one per entry of
-/// [`SelectionGrid::channels`], in order), each candidate a superposition of one transfer
+/// [`SelectionGrid::channel_candidates`] of `grid`'s families and `channels` on `record`,
+/// driven by `inputs` (one per entry of `channels`, in order), each candidate a superposition of one transfer
 /// function per input (parameters `"{input}.b0"`, `"{input}.a0"`, …) with the options'
 /// output offset; ranked best first as one input's candidates are. A candidate's `poles` and
 /// `zeros` count all its channels'; `channels` gives them per input.
@@ -170,17 +171,18 @@ pub fn select_channels(
     record: &Record,
     inputs: &[Input],
     grid: &SelectionGrid,
+    channels: &[ChannelOrders],
     registry: &JitterRegistry,
     options: &SelectionOptions,
 ) -> Result<Vec<Candidate>, SelectionError> {
     check_fractions(options)?;
-    if inputs.len() != grid.channels.len() {
+    if inputs.len() != channels.len() {
         return Err(invalid(
             "inputs",
             format!(
                 "{} inputs for a grid of {} inputs",
                 inputs.len(),
-                grid.channels.len()
+                channels.len()
             ),
         ));
     }
@@ -190,8 +192,8 @@ pub fn select_channels(
             "the candidates of several inputs carry no input delay and no free response",
         ));
     }
-    let list = grid.channel_candidates(registry, record.y().len())?;
-    let names: Vec<String> = grid.channels.iter().map(|c| c.input.clone()).collect();
+    let list = grid.channel_candidates(channels, registry, record.y().len())?;
+    let names: Vec<String> = channels.iter().map(|c| c.input.clone()).collect();
     let budget = jitterid_numeric::budget::current();
     let out: Vec<Candidate> = list
         .into_par_iter()

@@ -64,13 +64,11 @@ pub struct SelectionGrid {
     pub zeros: (usize, usize),
     /// Jitter family names, as the registry knows them (`"none"` for no jitter).
     pub families: Vec<String>,
-    /// For a system with several inputs, each input's candidate orders (then `poles` and
-    /// `zeros` are not read): the candidates are every combination of one order per input,
-    /// each fitted jointly as a superposition ([`select_channels`]). Empty for one input.
-    pub channels: Vec<ChannelOrders>,
 }
 
-/// The candidate orders of one input of a multi-input system.
+/// The candidate orders of one input of a multi-input system: with one per input, the
+/// candidates of [`select_channels`] are every combination of one order per input (the
+/// grid's `poles` and `zeros` are then not read), each fitted jointly as a superposition.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChannelOrders {
     /// The input's name (the prefix of its channel's parameters).

@@ -33,7 +33,6 @@ fn grid(families: &[&str]) -> SelectionGrid {
         poles: (1, 2),
         zeros: (0, 1),
         families: families.iter().map(|s| s.to_string()).collect(),
-        channels: Vec::new(),
     }
 }
 
@@ -272,7 +271,6 @@ fn picks_the_true_order_and_family_of_jittered_records() {
         poles: (1, 3),
         zeros: (0, 0),
         families: ["none", "gaussian", "periodic"].map(String::from).to_vec(),
-        channels: Vec::new(),
     };
     // One record per family keeps the test inside CI's budget (each record fits 9 candidates);
     // `cargo xtask reproduce select` runs the 128-record study.
@@ -413,7 +411,7 @@ fn poles_on_the_axis_are_found_and_named() {
 fn an_output_offset_is_carried_into_every_candidate() {
     let (record, input) = record();
     let y: Vec<f64> = record.y().iter().map(|y| y + 1.5).collect();
-    let shifted = Record::new(record.grid().clone(), y).unwrap();
+    let shifted = Record::new(*record.grid(), y).unwrap();
     let run = |offset| {
         let options = SelectionOptions {
             offset,

@@ -301,7 +301,7 @@ pub fn parse_with(
             offset_seen(&cx, &raw, &system, &estimate.frequencies, &grid)?;
         }
     }
-    let select = match &raw.select {
+    let (select, select_orders) = match &raw.select {
         Some(r) => {
             // The inputs whose orders a multi-input grid lists; none for one input.
             let multi = system.kind.get(jitterid::signal::registry::KIND_KEY)
@@ -310,9 +310,10 @@ pub fn parse_with(
                 true => inputs.iter().map(|c| c.name.as_str()).collect(),
                 false => Vec::new(),
             };
-            Some(select::parse_select(&cx, r, grid.len(), &names)?)
+            let (grid, orders) = select::parse_select(&cx, r, grid.len(), &names)?;
+            (Some(grid), orders)
         }
-        None => None,
+        None => (None, Vec::new()),
     };
     let design = match &raw.design {
         Some(r) => {
@@ -339,6 +340,7 @@ pub fn parse_with(
         noise,
         estimate,
         select,
+        select_orders,
         design,
     })
 }

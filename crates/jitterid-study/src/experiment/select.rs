@@ -71,15 +71,15 @@ fn channel_orders(
 }
 
 /// The selection grid of `[select]` (defaults: 1–2 poles, 0–1 zeros, families `none` and
-/// `gaussian`), checked against the registry and the record length `len`. For a system with
-/// several inputs (`names`, in input order; empty for one input) each input's orders are its
-/// list in `orders`, or the `poles` × `zeros` ranges.
+/// `gaussian`), checked against the registry and the record length `len`, and for a system
+/// with several inputs (`names`, in input order; empty for one input) each input's orders:
+/// its list in `orders`, or the `poles` × `zeros` ranges (none for one input).
 pub(super) fn parse_select(
     cx: &Source,
     r: &RawSelect,
     len: usize,
     names: &[&str],
-) -> StudyResult<SelectionGrid> {
+) -> StudyResult<(SelectionGrid, Vec<ChannelOrders>)> {
     let poles = match &r.poles {
         Some(v) => range(cx, "poles", v)?,
         None => (1, 2),
@@ -108,16 +108,15 @@ pub(super) fn parse_select(
         poles,
         zeros,
         families,
-        channels,
     };
-    let checked = if grid.channels.is_empty() {
+    let checked = if channels.is_empty() {
         grid.candidates(&cx.registries.jitter, len).map(|_| ())
     } else {
-        grid.channel_candidates(&cx.registries.jitter, len)
+        grid.channel_candidates(&channels, &cx.registries.jitter, len)
             .map(|_| ())
     };
     let (key, message) = match checked {
-        Ok(()) => return Ok(grid),
+        Ok(()) => return Ok((grid, channels)),
         Err(SelectionError::InvalidKey { key, message }) => (key, message),
         Err(SelectionError::TooManyCandidates { candidates }) => (
             "orders",

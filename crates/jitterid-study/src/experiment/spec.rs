@@ -325,6 +325,9 @@ pub struct Experiment {
     pub estimate: EstimateSpec,
     /// The `[select]` grid of model orders and jitter families, when the file has one.
     pub select: Option<jitterid::estimate::selection::SelectionGrid>,
+    /// For a system with several inputs, each input's candidate orders of `[select]` (its
+    /// `orders`, or the grid's `poles` × `zeros`); empty for one input or without `[select]`.
+    pub select_orders: Vec<jitterid::estimate::selection::ChannelOrders>,
     /// The `[design]` section's free design variables, when the file has one.
     pub design: Option<super::DesignSpec>,
 }
