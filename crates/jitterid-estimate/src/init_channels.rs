@@ -21,7 +21,7 @@ pub const MAX_SWEEPS: usize = 20;
 
 /// The sweeps stop when no channel's expected samples change by more than this fraction of
 /// the record's RMS: far below the accuracy of a start (a few per cent, see
-/// [`crate::init`]), so the last sweep changes nothing a fit would notice.
+/// the initializer's module docs), so the last sweep changes nothing a fit would notice.
 const SETTLED: f64 = 1e-6;
 
 /// One channel of [`fit_channels`]: the input as the channel's system sees it (delayed by its

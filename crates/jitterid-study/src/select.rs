@@ -258,7 +258,7 @@ fn delayed_input(input: &Input, delay: Option<f64>) -> Result<Input, String> {
 /// start of `fit --init auto`. Only the model's own keys change; a delay or an initial state
 /// keeps the experiment's value, and the initializer sees the input delayed by that delay. A
 /// system with several inputs starts every estimated channel from the multi-input initializer
-/// ([`crate::rational_start::channels_start`]).
+/// ([`jitterid::estimate::fit_channels`]).
 pub fn auto_start(
     exp: &Experiment,
     signal: &AnySignal,

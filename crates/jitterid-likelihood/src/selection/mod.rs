@@ -98,7 +98,7 @@ pub struct SelectionOptions {
     /// The record's output offset `(y₀, estimated)` every candidate carries (the keys `offset`
     /// and `estimate_offset` of its spec table): a known `y₀` is part of each candidate's model,
     /// an estimated one is the parameter `offset`, started at `mean(y) − mean(m_k)` for the
-    /// candidate's initial system ([`offset_start`](jitterid_estimate::offset_start)). Without
+    /// candidate's initial system ([`offset_start`]). Without
     /// it a record around an operating point would be ranked by how well each order's DC gain
     /// and slow poles imitate a constant. `None`: no offset.
     pub offset: Option<(f64, bool)>,
