@@ -210,14 +210,121 @@ fn bad_multi_input_files_exit_2_naming_the_problem() {
     );
 }
 
+/// The two-input example with `select` appended to it, in `dir`.
+fn with_select(dir: &Path, select: &str) -> String {
+    let text = std::fs::read_to_string(example("two-input.toml")).unwrap();
+    let exp = dir.join("e.toml");
+    std::fs::write(&exp, format!("{text}\n[select]\n{select}\n")).unwrap();
+    s(&exp).to_string()
+}
+
+/// `select` over each input's order on a seeded two-input record: the joint candidates of
+/// (1 or 2 poles) for torque × (1 pole, or 2 poles and a zero) for brake, and the true pair
+/// (torque 1/0, brake 2/1) ranks first.
 #[test]
-fn select_and_the_initializer_say_they_take_one_input() {
-    let dir = scratch_in("jitterid-multi-input", "refusals");
+fn select_recovers_each_input_s_order() {
+    let dir = scratch_in("jitterid-multi-input", "select");
+    let data = simulated(&dir, "3");
+    let exp = with_select(
+        &dir,
+        "families = [\"gaussian\"]\norders = { torque = [[1, 0], [2, 0]], brake = [[1, 0], [2, 1]] }",
+    );
+    let sel = json_of(&["select", &exp, "--data", s(&data), "--json"]);
+    let candidates = sel["candidates"].as_array().unwrap();
+    assert_eq!(candidates.len(), 4, "{sel}");
+    let best = &sel["best"];
+    assert_eq!(best["converged"], true, "{best}");
+    assert_eq!(
+        best["orders"]["torque"],
+        serde_json::json!([1, 0]),
+        "{best}"
+    );
+    assert_eq!(best["orders"]["brake"], serde_json::json!([2, 1]), "{best}");
+    assert_eq!(
+        (best["poles"].as_u64(), best["zeros"].as_u64()),
+        (Some(3), Some(1))
+    );
+    assert!(best["estimates"]["torque.a0"].is_number(), "{best}");
+    // The table names each input's order (one candidate, to keep the test short).
+    let one = with_select(
+        &dir,
+        "families = [\"none\"]\norders = { torque = [[1, 0]], brake = [[2, 1]] }",
+    );
+    let o = run(&["select", &one, "--data", s(&data)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("torque 1/0, brake 2/1"),
+        "{}",
+        stdout(&o)
+    );
+}
+
+/// Bad multi-input grids exit 2 naming the key: an unknown input, too many candidates, an
+/// `orders` for a single input, a channel select cannot carry.
+#[test]
+fn bad_multi_input_grids_exit_2_naming_the_key() {
+    let dir = scratch_in("jitterid-multi-input", "select-bad");
     let data = simulated(&dir, "0");
-    let exp = example("two-input.toml");
-    let o = run(&["fit", &exp, "--data", s(&data), "--init", "auto"]);
+    let refused = |select: &str| {
+        let exp = with_select(&dir, select);
+        let o = run(&["select", &exp, "--data", s(&data)]);
+        assert_eq!(o.status.code(), Some(2), "{select}: {}", stdout(&o));
+        stderr(&o)
+    };
+    let e = refused("orders = { wheel = [[1, 0]] }");
+    assert!(
+        e.contains("[select] orders") && e.contains("`wheel`"),
+        "{e}"
+    );
+    let e = refused("poles = [1, 4]\nzeros = [0, 3]\nfamilies = [\"none\", \"gaussian\"]");
+    assert!(
+        e.contains("[select] orders") && e.contains("at most 64"),
+        "{e}"
+    );
+    let e = refused("orders = { torque = [[0, 0]] }");
+    assert!(e.contains("[select] orders") && e.contains("torque"), "{e}");
+    let one = dir.join("one.toml");
+    let text = std::fs::read_to_string(example("offset.toml")).unwrap();
+    std::fs::write(
+        &one,
+        format!("{text}\n[select]\norders = {{ u = [[1, 0]] }}\n"),
+    )
+    .unwrap();
+    let o = run(&["select", s(&one), "--data", s(&data)]);
     assert_eq!(o.status.code(), Some(2), "{}", stdout(&o));
-    assert!(stderr(&o).contains("several inputs"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("[select] orders"), "{}", stderr(&o));
+    let text = std::fs::read_to_string(example("two-input.toml")).unwrap();
+    let delayed = text.replacen("den = [1.0, 0.5]", "den = [1.0, 0.5]\ndelay = 0.5", 1);
+    let exp = dir.join("delayed.toml");
+    std::fs::write(
+        &exp,
+        format!("{delayed}\n[select]\nfamilies = [\"none\"]\n"),
+    )
+    .unwrap();
+    let o = run(&["select", s(&exp), "--data", s(&data)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stdout(&o));
+    assert!(stderr(&o).contains("[[system]] delay"), "{}", stderr(&o));
+}
+
+/// `fit --init auto` of the two-input example: the multi-input initializer's start, far from
+/// nothing but the record, converges to the optimum the fit from the truth reaches (to the
+/// solver's tolerance, well inside a hundredth of each standard error).
+#[test]
+fn init_auto_reaches_the_fit_from_the_truth() {
+    let dir = scratch_in("jitterid-multi-input", "init-auto");
+    let data = simulated(&dir, "5");
+    let exp = example("two-input.toml");
+    let from_truth = json_of(&["fit", &exp, "--data", s(&data), "--json"]);
+    let auto = json_of(&["fit", &exp, "--data", s(&data), "--init", "auto", "--json"]);
+    assert_eq!(auto["converged"], true, "{auto}");
+    for (name, _) in TRUTH {
+        let (a, se) = param(&from_truth, name);
+        let (b, _) = param(&auto, name);
+        assert!(
+            (a - b).abs() < 0.01 * se,
+            "{name}: {a} from the truth, {b} from auto (se {se})"
+        );
+    }
 }
 
 /// The worked example (`docs/walkthrough-inputs.md`): one grey-box model with a column of `B`
@@ -275,4 +382,46 @@ fn a_grey_box_with_a_column_per_input_shares_its_parameters() {
         e.contains("[system] b") && e.contains("expected 2 entries"),
         "{e}"
     );
+}
+
+/// `validate --bode` of the two-input example writes each input's frequency response, the
+/// columns of one input's after `input`: at the lowest frequency each magnitude is its true
+/// transfer function's within 2 of its band's σ (the band is ±2σ, so within the band), and the
+/// two inputs' responses differ as their systems do.
+#[test]
+fn validate_bode_writes_one_response_per_input() {
+    let dir = scratch_in("jitterid-multi-input", "bode");
+    let data = simulated(&dir, "3");
+    let bode = dir.join("b.csv");
+    let exp = example("two-input.toml");
+    let o = run(&["validate", &exp, "--data", s(&data), "--bode", s(&bode)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(&bode).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("input,f_hz,omega_rad_s,magnitude_db,phase_deg,magnitude_db_lo,magnitude_db_hi,phase_deg_lo,phase_deg_hi")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 400, "200 frequencies per input");
+    let first = |input: &str| rows.iter().find(|r| r[0] == input).unwrap().clone();
+    let num = |r: &[&str], i: usize| r[i].parse::<f64>().unwrap();
+    // |G(i2πf)| of the truth at f = 1/(NT) = 1/400 Hz.
+    let w = std::f64::consts::TAU / 400.0;
+    let torque = 0.5 / (w * w + 0.25f64).sqrt();
+    let brake = {
+        let n = (0.2 * 0.2 * (w * w + 0.25)).sqrt();
+        let (re, im) = (0.1525 - w * w, 0.5 * w);
+        n / (re * re + im * im).sqrt()
+    };
+    for (input, truth) in [("torque", torque), ("brake", brake)] {
+        let r = first(input);
+        let (db, lo, hi) = (num(&r, 3), num(&r, 5), num(&r, 6));
+        let want = 20.0 * truth.log10();
+        assert!(lo < db && db < hi, "{input}: {r:?}");
+        assert!(
+            (db - want).abs() <= hi - lo,
+            "{input}: {db} dB, truth {want} dB, band [{lo}, {hi}]"
+        );
+    }
 }

@@ -237,3 +237,34 @@ fn init_auto_starts_the_offset_from_the_record() {
         assert!((a - b).abs() < 1e-3 * se, "{name}: {a} vs {b} (± {se})");
     }
 }
+
+/// `select` carries the estimated offset into every candidate: on a record of `offset.toml`
+/// (y₀ = 1.5, 150 times the noise) the true order wins and its offset is recovered; the
+/// candidates' parameters include it.
+#[test]
+fn select_carries_the_offset_into_every_candidate() {
+    let dir = scratch_in("jitterid-offset", "select");
+    let text = std::fs::read_to_string(example("offset.toml")).unwrap();
+    let exp = dir.join("e.toml");
+    std::fs::write(&exp, format!("{text}\n[select]\npoles = [1, 2]\n")).unwrap();
+    let data = dir.join("d.csv");
+    let o = run(&["simulate", s(&exp), "--run", "4", "--out", s(&data)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["select", s(&exp), "--data", s(&data), "--json"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let sel: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let best = &sel["best"];
+    assert_eq!(
+        (best["poles"].as_u64(), best["zeros"].as_u64()),
+        (Some(2), Some(1)),
+        "{best}"
+    );
+    // The offset's standard error on such a record is about 0.002 (the fit's, see above).
+    let y0 = best["estimates"]["offset"].as_f64().unwrap();
+    assert!((y0 - 1.5).abs() < 0.01, "offset {y0}");
+    for c in sel["candidates"].as_array().unwrap() {
+        if c["failure_kind"].is_null() {
+            assert!(c["estimates"]["offset"].is_number(), "{c}");
+        }
+    }
+}

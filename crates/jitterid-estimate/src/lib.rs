@@ -67,6 +67,7 @@ mod fit_criterion;
 mod flatness;
 mod frequency_data;
 mod init;
+mod init_channels;
 mod jitter_floor;
 mod joint;
 mod likelihood_error;
@@ -97,6 +98,7 @@ pub use init::{
     fit_rational, initial_model, initialize, offset_start, InitError, InitOptions, InitialModel,
     RationalFit,
 };
+pub use init_channels::{fit_channels, ChannelOrder};
 pub use jitter_floor::{mean_jitter_variance, JITTER_FLOOR_ROUNDS};
 /// The optimisation layer (`jitterid-optim`): objectives, least squares, solvers.
 pub use jitterid_optim as solver;

@@ -28,6 +28,7 @@
 //! reports progress through [`Watch`] hooks that a front end draws as it likes.
 #![warn(missing_docs)]
 
+pub mod bode_inputs;
 pub mod csvio;
 pub mod design;
 pub mod error;
@@ -41,6 +42,7 @@ pub mod likelihood_start;
 pub mod merge;
 pub mod montecarlo;
 pub mod notes;
+mod rational_start;
 pub mod records;
 mod registries;
 pub mod residual_tests;

@@ -10,13 +10,15 @@
 use crate::error::StudyResult;
 use crate::experiment::Experiment;
 use crate::fit;
+use crate::rational_start::Template;
 use crate::records::{read_data, read_input};
 use crate::study_err;
-use jitterid::estimate::selection::{select as run_select, Candidate, SelectionOptions};
-use jitterid::estimate::{initial_model, InitError, InitOptions};
+use jitterid::estimate::selection::{
+    select as run_select, select_channels, Candidate, SelectionOptions,
+};
+use jitterid::estimate::{fit_rational, InitOptions};
 use jitterid::jitter::JitterModel;
-use jitterid::signal::registry::{roots_json, SpecTable};
-use jitterid::signal::{AnySignal, Input, Root, TransferFunction, Zpk};
+use jitterid::signal::{AnySignal, Input};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -36,7 +38,7 @@ pub fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
         .iter()
         .map(|(n, v)| (n.clone(), json!(v)))
         .collect();
-    json!({
+    let mut doc = json!({
         "poles": c.poles,
         "zeros": c.zeros,
         "family": c.family,
@@ -51,7 +53,28 @@ pub fn candidate_json(c: &Candidate, validation: Option<f64>) -> Value {
         "validation_fit_percent": validation,
         "failure": c.failure,
         "failure_kind": c.failure_kind,
-    })
+    });
+    // A multi-input candidate's order per input (its `poles` and `zeros` are the totals).
+    if !c.channels.is_empty() {
+        let orders: serde_json::Map<String, Value> = c
+            .channels
+            .iter()
+            .map(|(n, p, z)| (n.clone(), json!([p, z])))
+            .collect();
+        doc["orders"] = Value::Object(orders);
+    }
+    doc
+}
+
+/// A multi-input candidate's orders as `torque 1/0, brake 2/1` (input, poles/zeros), for a
+/// table; `None` for one input's.
+pub fn orders_text(c: &Candidate) -> Option<String> {
+    let parts: Vec<String> = c
+        .channels
+        .iter()
+        .map(|(n, p, z)| format!("{n} {p}/{z}"))
+        .collect();
+    (!parts.is_empty()).then(|| parts.join(", "))
 }
 
 /// A finished selection: the candidates ranked, best first.
@@ -96,33 +119,39 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
     })?;
     let table = read_data(exp, data)?;
     exp.selectable()?;
-    let input: Input = read_input(exp, data, None)?
-        .into_iter()
-        .next()
-        .ok_or_else(|| {
-            study_err!(
-                "{}: [input]: selection needs an input to identify a system",
-                exp.file
-            )
-        })?;
+    let inputs = read_input(exp, data, None)?;
+    if inputs.is_empty() {
+        return Err(study_err!(
+            "{}: [input]: selection needs an input to identify a system",
+            exp.file
+        ));
+    }
     let record = fit::record(&exp.grid, table.y).map_err(|e| study_err!("{}: {e}", table.name))?;
     // The candidates carry the system's delay (a parameter when the system is estimated,
-    // else the input is delayed by it) and, with `initial = "estimate"`, a free response.
+    // else the input is delayed by it), with `initial = "estimate"` a free response, and the
+    // output offset of `[output]` (known, or estimated with each candidate).
     let delay = exp.system.kind.get("delay").and_then(Value::as_f64);
     let known_delay = delay.filter(|_| !exp.system.estimate);
-    let delay_err = |e: String| study_err!("{}: [system] delay: {e}", exp.file);
-    let input = delayed_input(&input, known_delay).map_err(delay_err)?;
+    let delayed = |inputs: Vec<Input>| -> StudyResult<Vec<Input>> {
+        inputs
+            .iter()
+            .map(|i| delayed_input(i, known_delay))
+            .collect::<Result<_, _>>()
+            .map_err(|e| study_err!("{}: [system] delay: {e}", exp.file))
+    };
+    let inputs = delayed(inputs)?;
     let options = SelectionOptions {
         delay: delay.filter(|_| exp.system.estimate),
         initial_state: exp.system.kind.contains_key("initial"),
+        offset: exp.output_offset(),
         ..SelectionOptions::default()
     };
     let validation = match validation {
         Some(path) => {
             let t = read_data(exp, path)?;
-            let vi = match read_input(exp, path, None)?.into_iter().next() {
-                Some(vi) => delayed_input(&vi, known_delay).map_err(delay_err)?,
-                None => input.clone(),
+            let vi = match read_input(exp, path, None)? {
+                vi if vi.is_empty() => inputs.clone(),
+                vi => delayed(vi)?,
             };
             let r = fit::record(&exp.grid, t.y).map_err(|e| study_err!("{}: {e}", t.name))?;
             Some((r, vi))
@@ -132,8 +161,16 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
     // The whole selection under the command's time limit: candidates still fitting when it is
     // spent stop, and a ranking of unfinished fits is no ranking.
     let budget = crate::budget_of(exp, None);
+    let jitters = &exp.registries.jitter;
     let ranked = budget
-        .run(|| run_select(&record, &input, &grid, &exp.registries.jitter, &options))
+        .run(|| {
+            let orders = &exp.select_orders;
+            if orders.is_empty() {
+                run_select(&record, &inputs[0], &grid, jitters, &options)
+            } else {
+                select_channels(&record, &inputs, &grid, orders, jitters, &options)
+            }
+        })
         .map_err(|e| study_err!("{}: {e}", exp.file))?;
     if let Some(stop) = budget.stop() {
         return Err(study_err!(
@@ -206,24 +243,6 @@ impl InitChoice {
     }
 }
 
-fn roots_of(spec: &SpecTable, key: &str) -> Option<Vec<Root>> {
-    let Some(v) = spec.get(key) else {
-        return Some(Vec::new());
-    };
-    v.as_array()?
-        .iter()
-        .map(|r| Root::from_json(r).ok())
-        .collect()
-}
-
-fn f64s(spec: &SpecTable, key: &str) -> Option<Vec<f64>> {
-    spec.get(key)?
-        .as_array()?
-        .iter()
-        .map(Value::as_f64)
-        .collect()
-}
-
 /// `input` delayed by `delay` seconds: what drives the rational part of a system with an input
 /// delay. The initializer fits the frequency response from this input to the output, so that
 /// the rational model it returns does not carry the delay's phase a second time.
@@ -235,9 +254,11 @@ fn delayed_input(input: &Input, delay: Option<f64>) -> Result<Input, String> {
 }
 
 /// The experiment's system with its rational model replaced by the data-driven initializer's
-/// ([`initial_model`], the jitter's damping compensated with the experiment's jitter): the
+/// ([`fit_rational`], the jitter's damping compensated with the experiment's jitter): the
 /// start of `fit --init auto`. Only the model's own keys change; a delay or an initial state
-/// keeps the experiment's value, and the initializer sees the input delayed by that delay.
+/// keeps the experiment's value, and the initializer sees the input delayed by that delay. A
+/// system with several inputs starts every estimated channel from the multi-input initializer
+/// ([`jitterid::estimate::fit_channels`]).
 pub fn auto_start(
     exp: &Experiment,
     signal: &AnySignal,
@@ -246,10 +267,7 @@ pub fn auto_start(
     data: &str,
 ) -> StudyResult<AnySignal> {
     if exp.multi_input() {
-        return Err(study_err!(
-            "{}: --init auto: the initializer fits a single-input system's frequency response; a system with several inputs starts from the experiment's values (--init experiment)",
-            exp.file
-        ));
+        return crate::rational_start::channels_start(exp, signal, inputs, y, data);
     }
     let input = inputs.first().ok_or_else(|| {
         study_err!(
@@ -267,38 +285,15 @@ pub fn auto_start(
         offset: spec.get("estimate_offset") == Some(&Value::Bool(true)),
         ..InitOptions::default()
     };
-    let init_err = |e: InitError| study_err!("{data}: --init auto: the initializer failed: {e}");
     let driven = delayed_input(input, spec.get("delay").and_then(Value::as_f64))
         .map_err(|e| study_err!("{}: [system] delay: {e}", exp.file))?;
-    match signal.kind() {
-        "tf" => {
-            let (num, den) = f64s(&spec, "num")
-                .zip(f64s(&spec, "den"))
-                .ok_or_else(|| study_err!("{}: [system] num, den: not numbers", exp.file))?;
-            let tf = TransferFunction::new(&num, &den)
-                .map_err(|e| study_err!("{}: [system]: {e}", exp.file))?;
-            let g = initial_model(&tf, &record, &driven, Some(jitter), &opts).map_err(init_err)?;
-            spec.insert("num".into(), json!(g.num()));
-            spec.insert("den".into(), json!(g.den()));
-        }
-        "zpk" => {
-            let (zeros, poles) = roots_of(&spec, "zeros")
-                .zip(roots_of(&spec, "poles"))
-                .ok_or_else(|| study_err!("{}: [system] zeros, poles: not roots", exp.file))?;
-            let zpk =
-                Zpk::new(1.0, zeros, poles).map_err(|e| study_err!("{}: [system]: {e}", exp.file))?;
-            let g = initial_model(&zpk, &record, &driven, Some(jitter), &opts).map_err(init_err)?;
-            spec.insert("gain".into(), json!(g.gain()));
-            spec.insert("zeros".into(), roots_json(g.zeros()));
-            spec.insert("poles".into(), roots_json(g.poles()));
-        }
-        other => {
-            return Err(study_err!(
-                "{}: --init auto: the initializer fits rational systems (kind tf or zpk), not `{other}`",
-                exp.file
-            ))
-        }
-    }
+    let template = Template::of(signal.kind(), &spec, &format!("{}: [system]", exp.file))?;
+    let (zeros, poles) = template.orders();
+    let g = fit_rational(&record, &driven, Some(jitter), zeros, poles, &opts)
+        .map_err(|e| study_err!("{data}: --init auto: the initializer failed: {e}"))?;
+    template
+        .write(&g, &mut spec)
+        .map_err(|e| study_err!("{data}: {e}"))?;
     exp.registries
         .signal
         .build(&spec, Some(input))

@@ -351,7 +351,11 @@ pub fn validation_grid(
 /// the `initial.*` coefficients of a free response and the output `offset`, on which
 /// `G e^{−sD}` does not depend). `None` without a covariance.
 fn system_covariance(s: &Structure, cov: Option<&[Vec<f64>]>) -> Option<Vec<Vec<f64>>> {
-    let names = s.signal.param_names();
+    system_block(&s.signal.param_names(), cov)
+}
+
+/// [`system_covariance`] of a signal whose parameters are `names`.
+pub(crate) fn system_block(names: &[String], cov: Option<&[Vec<f64>]>) -> Option<Vec<Vec<f64>>> {
     let p = names
         .iter()
         .take_while(|n| {
@@ -373,10 +377,15 @@ pub fn frequency_response(
     flag: &str,
 ) -> StudyResult<Option<Vec<BodePoint>>> {
     let cov = system_covariance(s, cov);
-    let freqs = validation::log_spaced(1.0 / grid.duration(), 0.5 / grid.interval(), 200)
-        .map_err(|e| study_err!("{flag}: {e}"))?;
+    let freqs = bode_frequencies(grid, flag)?;
     export::bode_of(&s.signal, &freqs, cov.as_deref())
         .transpose()
+        .map_err(|e| study_err!("{flag}: {e}"))
+}
+
+/// The frequencies of a Bode diagram on `grid`: 200 log-spaced from `1/(NT)` to `1/(2T)`.
+pub(crate) fn bode_frequencies(grid: &SampleGrid, flag: &str) -> StudyResult<Vec<f64>> {
+    validation::log_spaced(1.0 / grid.duration(), 0.5 / grid.interval(), 200)
         .map_err(|e| study_err!("{flag}: {e}"))
 }
 
@@ -422,24 +431,32 @@ pub fn step_response(
         .map_err(|e| study_err!("{what}: step response: {e}"))
 }
 
+/// The columns of the frequency-response CSV.
+pub(crate) const BODE_COLUMNS: &str =
+    "f_hz,omega_rad_s,magnitude_db,phase_deg,magnitude_db_lo,magnitude_db_hi,phase_deg_lo,phase_deg_hi";
+
+/// One row of the frequency-response CSV, without its line end.
+pub(crate) fn bode_row(p: &BodePoint) -> String {
+    let o = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
+    format!(
+        "{:e},{:e},{:e},{:e},{},{},{},{}",
+        p.f_hz,
+        p.omega_rad_s,
+        p.magnitude_db,
+        p.phase_deg,
+        o(p.magnitude_db_lo),
+        o(p.magnitude_db_hi),
+        o(p.phase_deg_lo),
+        o(p.phase_deg_hi)
+    )
+}
+
 /// The frequency-response CSV of `points`.
 pub fn bode_csv(points: &[BodePoint]) -> String {
-    let o = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
-    let mut out = String::from(
-        "f_hz,omega_rad_s,magnitude_db,phase_deg,magnitude_db_lo,magnitude_db_hi,phase_deg_lo,phase_deg_hi\n",
-    );
+    let mut out = format!("{BODE_COLUMNS}\n");
     for p in points {
-        out.push_str(&format!(
-            "{:e},{:e},{:e},{:e},{},{},{},{}\n",
-            p.f_hz,
-            p.omega_rad_s,
-            p.magnitude_db,
-            p.phase_deg,
-            o(p.magnitude_db_lo),
-            o(p.magnitude_db_hi),
-            o(p.phase_deg_lo),
-            o(p.phase_deg_hi)
-        ));
+        out.push_str(&bode_row(p));
+        out.push('\n');
     }
     out
 }

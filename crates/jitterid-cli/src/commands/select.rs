@@ -11,7 +11,7 @@ use crate::output::OutputSet;
 use jitterid_study::error::StudyResult;
 use jitterid_study::experiment::{Purpose, ReadOptions};
 use jitterid_study::records::read_experiment;
-use jitterid_study::select::select as run_selection;
+use jitterid_study::select::{orders_text, select as run_selection};
 use jitterid_study::study_err;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -67,16 +67,24 @@ pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
     let mut out = format!("selection on {} ({})\n", selection.data, exp.file);
     // The two criteria are on different scales, so each has its column: the screen's BCLS BIC
     // (every candidate) and the final exact likelihood's BIC (the finalists, which rank first).
+    // Several inputs: the poles and zeros are totals, and the last column each input's.
+    let orders = |c| orders_text(c).map_or(String::new(), |t| format!("  {t}"));
+    let multi = ranked.iter().any(|c| orders_text(c).is_some());
     let _ = writeln!(
         out,
-        "{:>5}  {:>5}  {:<14}  {:>16}  {:>16}  {:>9}  {:>14}",
+        "{:>5}  {:>5}  {:<14}  {:>16}  {:>16}  {:>9}  {:>14}{}",
         "poles",
         "zeros",
         "family",
         "screen BCLS BIC",
         "final ML BIC",
         "converged",
-        "validation fit"
+        "validation fit",
+        if multi {
+            "  orders (input poles/zeros)"
+        } else {
+            ""
+        }
     );
     for (c, f) in ranked.iter().zip(fits) {
         let final_bic = c
@@ -85,14 +93,15 @@ pub fn select(o: &SelectOptions) -> StudyResult<Outcome> {
             .map_or("–".into(), |b| format!("{b:.4}"));
         let _ = writeln!(
             out,
-            "{:>5}  {:>5}  {:<14}  {:>16.4}  {:>16}  {:>9}  {:>14}",
+            "{:>5}  {:>5}  {:<14}  {:>16.4}  {:>16}  {:>9}  {:>14}{}",
             c.poles,
             c.zeros,
             c.family,
             c.bcls_criterion,
             final_bic,
             if c.converged { "yes" } else { "no" },
-            f.map_or("–".into(), |v| format!("{v:.2} %"))
+            f.map_or("–".into(), |v| format!("{v:.2} %")),
+            orders(c)
         );
     }
     Ok(Outcome { text: out, status })

@@ -6,12 +6,13 @@ use crate::exit::Outcome;
 use crate::output::OutputSet;
 use crate::plots::{self, RecordPlot, ValidatePlots};
 use jitterid::estimate::validation::CorrelationTest;
+use jitterid_study::bode_inputs::bode_text;
 use jitterid_study::error::StudyResult;
 use jitterid_study::experiment::{self, Experiment, Purpose, ReadOptions};
 use jitterid_study::fit::Structure;
 use jitterid_study::study_err;
 use jitterid_study::validate::{
-    bode_csv, frequency_response, step, validate as run_validation, RecordReport,
+    frequency_response, step, validate as run_validation, RecordReport,
     ValidateOptions as StudyValidateOptions, ValidatedRecord, Validation,
 };
 use jitterid_study::Watch;
@@ -105,16 +106,8 @@ pub fn validate(o: &ValidateOptions) -> StudyResult<Outcome> {
     )?;
     let mut outputs = OutputSet::new();
     if let Some(path) = &o.bode {
-        if exp.multi_input() {
-            return Err(study_err!(
-                "--bode: a system with several inputs has one frequency response per input, which --bode does not write yet; fit --json gives each input's transfer function (model.inputs)"
-            ));
-        }
-        let points = frequency_response(&v.fitted, &exp.grid, v.covariance.as_deref(), "--bode")?
-            .ok_or_else(|| {
-            study_err!("--bode: the system is not a rational transfer function")
-        })?;
-        outputs.file(path, bode_csv(&points));
+        let text = bode_text(&v.fitted, &exp.grid, v.covariance.as_deref(), "--bode")?;
+        outputs.file(path, text);
     }
     if let Some(dir) = &o.plot {
         stage_figures(

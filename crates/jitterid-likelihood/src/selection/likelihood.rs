@@ -122,7 +122,12 @@ pub(super) fn starts(
         return out;
     }
     for (i, c) in candidates.iter().enumerate() {
-        let same_order = (c.poles, c.zeros) == (candidates[w].poles, candidates[w].zeros);
+        let same_order = (c.poles, c.zeros, &c.channels)
+            == (
+                candidates[w].poles,
+                candidates[w].zeros,
+                &candidates[w].channels,
+            );
         if !same_order || c.family == candidates[w].family || c.family == "none" {
             continue;
         }

@@ -46,9 +46,14 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use crate::validation::{fit_percent, on_record};
-use jitterid_estimate::{fit, initialize, Bcls, FitOptions, InitOptions, ModelStructure, Record};
+use jitterid_estimate::{
+    fit, initialize, offset_start, Bcls, FitOptions, InitOptions, ModelStructure, Record,
+};
 
+mod channels;
 mod likelihood;
+
+pub use channels::select_channels;
 
 /// A rectangular grid of candidate model orders and jitter families.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,6 +64,17 @@ pub struct SelectionGrid {
     pub zeros: (usize, usize),
     /// Jitter family names, as the registry knows them (`"none"` for no jitter).
     pub families: Vec<String>,
+}
+
+/// The candidate orders of one input of a multi-input system: with one per input, the
+/// candidates of [`select_channels`] are every combination of one order per input (the
+/// grid's `poles` and `zeros` are then not read), each fitted jointly as a superposition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelOrders {
+    /// The input's name (the prefix of its channel's parameters).
+    pub input: String,
+    /// Its candidate orders, `(poles, zeros)`.
+    pub orders: Vec<(usize, usize)>,
 }
 
 /// Settings of [`select`].
@@ -79,6 +95,13 @@ pub struct SelectionOptions {
     /// Whether every candidate carries the free response from an unknown state at the record's
     /// first instant (parameters `initial.0 … initial.{n−1}` for `n` poles, started at 0).
     pub initial_state: bool,
+    /// The record's output offset `(y₀, estimated)` every candidate carries (the keys `offset`
+    /// and `estimate_offset` of its spec table): a known `y₀` is part of each candidate's model,
+    /// an estimated one is the parameter `offset`, started at `mean(y) − mean(m_k)` for the
+    /// candidate's initial system ([`offset_start`]). Without
+    /// it a record around an operating point would be ranked by how well each order's DC gain
+    /// and slow poles imitate a constant. `None`: no offset.
+    pub offset: Option<(f64, bool)>,
 }
 
 impl Default for SelectionOptions {
@@ -88,6 +111,7 @@ impl Default for SelectionOptions {
             refine_by_likelihood: true,
             delay: None,
             initial_state: false,
+            offset: None,
         }
     }
 }
@@ -95,10 +119,12 @@ impl Default for SelectionOptions {
 /// One fitted (or failed) candidate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Candidate {
-    /// Number of poles.
+    /// Number of poles (of a multi-input candidate: of all its channels).
     pub poles: usize,
-    /// Number of zeros.
+    /// Number of zeros (of a multi-input candidate: of all its channels).
     pub zeros: usize,
+    /// A multi-input candidate's order per input, `(input, poles, zeros)`; empty for one input.
+    pub channels: Vec<(String, usize, usize)>,
     /// Jitter family name.
     pub family: String,
     /// The information criterion the candidate is ranked by: the exact likelihood's BIC if
@@ -162,16 +188,25 @@ impl Candidate {
     /// delay is kept. A candidate with a free response starts from the validation record's own
     /// state, re-estimated on that record with everything else held
     /// ([`on_record`], as `jitterid validate` does): the
-    /// estimation record's state says nothing about another record's. `None` for a failed
+    /// estimation record's state says nothing about another record's. A multi-input
+    /// candidate is driven by `inputs`, one per input; one input's by the first. `None` for a failed
     /// candidate, where that re-estimation or the rebuilt model fails, or where the fit percent
     /// is undefined (constant data).
-    pub fn validation_fit(&self, record: &Record, input: &Input) -> Option<f64> {
+    pub fn validation_fit(&self, record: &Record, inputs: &[Input]) -> Option<f64> {
         let (signal, jitter) = self.fitted.as_ref()?;
-        let fitted = ModelStructure::oe(signal.clone(), jitter.clone());
-        let carried = on_record(&fitted, record.grid(), record.y(), Some(input)).ok()?;
-        let m = carried
-            .signal
-            .expected_values(record.grid(), &carried.jitter);
+        let m = if self.channels.is_empty() {
+            let fitted = ModelStructure::oe(signal.clone(), jitter.clone());
+            let carried = on_record(&fitted, record.grid(), record.y(), inputs.first()).ok()?;
+            carried
+                .signal
+                .expected_values(record.grid(), &carried.jitter)
+        } else {
+            // A multi-input candidate has no free response: only its inputs change.
+            let registry = SignalRegistry::builtin();
+            jitterid_signal::superposition::build(registry, &signal.spec(), inputs)
+                .ok()?
+                .expected_values(record.grid(), jitter)
+        };
         fit_percent(record.y(), &m).ok()
     }
 }
@@ -188,7 +223,19 @@ pub enum SelectionError {
         /// What is wrong.
         message: String,
     },
+    /// A multi-input grid whose combinations of orders and families exceed
+    /// [`MAX_CANDIDATES`].
+    #[error("select.orders: {candidates} candidates (the product of each input's orders and the families), at most {MAX_CANDIDATES}: list fewer orders per input")]
+    TooManyCandidates {
+        /// The grid's number of candidates.
+        candidates: usize,
+    },
 }
+
+/// Most candidates of a multi-input grid: each is a joint fit of every channel, and the
+/// product of the inputs' order lists grows fast (four orders for each of three inputs and two
+/// families are 128 fits).
+pub const MAX_CANDIDATES: usize = 64;
 
 fn invalid(key: &'static str, message: impl Into<String>) -> SelectionError {
     SelectionError::InvalidKey {
@@ -227,6 +274,30 @@ impl SelectionGrid {
                 format!("at least {z0} zeros but at most {p1} poles: no proper model"),
             ));
         }
+        self.check_families(registry)?;
+        // Levy's linear fit needs 2n + m + 1 real equations from bins below N/2.
+        let needed = 2 * p1 + p1.min(z1) + 2;
+        if needed > len {
+            return Err(invalid(
+                "poles",
+                format!("{p1} poles need at least {needed} samples; the record has {len}"),
+            ));
+        }
+        let mut out = Vec::new();
+        for poles in p0..=p1 {
+            for zeros in z0..=z1.min(poles) {
+                for family in &self.families {
+                    out.push((poles, zeros, family.clone()));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+impl SelectionGrid {
+    /// Every family is known to `registry` and can be started from a standard deviation.
+    fn check_families(&self, registry: &JitterRegistry) -> Result<(), SelectionError> {
         if self.families.is_empty() {
             return Err(invalid("families", "the list is empty"));
         }
@@ -250,23 +321,7 @@ impl SelectionGrid {
                 ));
             }
         }
-        // Levy's linear fit needs 2n + m + 1 real equations from bins below N/2.
-        let needed = 2 * p1 + p1.min(z1) + 2;
-        if needed > len {
-            return Err(invalid(
-                "poles",
-                format!("{p1} poles need at least {needed} samples; the record has {len}"),
-            ));
-        }
-        let mut out = Vec::new();
-        for poles in p0..=p1 {
-            for zeros in z0..=z1.min(poles) {
-                for family in &self.families {
-                    out.push((poles, zeros, family.clone()));
-                }
-            }
-        }
-        Ok(out)
+        Ok(())
     }
 }
 
@@ -296,12 +351,42 @@ fn structure_of(family: &str, signal: AnySignal, jitter: AnyJitter) -> Structure
     }
 }
 
-/// The candidate's signal: `model` driven by `input`, with the options' delay and free
-/// response from an unknown state at the record's first instant (coefficients at 0).
+/// `spec` with the options' output offset: a known `y₀` as it is, an estimated one started at
+/// `mean(y) − mean(m_k)` of the candidate's response `bare` (the spec without the offset) under
+/// `jitter`.
+fn with_offset(
+    mut spec: SpecTable,
+    bare: &dyn Fn(&SpecTable) -> Result<AnySignal, String>,
+    record: &Record,
+    jitter: &AnyJitter,
+    options: &SelectionOptions,
+) -> Result<SpecTable, String> {
+    let Some((y0, estimated)) = options.offset else {
+        return Ok(spec);
+    };
+    let y0 = if estimated {
+        let start = offset_start(&bare(&spec)?, record, jitter);
+        if !start.is_finite() {
+            return Err("offset start: not finite".into());
+        }
+        start
+    } else {
+        y0
+    };
+    spec.insert("offset".into(), json!(y0));
+    if estimated {
+        spec.insert("estimate_offset".into(), json!(true));
+    }
+    Ok(spec)
+}
+
+/// The candidate's signal: `model` driven by `input`, with the options' delay, free response
+/// from an unknown state at the record's first instant (coefficients at 0) and output offset.
 fn candidate_signal(
     model: &TransferFunction,
     input: &Input,
     record: &Record,
+    jitter: &AnyJitter,
     options: &SelectionOptions,
 ) -> Result<AnySignal, String> {
     let mut spec = SpecTable::new();
@@ -315,9 +400,48 @@ fn candidate_signal(
         spec.insert("initial".into(), json!(vec![0.0; model.den().len() - 1]));
         spec.insert("origin".into(), json!(record.grid().start()));
     }
-    SignalRegistry::builtin()
-        .build(&spec, Some(input))
-        .map_err(|e| e.to_string())
+    let build = |spec: &SpecTable| {
+        SignalRegistry::builtin()
+            .build(spec, Some(input))
+            .map_err(|e| e.to_string())
+    };
+    build(&with_offset(spec, &build, record, jitter, options)?)
+}
+
+/// The jitter start of a candidate of `family`: a standard deviation of `fraction · T`.
+fn jitter_at(
+    registry: &JitterRegistry,
+    family: &str,
+    record: &Record,
+    fraction: f64,
+) -> Result<AnyJitter, String> {
+    let sigma = fraction * record.grid().interval();
+    registry
+        .from_std_dev(family, sigma, &serde_json::Map::new())
+        .map_err(|e| format!("jitter start: {e}"))
+}
+
+/// The BCLS fit of a candidate of `family` from the start `signal`, `jitter`.
+fn bcls_from(
+    record: &Record,
+    family: &str,
+    signal: AnySignal,
+    jitter: AnyJitter,
+) -> Result<(Structure, jitterid_estimate::Fit), String> {
+    let structure = structure_of(family, signal, jitter);
+    // The ranking needs the cost only; the sandwich covariance would dominate the time.
+    let options = FitOptions::default().with_covariance(false);
+    let estimate = fit(&structure, record, &Bcls, &options).map_err(|e| format!("fit: {e}"))?;
+    Ok((structure, estimate))
+}
+
+/// The initializer's options for the candidates: an output offset moves the bin `f = 0`
+/// only, which the initializer then leaves out.
+fn init_options(options: &SelectionOptions) -> InitOptions {
+    InitOptions {
+        offset: options.offset.is_some(),
+        ..InitOptions::default()
+    }
 }
 
 /// One BCLS fit of a candidate from the initializer's model with the jitter at `fraction · T`.
@@ -329,10 +453,7 @@ fn fit_from(
     (family, poles, zeros): (&str, usize, usize),
     fraction: f64,
 ) -> Result<(Structure, jitterid_estimate::Fit), String> {
-    let sigma = fraction * record.grid().interval();
-    let jitter = registry
-        .from_std_dev(family, sigma, &serde_json::Map::new())
-        .map_err(|e| format!("jitter start: {e}"))?;
+    let jitter = jitter_at(registry, family, record, fraction)?;
     let model = template(zeros, poles).map_err(|e| format!("template: {e}"))?;
     // The initializer fits the response to the input as the system sees it, so that the
     // rational model does not absorb the delay's phase as well.
@@ -341,27 +462,48 @@ fn fit_from(
         None => input.clone(),
     };
     let rational = ModelStructure::oe(LtiResponse::new(model, driven), jitter.clone());
-    let rational = initialize(&rational, record, &InitOptions::default())
+    let rational = initialize(&rational, record, &init_options(options))
         .map_err(|e| format!("initializer: {e}"))?;
-    let signal = candidate_signal(rational.signal.model(), input, record, options)
-        .map_err(|e| format!("candidate system: {e}"))?;
-    let structure = structure_of(family, signal, rational.jitter);
-    // The ranking needs the cost only; the sandwich covariance would dominate the time.
-    let options = FitOptions::default().with_covariance(false);
-    let estimate = fit(&structure, record, &Bcls, &options).map_err(|e| format!("fit: {e}"))?;
-    Ok((structure, estimate))
+    let signal = candidate_signal(
+        rational.signal.model(),
+        input,
+        record,
+        &rational.jitter,
+        options,
+    )
+    .map_err(|e| format!("candidate system: {e}"))?;
+    bcls_from(record, family, signal, rational.jitter)
 }
 
+/// A candidate before its fit: its orders and jitter family.
+struct Label {
+    poles: usize,
+    zeros: usize,
+    channels: Vec<(String, usize, usize)>,
+    family: String,
+}
+
+/// A candidate's BCLS fit from the jitter start `fraction · T`.
+type FitAt<'a> = dyn Fn(f64) -> Result<(Structure, jitterid_estimate::Fit), String> + 'a;
+
+/// The screened candidate `label`, fitted by `fit_at` from every jitter start of `options`
+/// (one for `"none"`), keeping the best fit, with its BIC and the kind of its failure.
 fn fit_candidate(
     record: &Record,
-    input: &Input,
-    registry: &JitterRegistry,
     options: &SelectionOptions,
-    (poles, zeros, family): (usize, usize, String),
+    label: Label,
+    fit_at: &FitAt<'_>,
 ) -> Candidate {
+    let Label {
+        poles,
+        zeros,
+        channels,
+        family,
+    } = label;
     let failed = |reason: String| Candidate {
         poles,
         zeros,
+        channels: channels.clone(),
         family: family.clone(),
         criterion: f64::INFINITY,
         converged: false,
@@ -384,14 +526,7 @@ fn fit_candidate(
     let mut best: Option<(Structure, jitterid_estimate::Fit)> = None;
     let mut last_error = String::new();
     for &fraction in fractions {
-        match fit_from(
-            record,
-            input,
-            registry,
-            options,
-            (&family, poles, zeros),
-            fraction,
-        ) {
+        match fit_at(fraction) {
             Ok((s, fit)) => {
                 let better = match &best {
                     None => true,
@@ -441,6 +576,7 @@ fn fit_candidate(
     Candidate {
         poles,
         zeros,
+        channels,
         family,
         criterion,
         converged: fit.converged,
@@ -483,19 +619,27 @@ fn poles_where(
 ) -> Option<String> {
     let at = structure.with_params(params).ok()?;
     let spec = at.signal.spec();
-    let r = SignalRegistry::builtin()
-        .kind(at.signal.kind())?
-        .reader(&spec)
-        .ok()?;
-    let tf = TfForm::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok()?;
-    let kept: Vec<String> = tf
-        .to_zpk()
-        .ok()?
-        .poles()
-        .iter()
-        .filter(|p| keep(p))
-        .map(|p| format!("{:.4}{:+.4}i", p.re, p.im))
-        .collect();
+    // A multi-input candidate's poles are those of its channels, each a `tf` table.
+    let parts: Vec<(&str, SpecTable)> = match spec.get("channels").and_then(|c| c.as_array()) {
+        Some(channels) => channels
+            .iter()
+            .filter_map(|c| c.as_object().map(|t| ("tf", t.clone())))
+            .collect(),
+        None => vec![(at.signal.kind(), spec)],
+    };
+    let mut kept: Vec<String> = Vec::new();
+    for (kind, spec) in &parts {
+        let r = SignalRegistry::builtin().kind(kind)?.reader(spec).ok()?;
+        let tf = TfForm::new(&r.f64_list("num").ok()?, &r.f64_list("den").ok()?).ok()?;
+        kept.extend(
+            tf.to_zpk()
+                .ok()?
+                .poles()
+                .iter()
+                .filter(|p| keep(p))
+                .map(|p| format!("{:.4}{:+.4}i", p.re, p.im)),
+        );
+    }
     (!kept.is_empty()).then(|| kept.join(", "))
 }
 
@@ -509,6 +653,18 @@ fn axis_poles(structure: &Structure, params: &[f64]) -> Option<String> {
 /// The poles of the candidate at `params` beyond the sampling's reach at interval `t`.
 fn fast_poles(structure: &Structure, params: &[f64], t: f64) -> Option<String> {
     poles_where(structure, params, |p| p.norm() * t > BEYOND_SAMPLING)
+}
+
+/// The options' jitter starts are a non-empty list of positive finite fractions.
+fn check_fractions(options: &SelectionOptions) -> Result<(), SelectionError> {
+    let fractions = &options.jitter_fractions;
+    if fractions.is_empty() || !fractions.iter().all(|f| f.is_finite() && *f > 0.0) {
+        return Err(invalid(
+            "jitter_fractions",
+            format!("{fractions:?} must be a non-empty list of positive finite numbers"),
+        ));
+    }
+    Ok(())
 }
 
 /// Fit every candidate of `grid` on `record` (driven by `input`) and return them best first
@@ -526,23 +682,44 @@ pub fn select(
     registry: &JitterRegistry,
     options: &SelectionOptions,
 ) -> Result<Vec<Candidate>, SelectionError> {
-    let fractions = &options.jitter_fractions;
-    if fractions.is_empty() || !fractions.iter().all(|f| f.is_finite() && *f > 0.0) {
-        return Err(invalid(
-            "jitter_fractions",
-            format!("{fractions:?} must be a non-empty list of positive finite numbers"),
-        ));
-    }
+    check_fractions(options)?;
     let list = grid.candidates(registry, record.y().len())?;
     let budget = jitterid_numeric::budget::current();
-    let mut out: Vec<Candidate> = list
+    let out: Vec<Candidate> = list
         .into_par_iter()
-        .map(|c| {
+        .map(|(poles, zeros, family)| {
             jitterid_numeric::budget::run_with(budget.clone(), || {
-                fit_candidate(record, input, registry, options, c)
+                let fit_at = |fraction| {
+                    fit_from(
+                        record,
+                        input,
+                        registry,
+                        options,
+                        (&family, poles, zeros),
+                        fraction,
+                    )
+                };
+                let label = Label {
+                    poles,
+                    zeros,
+                    channels: Vec::new(),
+                    family: family.clone(),
+                };
+                fit_candidate(record, options, label, &fit_at)
             })
         })
         .collect();
+    Ok(rank(record, registry, options, out))
+}
+
+/// The screened candidates `out`, their finalists refitted by exact likelihood when the
+/// options say so, best first (see [`select`]).
+fn rank(
+    record: &Record,
+    registry: &JitterRegistry,
+    options: &SelectionOptions,
+    mut out: Vec<Candidate>,
+) -> Vec<Candidate> {
     if options.refine_by_likelihood {
         likelihood::refine_finalists(record, registry, &mut out);
     }
@@ -558,7 +735,7 @@ pub fn select(
             .cmp(&group(b))
             .then(a.criterion.total_cmp(&b.criterion))
     });
-    Ok(out)
+    out
 }
 
 #[cfg(test)]

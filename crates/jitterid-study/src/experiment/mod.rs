@@ -317,9 +317,19 @@ pub fn parse_with(
             offset_seen(&cx, &raw, &system, &estimate.frequencies, &grid)?;
         }
     }
-    let select = match &raw.select {
-        Some(r) => Some(select::parse_select(&cx, r, grid.len())?),
-        None => None,
+    let (select, select_orders) = match &raw.select {
+        Some(r) => {
+            // The inputs whose orders a multi-input grid lists; none for one input.
+            let multi = system.kind.get(jitterid::signal::registry::KIND_KEY)
+                == Some(&jitterid::signal::superposition::SUPERPOSITION_KIND.into());
+            let names: Vec<&str> = match multi {
+                true => inputs.iter().map(|c| c.name.as_str()).collect(),
+                false => Vec::new(),
+            };
+            let (grid, orders) = select::parse_select(&cx, r, grid.len(), &names)?;
+            (Some(grid), orders)
+        }
+        None => (None, Vec::new()),
     };
     let design = match &raw.design {
         Some(r) => {
@@ -346,6 +356,7 @@ pub fn parse_with(
         noise,
         estimate,
         select,
+        select_orders,
         design,
     })
 }

@@ -108,6 +108,7 @@ section!(RawSelect, "table [select]" {
     poles: Vec<i64>,
     zeros: Vec<i64>,
     families: Vec<String>,
+    orders: BTreeMap<String, Vec<Vec<i64>>>,
 });
 
 section!(RawDesign, "table [design]" {

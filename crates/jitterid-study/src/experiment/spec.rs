@@ -325,6 +325,9 @@ pub struct Experiment {
     pub estimate: EstimateSpec,
     /// The `[select]` grid of model orders and jitter families, when the file has one.
     pub select: Option<jitterid::estimate::selection::SelectionGrid>,
+    /// For a system with several inputs, each input's candidate orders of `[select]` (its
+    /// `orders`, or the grid's `poles` × `zeros`); empty for one input or without `[select]`.
+    pub select_orders: Vec<jitterid::estimate::selection::ChannelOrders>,
     /// The `[design]` section's free design variables, when the file has one.
     pub design: Option<super::DesignSpec>,
 }
@@ -358,25 +361,16 @@ impl Experiment {
     }
 
     /// Whether `select` can run this experiment: its candidates are built from the `[select]`
-    /// orders with the system's delay and free response, and do not carry an output offset
-    /// yet, so an experiment with one is refused rather than ranked without it.
+    /// orders with the system's delay, free response and output offset; a multi-input system's
+    /// from one transfer function per input, each estimated, without a delay or free response.
     ///
     /// # Errors
     ///
-    /// One line naming `[output]` when the experiment has an output offset.
+    /// One line naming the `[[system]]` key a multi-input candidate cannot carry.
     pub fn selectable(&self) -> crate::error::StudyResult<()> {
         if self.multi_input() {
-            return Err(crate::study_err!(
-                "{}: [[input]]: select ranks the orders of a single-input system; a system with several inputs is fitted with its orders given (jitterid fit), and compared by its fits' criteria",
-                self.file
-            ));
+            return super::select::channels_selectable(self);
         }
-        match self.output_offset() {
-            None => Ok(()),
-            Some(_) => Err(crate::study_err!(
-                "{}: [output]: select does not carry an output offset into its candidates yet; fit the record with the offset (jitterid fit), or subtract the offset from y and select without [output]",
-                self.file
-            )),
-        }
+        Ok(())
     }
 }
