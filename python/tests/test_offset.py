@@ -79,3 +79,14 @@ def test_unknown_output_keys_are_refused():
         "estimate_offset = true", "estimate_ofset = true")
     with pytest.raises(ValueError, match="estimate_ofset"):
         jitterid.Experiment(text, "e.toml", str(REPO / "examples" / "experiments"))
+
+
+def test_select_carries_the_output_offset():
+    # An experiment with [output] is selected with the offset estimated in every candidate.
+    text = (REPO / "examples/experiments/offset.toml").read_text() + (
+        '\n[select]\npoles = [1, 2]\nzeros = [0, 1]\nfamilies = ["uniform-sum"]\n')
+    exp = jitterid.Experiment(text, "offset-select.toml", str(REPO / "examples/experiments"))
+    sel = jitterid.select(exp, exp.simulate(run=2))
+    best = sel.best
+    assert (best["poles"], best["zeros"]) == (2, 1)
+    assert abs(best["estimates"]["offset"] - 1.5) < 0.05

@@ -44,3 +44,24 @@ def test_a_record_without_one_input_s_levels_is_refused():
     rec["input_u"] = {"torque": rec["input_u"]["torque"]}
     with pytest.raises(ValueError, match='no levels for the input "brake"'):
         exp.fit(rec)
+
+
+def test_select_ranks_each_input_s_order_from_python():
+    # The command line's multi-input selection through jitterid.select, whose temporary side
+    # file holds one column per input.
+    text = (REPO / "examples/experiments/two-input.toml").read_text() + (
+        '\n[select]\nfamilies = ["gaussian"]\norders = { torque = [[1, 0], [2, 0]], brake = [[1, 0], [2, 1]] }\n')
+    exp = jitterid.Experiment(text, "two-input-select.toml", str(REPO / "examples/experiments"))
+    sel = jitterid.select(exp, exp.simulate(run=3))
+    assert len(sel.candidates) == 4
+    assert sel.best["orders"] == {"torque": [1, 0], "brake": [2, 1]}
+
+
+def test_init_auto_reaches_the_fit_from_the_truth():
+    exp = experiment()
+    rec = exp.simulate(run=5)
+    truth = exp.fit(rec)
+    auto = exp.fit(rec, init="auto")
+    assert auto.converged
+    for a, t, se in zip(auto.params, truth.params, truth.std_errors):
+        assert abs(a - t) < 0.01 * se
