@@ -232,15 +232,7 @@ fn a_small_width_inside_the_domain_is_found() {
     let r = 42;
     let (structure, record) = setup(r);
     let fit = fit_realisation(r);
-    assert!(fit.converged, "{}", fit.termination);
-    assert!(
-        !matches!(
-            fit.termination,
-            jitterid_estimate::FitTermination::Solver(Termination::AtBound { .. })
-        ),
-        "{}",
-        fit.termination
-    );
+    assert_converged_inside(&fit);
     assert!(
         fit.params[4] > 1e-3 && fit.params[4] < 2e-2,
         "{:?}",
@@ -260,6 +252,19 @@ fn a_small_width_inside_the_domain_is_found() {
             profile.cost
         );
     }
+}
+
+/// `fit` converged inside the domain, not by stopping at the width's bound.
+fn assert_converged_inside(fit: &Estimate) {
+    assert!(fit.converged, "{}", fit.termination);
+    assert!(
+        !matches!(
+            fit.termination,
+            jitterid_estimate::FitTermination::Solver(Termination::AtBound { .. })
+        ),
+        "{}",
+        fit.termination
+    );
 }
 
 fn fit_with(structure: &ModelStructure<LtiResponse<Zpk>, Gaussian>, record: &Record) -> Estimate {
@@ -289,15 +294,7 @@ fn an_interior_small_width_converges_within_the_default_limit() {
     assert_eq!(plain.iterations, 500);
 
     let fit = fit_realisation(r);
-    assert!(fit.converged, "{}", fit.termination);
-    assert!(
-        !matches!(
-            fit.termination,
-            jitterid_estimate::FitTermination::Solver(Termination::AtBound { .. })
-        ),
-        "{}",
-        fit.termination
-    );
+    assert_converged_inside(&fit);
     assert!(fit.iterations < 50, "{}", fit.iterations);
     assert!(fit.cost < plain.cost, "{} ≥ {}", fit.cost, plain.cost);
     assert!(

@@ -4,6 +4,9 @@
 //! estimate of that term restores a fast rate. Where Gauss–Newton's model is right (zero
 //! residual), the adaptive search keeps to it and takes the same steps.
 
+mod common;
+
+use common::Rosenbrock;
 use faer::Mat;
 use jitterid_optim::LmModel as Model;
 use jitterid_optim::{LeastSquares, LevenbergMarquardt, Solver, SolverError, SolverReport};
@@ -32,26 +35,6 @@ impl LeastSquares for LargeResidual {
     fn jacobian(&self, p: &[f64]) -> Result<Mat<f64>, SolverError> {
         let j = [1.0, 2.0 * self.lambda * p[0] + 1.0];
         Ok(Mat::from_fn(2, 1, |r, _| j[r]))
-    }
-}
-
-/// Rosenbrock's function as residuals `[10(y − x²), 1 − x]`: zero residual at (1, 1), a
-/// curved valley on the way.
-struct Rosenbrock;
-
-impl LeastSquares for Rosenbrock {
-    fn num_params(&self) -> usize {
-        2
-    }
-    fn num_residuals(&self) -> usize {
-        2
-    }
-    fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, SolverError> {
-        Ok(vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]])
-    }
-    fn jacobian(&self, p: &[f64]) -> Result<Mat<f64>, SolverError> {
-        let j = [[-20.0 * p[0], 10.0], [-1.0, 0.0]];
-        Ok(Mat::from_fn(2, 2, |r, c| j[r][c]))
     }
 }
 

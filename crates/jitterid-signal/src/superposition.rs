@@ -456,13 +456,7 @@ pub fn superposition(
     offset: f64,
     estimate_offset: bool,
 ) -> Result<AnySignal, SignalError> {
-    let spectral = channels.iter().all(|c| c.signal.has_spectrum());
-    wrapped(
-        Superposition::new(channels)?,
-        spectral,
-        offset,
-        estimate_offset,
-    )
+    wrapped(Superposition::new(channels)?, offset, estimate_offset)
 }
 
 /// [`superposition`] of channels that share their parameters ([`Superposition::shared`]).
@@ -475,21 +469,16 @@ pub fn shared_superposition(
     offset: f64,
     estimate_offset: bool,
 ) -> Result<AnySignal, SignalError> {
-    let spectral = channels.iter().all(|c| c.signal.has_spectrum());
-    wrapped(
-        Superposition::shared(channels)?,
-        spectral,
-        offset,
-        estimate_offset,
-    )
+    wrapped(Superposition::shared(channels)?, offset, estimate_offset)
 }
 
 fn wrapped(
     sum: Superposition,
-    spectral: bool,
     offset: f64,
     estimate_offset: bool,
 ) -> Result<AnySignal, SignalError> {
+    // The sum has a spectrum when every channel has one.
+    let spectral = sum.channels.iter().all(|c| c.signal.has_spectrum());
     let model = Offset::new(sum, offset, estimate_offset)?;
     let to_spec = |m: &Offset<Superposition>| {
         let mut spec = m.signal().spec();
