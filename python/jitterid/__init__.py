@@ -329,11 +329,9 @@ def _driven(system: Any, input: Any, inputs: Optional[Inputs]) -> Tuple[Any, lis
     """The system and the inputs that drive it, in its input order: ``(system, [(name,
     input)])``, the name ``None`` for a system with one input.
 
-    ``system`` may be a list or dict of systems (one per input, ``System.several``); ``inputs``
-    a list (in the system's input order) or a dict by input name. Refuses ``input`` and
-    ``inputs`` together, a count or a name that does not match the system's inputs."""
-    if isinstance(system, (list, tuple, Mapping)):
-        system = System.several(system)
+    ``inputs`` is a list (in the system's input order) or a dict by input name. Refuses
+    ``input`` and ``inputs`` together, a count or a name that does not match the system's
+    inputs."""
     if inputs is None:
         if getattr(system, "inputs", None) is not None:
             raise ValueError(f"inputs: the system has several inputs ({', '.join(system.inputs)}); give one Input per "
@@ -430,7 +428,6 @@ def _in_range(system: Any, jitter_model: Any, inputs: list, samples: Any, interv
     the argument's key in its ``ValueError``."""
     from ._spec import spec_json
 
-    _model(system, jitter_model, None)
     samples, interval, start = _grid(samples, interval, start)
     sections: dict = {"sampling": {"interval": interval, "samples": samples, "start": start}}
     spec = dict(system.spec)
@@ -449,10 +446,9 @@ def _in_range(system: Any, jitter_model: Any, inputs: list, samples: Any, interv
 
 def _checked(system: Any, jitter_model: Any, input: Any, inputs: Optional[Inputs]) -> Tuple[Any, list]:
     """The arguments' types checked and the system with its inputs (``_driven``)."""
-    if not isinstance(system, (list, tuple, Mapping)):
-        _model(system, jitter_model, input)
-    elif input is not None and not isinstance(input, _jitterid.Input):
-        raise TypeError(f"input: expected an Input or None, found {type(input).__name__}")
+    if isinstance(system, (list, tuple, Mapping)):
+        system = System.several(system)
+    _model(system, jitter_model, input)
     return _driven(system, input, inputs)
 
 

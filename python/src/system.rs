@@ -39,14 +39,14 @@ impl System {
     /// several inputs on a unit step in each).
     pub fn of(spec: SpecTable) -> PyResult<Self> {
         let step = unit_step(1.0)?;
-        let model = match input_names(&spec) {
-            Some(names) => build_several(&spec, &vec![step; names.len()])?,
-            None => build(&spec, Some(&step))?,
-        };
         // A system with several inputs has one transfer function per input, not one.
-        let tf = match input_names(&spec) {
-            Some(_) => None,
-            None => tf_of(&model).map_err(value_error)?,
+        let (model, tf) = match input_names(&spec) {
+            Some(names) => (build_several(&spec, &vec![step; names.len()])?, None),
+            None => {
+                let model = build(&spec, Some(&step))?;
+                let tf = tf_of(&model).map_err(value_error)?;
+                (model, tf)
+            }
         };
         Ok(System { spec, model, tf })
     }

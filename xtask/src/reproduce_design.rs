@@ -109,7 +109,7 @@ fn study(
     let blind = jitter_blind(&plan, &criterion).map_err(text)?.design;
     let baseline = plan.baseline_design();
     // Predictions on the Monte Carlo's own input draws (draw r is run r's input).
-    let matched = plan.with_draws(runs as usize, seed);
+    let matched = plan.with_draws(runs as usize, seed).map_err(text)?;
     let mut predicted = Vec::new();
     let mut checks: Vec<MonteCarloCheck> = Vec::new();
     for d in [&optimal, &baseline, &blind] {

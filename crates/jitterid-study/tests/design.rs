@@ -451,7 +451,7 @@ fn jitter_blind_design_is_worse_on_jittered_data() {
     // The Monte Carlo, with the predictions on its own draws.
     let runs = 256;
     let seed = 11;
-    let matched = plan.with_draws(runs, seed);
+    let matched = plan.with_draws(runs, seed).unwrap();
     let mc_a = monte_carlo(&plan, &aware.design, &crit, runs as u64, seed).unwrap();
     let mc_b = monte_carlo(&plan, &blind.design, &crit, runs as u64, seed).unwrap();
     let (_, pa) = evaluate(&matched, &aware.design, &crit).unwrap();
@@ -491,7 +491,7 @@ fn predicted_std_agrees_with_monte_carlo_for_both_estimators() {
         };
         let runs = 40;
         let seed = 5;
-        let p = plan.with_draws(runs, seed).predict(&d).unwrap();
+        let p = plan.with_draws(runs, seed).unwrap().predict(&d).unwrap();
         let mc = monte_carlo(&plan, &d, &DesignCriterion::D, runs as u64, seed).unwrap();
         assert_eq!(p.names, mc.names);
         for i in 0..p.names.len() {

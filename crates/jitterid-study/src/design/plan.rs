@@ -5,7 +5,7 @@ use super::blind::without_jitter;
 use super::candidate::Design;
 use super::criterion::criterion_value;
 use super::predict::{predict, Prediction};
-use super::prior::prior_experiments;
+use super::prior::{prior_draws, PriorDraw};
 use crate::error::StudyResult;
 use crate::experiment::{
     directory_of, parse_edited, read_text, DesignCriterion, DesignSpec, Experiment, Purpose,
@@ -31,6 +31,9 @@ pub struct Plan {
     pub spec: DesignSpec,
     /// Whether the prior's jitter is replaced by none (see [`Plan::jitter_blind`]).
     blind: bool,
+    /// A robust design's prior draws (empty without a prior spread), drawn once: they move
+    /// the truth alone, the same at every design.
+    prior: Vec<PriorDraw>,
 }
 
 impl Plan {
@@ -69,6 +72,11 @@ impl Plan {
                 "{file}: no [design] section; expected one naming the free design variables (mean_dwell = [min, max], interval = [min, max])"
             )
         })?;
+        // A prior draw that makes the model invalid is refused here, naming its key.
+        let prior = match &spec.prior {
+            Some(p) => prior_draws(&baseline, p, spec.seed)?,
+            None => Vec::new(),
+        };
         let plan = Plan {
             registries: Arc::clone(registries),
             file: file.to_string(),
@@ -78,12 +86,8 @@ impl Plan {
             baseline,
             spec,
             blind: false,
+            prior,
         };
-        // A robust design's prior draws move the truth alone, the same at every design: one
-        // that makes the model invalid is refused here, naming its key.
-        if let Some(prior) = &plan.spec.prior {
-            prior_experiments(&plan.baseline, prior, plan.spec.seed)?;
-        }
         // A budget on a fixed interval is one record: it must be one the experiment allows
         // (the jitter's reach within it, the input's switches), or no design can meet it.
         if let (Some(key), None) = (plan.spec.budget_key, plan.spec.interval) {
@@ -113,17 +117,27 @@ impl Plan {
         Ok(Plan {
             baseline: without_jitter(self.baseline.clone())?,
             blind: true,
+            // The jitter-blind prior has no jitter to move.
+            prior: self.prior.iter().map(PriorDraw::without_jitter).collect(),
             ..self.clone()
         })
     }
 
     /// The same plan with its predictions averaged over `draws` input draws of master seed
-    /// `seed` (a Monte Carlo of `draws` runs with that seed sees the same inputs).
-    pub fn with_draws(&self, draws: usize, seed: u64) -> Plan {
+    /// `seed` (a Monte Carlo of `draws` runs with that seed sees the same inputs); a robust
+    /// design's prior is drawn again from `seed`.
+    ///
+    /// # Errors
+    ///
+    /// A prior draw of `seed` that makes the model invalid (see [`Plan::parse`]).
+    pub fn with_draws(&self, draws: usize, seed: u64) -> StudyResult<Plan> {
         let mut plan = self.clone();
         plan.spec.draws = draws;
         plan.spec.seed = seed;
-        plan
+        if let Some(p) = &plan.spec.prior {
+            plan.prior = prior_draws(&plan.baseline, p, seed)?;
+        }
+        Ok(plan)
     }
 
     /// Whether this is the jitter-blind plan.
@@ -157,17 +171,17 @@ impl Plan {
         criterion: &DesignCriterion,
         nominal: f64,
     ) -> StudyResult<f64> {
-        let Some(prior) = &self.spec.prior else {
+        if self.prior.is_empty() {
             return Ok(nominal);
-        };
+        }
         let exp = self.experiment(design)?;
-        let draws = prior_experiments(&exp, prior, self.spec.seed)?;
         let mut sum = 0.0;
-        for e in &draws {
-            let p = predict(e, self.spec.estimator, self.spec.draws, self.spec.seed)?;
+        for draw in &self.prior {
+            let e = draw.apply(&exp);
+            let p = predict(&e, self.spec.estimator, self.spec.draws, self.spec.seed)?;
             sum += criterion_value(criterion, &p)?;
         }
-        Ok(sum / draws.len() as f64)
+        Ok(sum / self.prior.len() as f64)
     }
 
     /// The edits the plan was read with (the user's `--set`), in order.

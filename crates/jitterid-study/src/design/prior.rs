@@ -10,9 +10,10 @@ use super::realization::realized_signal;
 use crate::error::StudyResult;
 use crate::experiment::{Experiment, PriorSpread};
 use crate::study_err;
-use jitterid::jitter::JitterModel;
+use jitterid::jitter::{AnyJitter, JitterModel};
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::{Rng, SeedableRng};
+use jitterid::signal::registry::SpecTable;
 use jitterid::signal::Signal;
 use rand_distr::StandardNormal;
 
@@ -26,18 +27,50 @@ fn factor(spread: f64, rng: &mut StdRng) -> f64 {
     1.0 + spread * z.clamp(-CUT, CUT)
 }
 
-/// The `prior.draws` experiments of the robust design of `exp` (its truth moved by the
-/// prior's spread), drawn from master seed `seed`: draw `i` is the same for every design.
+/// One prior draw: the moved system (its spec table) and the moved jitter, each `None` where
+/// the prior leaves it at the truth. A draw moves the truth alone, so the same draws serve
+/// every candidate design ([`PriorDraw::apply`]).
+#[derive(Debug, Clone)]
+pub(crate) struct PriorDraw {
+    system: Option<SpecTable>,
+    jitter: Option<AnyJitter>,
+}
+
+impl PriorDraw {
+    /// The same draw with the jitter left at the truth (for a prior without jitter).
+    pub(crate) fn without_jitter(&self) -> PriorDraw {
+        PriorDraw {
+            system: self.system.clone(),
+            jitter: None,
+        }
+    }
+
+    /// `exp` (any design of the plan's experiment) with this draw's truth.
+    pub(crate) fn apply(&self, exp: &Experiment) -> Experiment {
+        let mut out = exp.clone();
+        if let Some(kind) = &self.system {
+            out.system.kind = kind.clone();
+        }
+        if let Some(j) = &self.jitter {
+            out.jitter.truth = j.clone();
+            out.jitter.model = j.clone();
+        }
+        out
+    }
+}
+
+/// The `prior.draws` draws of the robust design of `exp` (its truth moved by the prior's
+/// spread), drawn from master seed `seed`.
 ///
 /// # Errors
 ///
 /// A draw that makes the model invalid (a parameter out of its range, an unstable pole): one
 /// line naming `[design] prior_spread` or `prior_jitter_spread` and the draw.
-pub fn prior_experiments(
+pub(crate) fn prior_draws(
     exp: &Experiment,
     prior: &PriorSpread,
     seed: u64,
-) -> StudyResult<Vec<Experiment>> {
+) -> StudyResult<Vec<PriorDraw>> {
     // The system's parameters do not depend on the input: any realisation shows them.
     let signal = realized_signal(exp, &mut StdRng::seed_from_u64(seed))?;
     let sigma = exp.jitter.truth.std_dev();
@@ -45,7 +78,10 @@ pub fn prior_experiments(
         .map(|i| {
             // A stream of its own per draw, apart from the input draws' streams.
             let mut rng = StdRng::seed_from_u64(seed ^ 0x5052_494f_525f_4452 ^ i as u64);
-            let mut out = exp.clone();
+            let mut draw = PriorDraw {
+                system: None,
+                jitter: None,
+            };
             if prior.system > 0.0 && exp.system.estimate {
                 let moved: Vec<f64> = signal
                     .params()
@@ -58,7 +94,7 @@ pub fn prior_experiments(
                         exp.file
                     )
                 })?;
-                out.system.kind = moved.spec();
+                draw.system = Some(moved.spec());
             }
             if prior.jitter > 0.0 && sigma > 0.0 {
                 let truth = &exp.jitter.truth;
@@ -76,10 +112,25 @@ pub fn prior_experiments(
                             exp.file
                         )
                     })?;
-                out.jitter.truth = moved.clone();
-                out.jitter.model = moved;
+                draw.jitter = Some(moved);
             }
-            Ok(out)
+            Ok(draw)
         })
         .collect()
+}
+
+/// The experiments of [`prior_draws`]: `exp` with each draw's truth.
+///
+/// # Errors
+///
+/// Those of [`prior_draws`].
+pub fn prior_experiments(
+    exp: &Experiment,
+    prior: &PriorSpread,
+    seed: u64,
+) -> StudyResult<Vec<Experiment>> {
+    Ok(prior_draws(exp, prior, seed)?
+        .iter()
+        .map(|d| d.apply(exp))
+        .collect())
 }
