@@ -119,11 +119,14 @@ pub(crate) fn prior_draws(
         .collect()
 }
 
-/// The experiments of [`prior_draws`]: `exp` with each draw's truth.
+/// The `prior.draws` experiments of the robust design of `exp`: its truth moved by the prior's
+/// spread, drawn from master seed `seed` (each estimated system parameter `θ(1 + s z)`, the
+/// jitter's σ `σ(1 + s_τ z)`, `z` standard normal cut at ±3).
 ///
 /// # Errors
 ///
-/// Those of [`prior_draws`].
+/// A draw that makes the model invalid: one line naming `[design] prior_spread` or
+/// `prior_jitter_spread` and the draw.
 pub fn prior_experiments(
     exp: &Experiment,
     prior: &PriorSpread,
