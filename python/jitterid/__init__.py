@@ -374,10 +374,20 @@ def _system_sections(spec: Mapping[str, Any], inputs: list, estimate: bool) -> T
     def section(u: Any) -> dict:
         return dict(u) if isinstance(u, _Realisation) else json.loads(u.section_json())
 
+    def level_keys(table: Mapping[str, Any]) -> Tuple[dict, dict]:
+        # The input's level is a key of the system's spec and of the input's section.
+        table = dict(table)
+        return table, {k: table.pop(k) for k in _LEVEL_KEYS if k in table}
+
     if not inputs or inputs[0][0] is None:
-        return dict(spec, estimate=estimate), None if not inputs else section(inputs[0][1])
+        spec, level = level_keys(spec)
+        return dict(spec, estimate=estimate), None if not inputs else dict(section(inputs[0][1]), **level)
     input_tables = [dict(section(u), name=name) for name, u in inputs]
-    channels = spec["channels"]
+    channels = []
+    for table, c in zip(input_tables, spec["channels"]):
+        c, level = level_keys(c)
+        table.update(level)
+        channels.append(c)
     if not spec.get("shared"):
         return [dict(c, estimate=estimate) for c in channels], input_tables
     one = dict(channels[0], estimate=estimate)
@@ -385,6 +395,36 @@ def _system_sections(spec: Mapping[str, Any], inputs: list, estimate: bool) -> T
     if "d" in one:
         one["d"] = [[c["d"][0][0] for c in channels]]
     return one, input_tables
+
+
+_LEVEL_KEYS = ("level", "estimate_level")
+
+
+def _level(system: Any, level: Any, estimate_level: Any) -> Any:
+    """``system`` with the input's level ``u₀`` (``[input] level``) and whether it is estimated
+    (``estimate_level``) in its spec when given (the system's own otherwise: a fitted system
+    carries them). Only a system with one input takes them here; ``level`` not a real number
+    and ``estimate_level`` not a boolean raise ``ValueError`` naming the argument."""
+    if level is None and estimate_level is None:
+        return system
+    if getattr(system, "inputs", None) is not None:
+        raise ValueError("level: a system with several inputs takes each input's level in an experiment file "
+                         "([[input]] level, estimate_level)")
+    spec = dict(system.spec)
+    if level is not None:
+        if isinstance(level, (bool, np.bool_)):
+            raise ValueError("level: expected a real number, found bool")
+        try:
+            spec["level"] = real_number(level, "level")
+        except TypeError as e:
+            raise ValueError(str(e)) from None
+        if not np.isfinite(spec["level"]):
+            raise ValueError(f"level: expected a finite number, found {spec['level']}")
+    if estimate_level is not None:
+        if not isinstance(estimate_level, (bool, np.bool_)):
+            raise ValueError(f"estimate_level: expected True or False, found {type(estimate_level).__name__}")
+        spec["estimate_level"] = bool(estimate_level)
+    return System(json.dumps(spec))
 
 
 def _output(system: Any, offset: Any, estimate_offset: Any) -> Tuple[Any, dict, Optional[dict]]:
@@ -479,12 +519,15 @@ def _record_inputs(system: Any, record: Mapping[str, Any]) -> Optional[Dict[str,
 def simulate(system: Union[System, Iterable[System], Mapping[str, System]], jitter: jitter.Jitter,
              input: Optional[Input] = None, *, samples: int, interval: float, start: float = 0.0,
              noise_std: float = 0.0, seed: int = DEFAULT_SEED, truth: bool = False,
-             offset: Optional[float] = None, inputs: Optional[Inputs] = None) -> dict:
+             offset: Optional[float] = None, inputs: Optional[Inputs] = None,
+             level: Optional[float] = None) -> dict:
     """``samples`` jittered samples ``y_k = y₀ + s(t_k + τ_k) + v_k`` of ``system`` driven by
     ``input`` at ``t_k = start + k·interval``, white noise of std ``noise_std``, seeded by
     ``seed``: a dict of arrays ``t``, ``y``, ``u`` (with an input), and with ``truth`` the drawn
     ``tau`` and ``v``. ``offset`` is the output offset ``y₀`` (the operating point, as
-    ``[output] offset``; default the system's own, else 0). The GIL is released while it runs.
+    ``[output] offset``; default the system's own, else 0). ``level`` is the input's level
+    ``u₀`` (as ``[input] level``: the system is driven by ``u − u₀`` over the input's span; one
+    input). The GIL is released while it runs.
     The arguments are checked as the command line checks an experiment file (``ValueError``
     naming the key).
 
@@ -493,6 +536,7 @@ def simulate(system: Union[System, Iterable[System], Mapping[str, System]], jitt
     ``inputs`` a list of Inputs in the system's input order or a dict by input name; ``u`` is
     then a dict of arrays by input name."""
     system, pairs = _checked(system, jitter, input, inputs)
+    system = _level(system, level, None)
     system, _, output = _output(system, offset, None)
     _in_range(system, jitter, pairs, samples, interval, start, noise_std, "simulate arguments", output)
     return _jitterid.simulate(system, jitter, [u for _, u in pairs], *_grid(samples, interval, start),
@@ -526,7 +570,8 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         start: Optional[float] = None, input: Optional[Input] = None, noise_std: float = 0.0,
         options: Optional[Mapping[str, Any]] = None, init: str = "experiment",
         progress: Optional[Callable[[int, float], Any]] = None, offset: Optional[float] = None,
-        estimate_offset: Optional[bool] = None, inputs: Optional[Inputs] = None) -> FitResult:
+        estimate_offset: Optional[bool] = None, inputs: Optional[Inputs] = None,
+        level: Optional[float] = None, estimate_level: Optional[bool] = None) -> FitResult:
     """Fits a record's samples with ``method``, starting from ``system`` and ``jitter``.
 
     Arguments:
@@ -563,6 +608,11 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
       it is estimated with the system, as the parameter ``offset`` (the keys of ``[output]``;
       default the system's own, else no offset). ``estimate_offset=True`` needs ``"system"``
       among the estimated parts.
+    * ``level``, ``estimate_level``: the input's level ``u₀`` (the system is driven by
+      ``u − u₀``) and whether it is estimated with the system, as the parameter ``level`` (the
+      keys of ``[input]``; default the system's own, else none; one input). Estimated, it
+      needs ``"system"`` among the estimated parts and, through a system that settles to a
+      static gain, a known offset (both would be constants in the output).
 
     Returns a ``FitResult`` (``names``, ``params``, ``std_errors``, ``covariance``, …), equal
     to ``Experiment.fit`` on an experiment with the same sections. Raises ``ValueError``
@@ -628,6 +678,7 @@ def fit(record: Mapping[str, Any], system: System, jitter: jitter.Jitter, method
         pairs = [] if input is None else [(None, input)]
     if options is not None and not isinstance(options, Mapping):
         raise TypeError(f"options: expected a mapping of [estimate] keys, found {type(options).__name__}")
+    system = _level(system, level, estimate_level)
     _, system_keys, output = _output(system, offset, estimate_offset)
     sections["system"], input_section = _system_sections(system_keys, pairs, "system" in parts)
     if input_section is not None:

@@ -17,7 +17,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 
 /// The cases: name, example file, method, what it shows.
-const CASES: [(&str, &str, &str, &str); 9] = [
+const CASES: [(&str, &str, &str, &str); 11] = [
     (
         "offset",
         "offset.toml",
@@ -71,6 +71,18 @@ const CASES: [(&str, &str, &str, &str); 9] = [
         "msd-delay-offset.toml",
         "bcls",
         "grey box with a dead time and an operating point: the mass–spring–damper's m, damp, k with its delay D and output offset y0, uniform-sum jitter",
+    ),
+    (
+        "input-level",
+        "input-level.toml",
+        "bcls",
+        "an operating point of the input: a tank 1/(s(s+1)) driven by u − u0, the level u0 = 0.5 estimated beside the output offset y0 = 1.5 by BCLS",
+    ),
+    (
+        "input-level-ml",
+        "input-level.toml",
+        "ml",
+        "the same records by exact maximum likelihood",
     ),
 ];
 

@@ -41,6 +41,45 @@ impl Input {
             Input::Tones(_) => Err(SignalError::NeedsSteps { what: "a delay" }),
         }
     }
+
+    /// `1` over the input's span: one step up at a piecewise input's first edge and down at
+    /// its last, or, for tones (on at all times), the constant `1` as a tone of frequency 0
+    /// and phase `π/2`.
+    ///
+    /// # Errors
+    ///
+    /// None for an input that was built (its span is valid); kept for the constructors'.
+    pub fn unit_span(&self) -> Result<Input, SignalError> {
+        Ok(match self {
+            Input::Piecewise(p) => {
+                let (first, last) = (p.edges[0], p.edges[p.edges.len() - 1]);
+                Input::Piecewise(PiecewiseConstant::new(vec![first, last], vec![1.0])?)
+            }
+            Input::Tones(_) => Input::Tones(Multisine::new(vec![Tone::constant(1.0)])?),
+        })
+    }
+
+    /// `u − level · 1` over the input's span ([`unit_span`](Self::unit_span)): the deviation
+    /// from an operating point `level`, what a linear model around it is driven by. A tone
+    /// input gets `−level` as its last tone.
+    ///
+    /// # Errors
+    ///
+    /// [`SignalError::NotFinite`] for a NaN or infinite level; for tones, the tone limit.
+    pub fn deviation(&self, level: f64) -> Result<Input, SignalError> {
+        crate::error::finite("level", level)?;
+        Ok(match self {
+            Input::Piecewise(p) => Input::Piecewise(PiecewiseConstant::new(
+                p.edges.clone(),
+                p.levels.iter().map(|u| u - level).collect(),
+            )?),
+            Input::Tones(m) => {
+                let mut tones = m.tones().to_vec();
+                tones.push(Tone::constant(-level));
+                Input::Tones(Multisine::new(tones)?)
+            }
+        })
+    }
 }
 
 impl From<PiecewiseConstant> for Input {
@@ -170,6 +209,17 @@ pub struct Tone {
     pub amplitude: f64,
     /// Phase in radians.
     pub phase: f64,
+}
+
+impl Tone {
+    /// The constant `c` as a tone: frequency 0, amplitude `c`, phase `π/2`.
+    pub fn constant(c: f64) -> Self {
+        Tone {
+            frequency: 0.0,
+            amplitude: c,
+            phase: std::f64::consts::FRAC_PI_2,
+        }
+    }
 }
 
 /// A sum of tones `u(t) = Σ A_l sin(2πf_l t + φ_l)`, on for all time (the response is the

@@ -296,6 +296,22 @@ impl Rational {
         &self.poles
     }
 
+    /// Whether a pole is taken as an integrator: closer to the origin than `1e-6` of the
+    /// smaller of 1 rad/s and the largest pole modulus (the rule that keeps such a model off
+    /// the modal form).
+    pub fn has_pole_at_origin(&self) -> bool {
+        let largest = self.poles.iter().map(|p| p.norm()).fold(0.0, f64::max);
+        self.poles
+            .iter()
+            .any(|p| p.norm() <= ORIGIN * largest.min(1.0))
+    }
+
+    /// Whether the step response settles to the finite static gain `G(0)`: every pole
+    /// strictly left of the imaginary axis and none taken as an integrator.
+    pub fn settles(&self) -> bool {
+        self.poles.iter().all(|p| p.re < 0.0) && !self.has_pole_at_origin()
+    }
+
     /// The coefficients the confluent realisation reads.
     pub(crate) fn coefficients(&self) -> Coefficients<'_> {
         Coefficients {

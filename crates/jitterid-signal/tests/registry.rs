@@ -26,6 +26,17 @@ fn specs() -> Vec<SpecTable> {
         table(
             json!({"kind": "pulse-response", "coefficients": [0.6, 0.3, -0.15], "interval": 0.5}),
         ),
+        // Around an input level: estimated, with a delay; known, on a grey-box model's
+        // transfer-function route.
+        table(
+            json!({"kind": "zpk", "gain": 0.2, "zeros": [-0.5], "poles": [[-0.25, 0.3]],
+                     "delay": 0.4, "level": 0.35, "estimate_level": true}),
+        ),
+        table(json!({
+            "kind": "grey-box", "params": {"m": 1.0, "damp": 0.4}, "fixed": {"k": 2.0},
+            "a": [["0", "1"], ["-k/m", "-damp/m"]], "b": [[0], ["1/m"]], "c": [[1, 0]],
+            "level": -0.5,
+        })),
         // A mass–spring–damper with a known constant and a bound.
         table(json!({
             "kind": "grey-box", "params": {"m": 1.0, "damp": 0.4}, "fixed": {"k": 2.0},

@@ -1,8 +1,8 @@
 //! The fitted model taken out of the command line: transfer-function coefficients, zeros,
 //! poles and gain, and a state-space realisation (`fit --json`'s `model`), with the input
-//! delay `D` of a delayed system (the model is `G(s) e^{−sD}`), the output offset `y₀` of a
-//! model around an operating point (`y = y₀ + G(s)u`), and the covariance of the reported
-//! parameters.
+//! delay `D` of a delayed system (the model is `G(s) e^{−sD}`), the output offset `y₀` and the
+//! input's level `u₀` of a model around an operating point (`y = y₀ + G(s)(u − u₀)`), and the
+//! covariance of the reported parameters.
 
 use jitterid::estimate::validation::{BodePoint, StepPoint};
 use jitterid::estimate::{validation, EstimateError};
@@ -33,6 +33,19 @@ pub struct ModelForms {
     /// three forms because none of them has a constant term (absent without an offset).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub offset: Option<f64>,
+    /// The input's level `u₀` of a model around an operating point of its input: the model is
+    /// driven by `u − u₀` (`y = G(s)(u − u₀)`; in state space `ẋ = Ax + B(u − u₀)`), reported
+    /// beside the forms for the same reason as the offset (absent without a level).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub level: Option<f64>,
+}
+
+/// The input's level `u₀` of a signal's system, `None` when it has none.
+pub fn level_of(signal: &AnySignal) -> Option<f64> {
+    signal
+        .spec()
+        .get("level")
+        .and_then(serde_json::Value::as_f64)
 }
 
 /// The output offset `y₀` of a signal around an operating point, `None` when it has none.
@@ -131,7 +144,15 @@ pub fn grey_box_of(signal: &AnySignal) -> Result<Option<AnySignal>, SignalError>
         return Ok(Some(signal.clone()));
     }
     let mut spec = signal.spec();
-    for key in ["delay", "initial", "origin", "offset", "estimate_offset"] {
+    for key in [
+        "delay",
+        "initial",
+        "origin",
+        "level",
+        "estimate_level",
+        "offset",
+        "estimate_offset",
+    ] {
         spec.remove(key);
     }
     let step = PiecewiseConstant::new(vec![0.0, 1.0], vec![1.0])?;
@@ -166,6 +187,7 @@ pub fn model_forms(signal: &AnySignal) -> Result<Option<ModelForms>, SignalError
         tf,
         delay: delay_of(signal),
         offset: offset_of(signal),
+        level: level_of(signal),
     }))
 }
 

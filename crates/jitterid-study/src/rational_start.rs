@@ -73,19 +73,51 @@ impl Template {
     }
 
     /// `spec` with the model's keys replaced by `fit` in this parameterisation.
+    ///
+    /// A model with structural integrators (`integrators = n`) holds `n` poles at exactly 0,
+    /// which the initializer's free fit puts only near it: the start moves them there (the
+    /// last `n` coefficients of `den` set to 0, or the `n` real poles nearest the origin), a
+    /// small change of a start that the fit then refines.
     pub(crate) fn write(&self, fit: &RationalFit, spec: &mut SpecTable) -> StudyResult<()> {
         let err = |e| study_err!("--init auto: the initializer's model: {e}");
+        let held = spec
+            .get("integrators")
+            .and_then(Value::as_u64)
+            .unwrap_or(0) as usize;
         match self {
             Self::Tf(t) => {
                 let g = t.with_fit(fit).map_err(err)?;
+                let mut den = g.den().to_vec();
+                let n = den.len();
+                den[n - held.min(n - 1)..].iter_mut().for_each(|a| *a = 0.0);
                 spec.insert("num".into(), json!(g.num()));
-                spec.insert("den".into(), json!(g.den()));
+                spec.insert("den".into(), json!(den));
             }
             Self::Zpk(z) => {
                 let g = z.with_fit(fit).map_err(err)?;
+                let mut poles = g.poles().to_vec();
+                let mut real: Vec<usize> = (0..poles.len())
+                    .filter(|&i| matches!(poles[i], Root::Real(_)))
+                    .collect();
+                real.sort_by(|&a, &b| {
+                    let m = |i: usize| match poles[i] {
+                        Root::Real(p) => p.abs(),
+                        _ => f64::INFINITY,
+                    };
+                    m(a).total_cmp(&m(b))
+                });
+                if real.len() < held {
+                    return Err(study_err!(
+                        "--init auto: the initializer's model has {} real pole(s) to hold at the origin for integrators = {held}; start from the experiment's values (--init experiment)",
+                        real.len()
+                    ));
+                }
+                for &i in &real[..held] {
+                    poles[i] = Root::Real(0.0);
+                }
                 spec.insert("gain".into(), json!(g.gain()));
                 spec.insert("zeros".into(), roots_json(g.zeros()));
-                spec.insert("poles".into(), roots_json(g.poles()));
+                spec.insert("poles".into(), roots_json(&poles));
             }
         }
         Ok(())
@@ -142,11 +174,12 @@ pub(crate) fn channels_start(
         }
         let kind = c.get("kind").and_then(Value::as_str).unwrap_or("");
         let template = Template::of(kind, &c, &at)?;
+        let around = crate::select::around_level(input, &c, &exp.file)?;
         let driven = match c.get("delay").and_then(Value::as_f64) {
-            Some(d) if d > 0.0 => input
+            Some(d) if d > 0.0 => around
                 .delayed(d)
                 .map_err(|e| study_err!("{at} delay: {e}"))?,
-            _ => input.clone(),
+            _ => around,
         };
         free.push((i, template, driven));
     }

@@ -144,6 +144,7 @@ pub fn select(exp: &Experiment, data: &Path, validation: Option<&Path>) -> Study
         delay: delay.filter(|_| exp.system.estimate),
         initial_state: exp.system.kind.contains_key("initial"),
         offset: exp.output_offset(),
+        level: exp.input_level(),
         ..SelectionOptions::default()
     };
     let validation = match validation {
@@ -243,6 +244,21 @@ impl InitChoice {
     }
 }
 
+/// `input` around the level of the system's spec table `spec` (`u − u₀` over its span), or
+/// `input` itself without a level: what the initializer fits a response to.
+pub(crate) fn around_level(
+    input: &Input,
+    spec: &jitterid::signal::registry::SpecTable,
+    file: &str,
+) -> StudyResult<Input> {
+    match spec.get("level").and_then(Value::as_f64) {
+        Some(u0) => input
+            .deviation(u0)
+            .map_err(|e| study_err!("{file}: [input] level: {e}")),
+        None => Ok(input.clone()),
+    }
+}
+
 /// `input` delayed by `delay` seconds: what drives the rational part of a system with an input
 /// delay. The initializer fits the frequency response from this input to the output, so that
 /// the rational model it returns does not carry the delay's phase a second time.
@@ -285,7 +301,10 @@ pub fn auto_start(
         offset: spec.get("estimate_offset") == Some(&Value::Bool(true)),
         ..InitOptions::default()
     };
-    let driven = delayed_input(input, spec.get("delay").and_then(Value::as_f64))
+    // The initializer fits the response to the input as the system sees it: around its
+    // level (the file's, the start of an estimated one), delayed.
+    let around = around_level(input, &spec, &exp.file)?;
+    let driven = delayed_input(&around, spec.get("delay").and_then(Value::as_f64))
         .map_err(|e| study_err!("{}: [system] delay: {e}", exp.file))?;
     let template = Template::of(signal.kind(), &spec, &format!("{}: [system]", exp.file))?;
     let (zeros, poles) = template.orders();

@@ -285,11 +285,24 @@ fn fit_text(exp: &Experiment, f: &Fit, notes: &Notes, name: &str, plot: Option<&
             fmt_num(d)
         );
     }
+    // Around an input level the model is driven by u − u0 (said once, below).
+    let level = export::level_of(&f.fitted.signal);
+    let (u, du) = match level {
+        Some(_) => ("(u - u0)", "D(u - u0)"),
+        None => ("u", "Du"),
+    };
     if let (Some(y0), Ok(Some(_))) = (export::offset_of(&f.fitted.signal), &tf) {
         let _ = writeln!(
             out,
-            "model: y = y0 + G(s)u with output offset y0 = {} (--json: model.offset; model.ss is x' = Ax + Bu, y = Cx + Du + y0)",
+            "model: y = y0 + G(s){u} with output offset y0 = {} (--json: model.offset; model.ss is x' = Ax + B{u}, y = Cx + {du} + y0)",
             fmt_num(y0)
+        );
+    }
+    if let (Some(u0), Ok(Some(_))) = (level, &tf) {
+        let _ = writeln!(
+            out,
+            "model: y = G(s)(u - u0) with input level u0 = {} (--json: model.level; model.ss is x' = Ax + B(u - u0))",
+            fmt_num(u0)
         );
     }
     for line in notes.lines() {

@@ -102,6 +102,12 @@ pub struct SelectionOptions {
     /// it a record around an operating point would be ranked by how well each order's DC gain
     /// and slow poles imitate a constant. `None`: no offset.
     pub offset: Option<(f64, bool)>,
+    /// The input's level `(u₀, estimated)` every candidate carries (the keys `level` and
+    /// `estimate_level` of its spec table, [`jitterid_signal::InputLevel`]): a known `u₀` is
+    /// part of each candidate's model, an estimated one the parameter `level`, started at the
+    /// given `u₀`. The initializer fits each candidate's response to the deviation `u − u₀`.
+    /// `None`: no level.
+    pub level: Option<(f64, bool)>,
 }
 
 impl Default for SelectionOptions {
@@ -112,6 +118,7 @@ impl Default for SelectionOptions {
             delay: None,
             initial_state: false,
             offset: None,
+            level: None,
         }
     }
 }
@@ -396,6 +403,12 @@ fn candidate_signal(
     if let Some(d) = options.delay {
         spec.insert("delay".into(), json!(d));
     }
+    if let Some((u0, estimated)) = options.level {
+        spec.insert("level".into(), json!(u0));
+        if estimated {
+            spec.insert("estimate_level".into(), json!(true));
+        }
+    }
     if options.initial_state {
         spec.insert("initial".into(), json!(vec![0.0; model.den().len() - 1]));
         spec.insert("origin".into(), json!(record.grid().start()));
@@ -455,11 +468,15 @@ fn fit_from(
 ) -> Result<(Structure, jitterid_estimate::Fit), String> {
     let jitter = jitter_at(registry, family, record, fraction)?;
     let model = template(zeros, poles).map_err(|e| format!("template: {e}"))?;
-    // The initializer fits the response to the input as the system sees it, so that the
-    // rational model does not absorb the delay's phase as well.
-    let driven = match options.delay {
-        Some(d) => input.delayed(d).map_err(|e| format!("delay: {e}"))?,
+    // The initializer fits the response to the input as the system sees it (around its
+    // level, delayed), so that the rational model does not absorb the delay's phase as well.
+    let around = match options.level {
+        Some((u0, _)) => input.deviation(u0).map_err(|e| format!("level: {e}"))?,
         None => input.clone(),
+    };
+    let driven = match options.delay {
+        Some(d) => around.delayed(d).map_err(|e| format!("delay: {e}"))?,
+        None => around,
     };
     let rational = ModelStructure::oe(LtiResponse::new(model, driven), jitter.clone());
     let rational = initialize(&rational, record, &init_options(options))

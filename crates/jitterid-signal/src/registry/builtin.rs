@@ -1,9 +1,11 @@
 //! The built-in signal kinds.
 
 use super::{KindReader, ParamSpec, SignalKind, SignalRegistry, SpecReader, SpecTable};
+use crate::spectrum::Spectrum;
 use crate::{
-    AnySignal, Delayed, Input, LtiResponse, Offset, PulseResponse, RationalModel, Root,
-    SignalError, Sinusoid, TransferFunction, WithInitialState, Zpk,
+    AnySignal, Delayed, DrivenSignal, Input, InputLevel, LtiResponse, ModalSignal, Offset,
+    PulseResponse, RationalModel, Root, SignalError, Sinusoid, TransferFunction, WithInitialState,
+    Zpk,
 };
 use serde_json::{json, Value};
 
@@ -259,6 +261,18 @@ pub(super) fn response_keys() -> Vec<ParamSpec> {
         )
         .with_default(0.0),
         ParamSpec::new(
+            "level",
+            "input level u₀ (operating point of the input): the model is driven by u − u₀ over the input's span",
+            "",
+            "optional; finite (absent: no level)",
+        ),
+        ParamSpec::new(
+            "estimate_level",
+            "whether u₀ is estimated, the parameter `level` (true), or known (false, the default)",
+            "",
+            "optional; true or false",
+        ),
+        ParamSpec::new(
             "offset",
             "output offset y₀ (operating point): the model is y₀ + the response",
             "",
@@ -319,8 +333,8 @@ pub(super) fn lti_signal<M: RationalModel + Clone + 'static>(
     with_offset(kind, r, lti_response(kind, r, response, keys)?)
 }
 
-/// `response`, delayed and given a free response as the spec table asks (without the output
-/// offset, which [`with_offset`] adds around it).
+/// `response`, delayed, around its input's level and given a free response as the spec table
+/// asks (without the output offset, which [`with_offset`] adds around it).
 fn lti_response<M: RationalModel + Clone + 'static>(
     kind: &'static str,
     r: &SpecReader<'_>,
@@ -336,54 +350,81 @@ fn lti_response<M: RationalModel + Clone + 'static>(
     } else {
         None
     };
-    let initial = r
-        .has("initial")
-        .then(|| r.f64_list("initial"))
-        .transpose()?;
+    match delay {
+        None => around_level(kind, r, response, move |s: &LtiResponse<M>| keys(s.model())),
+        Some(d) => {
+            let delayed = Delayed::new(response, d).map_err(|e| r.invalid("delay", e))?;
+            around_level(kind, r, delayed, move |s: &Delayed<M>| {
+                let mut out = keys(s.response().model());
+                out.insert("delay".into(), json!(s.delay()));
+                out
+            })
+        }
+    }
+}
+
+/// `response` around the input's level `level` (the parameter `level` when
+/// `estimate_level`), when the spec table has either key; else `response` unchanged (no
+/// wrapper, no parameter, every number as before). Then the free response.
+fn around_level<S>(
+    kind: &'static str,
+    r: &SpecReader<'_>,
+    response: S,
+    keys: impl Fn(&S) -> SpecTable + Clone + Send + Sync + 'static,
+) -> Result<AnySignal, SignalError>
+where
+    S: DrivenSignal + ModalSignal + Spectrum + Clone + 'static,
+{
+    if !r.has("level") && !r.has("estimate_level") {
+        return with_free_response(kind, r, response, keys);
+    }
+    let level = if r.has("level") { r.f64("level")? } else { 0.0 };
+    let estimated = r.flag("estimate_level")?;
+    let wrapped = InputLevel::new(response, level, estimated).map_err(|e| r.invalid("level", e))?;
+    with_free_response(kind, r, wrapped, move |s: &InputLevel<S>| {
+        let mut out = keys(s.response());
+        out.insert("level".into(), json!(s.level()));
+        if s.estimated() {
+            out.insert("estimate_level".into(), json!(true));
+        }
+        out
+    })
+}
+
+/// `response` with the free response from `initial` at `origin` when the spec table has
+/// `initial`.
+fn with_free_response<S>(
+    kind: &'static str,
+    r: &SpecReader<'_>,
+    response: S,
+    keys: impl Fn(&S) -> SpecTable + Send + Sync + 'static,
+) -> Result<AnySignal, SignalError>
+where
+    S: ModalSignal + Spectrum + Clone + 'static,
+{
+    if !r.has("initial") {
+        return Ok(AnySignal::with_spectrum(kind, response, keys));
+    }
+    let initial = r.f64_list("initial")?;
     let origin = r.f64("origin")?;
-    let with_origin = move |mut s: SpecTable, initial: &[f64], origin: f64| {
-        s.insert("initial".into(), json!(initial));
-        s.insert("origin".into(), json!(origin));
-        s
-    };
-    let delayed =
-        |resp| Delayed::new(resp, delay.unwrap_or(0.0)).map_err(|e| r.invalid("delay", e));
-    let free_error = |e: SignalError| {
+    let free = WithInitialState::new(response, origin, initial).map_err(|e| {
         let key = if matches!(e, SignalError::NotFinite { name: "origin", .. }) {
             "origin"
         } else {
             "initial"
         };
         r.invalid(key, e)
-    };
-    Ok(match (delay, initial) {
-        (None, None) => {
-            AnySignal::with_spectrum(kind, response, move |s: &LtiResponse<M>| keys(s.model()))
-        }
-        (Some(_), None) => {
-            AnySignal::with_spectrum(kind, delayed(response)?, move |s: &Delayed<M>| {
-                let mut out = keys(s.response().model());
-                out.insert("delay".into(), json!(s.delay()));
-                out
-            })
-        }
-        (None, Some(q)) => AnySignal::new(
-            kind,
-            WithInitialState::new(response, origin, q).map_err(free_error)?,
-            move |s: &WithInitialState<LtiResponse<M>>| {
-                with_origin(keys(s.response().model()), s.initial(), s.origin())
-            },
-        ),
-        (Some(_), Some(q)) => AnySignal::new(
-            kind,
-            WithInitialState::new(delayed(response)?, origin, q).map_err(free_error)?,
-            move |s: &WithInitialState<Delayed<M>>| {
-                let mut out = keys(s.response().response().model());
-                out.insert("delay".into(), json!(s.response().delay()));
-                with_origin(out, s.initial(), s.origin())
-            },
-        ),
-    })
+    })?;
+    Ok(AnySignal::new(
+        kind,
+        free,
+        move |s: &WithInitialState<S>| {
+            let mut out = keys(s.response());
+            out.insert("initial".into(), json!(s.initial()));
+            out.insert("origin".into(), json!(s.origin()));
+            out
+        },
+    ))
 }
 
 fn sinusoid() -> SignalKind {

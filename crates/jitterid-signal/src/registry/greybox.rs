@@ -51,7 +51,14 @@ pub(super) fn kind() -> SignalKind {
 
 /// The keys that put the model on its transfer function's route ([`GreyBox::transfer_response`]),
 /// where an input delay, a free response and an output offset are built as for `tf`.
-const RESPONSE_KEYS: [&str; 4] = ["delay", "initial", "offset", "estimate_offset"];
+const RESPONSE_KEYS: [&str; 6] = [
+    "delay",
+    "initial",
+    "level",
+    "estimate_level",
+    "offset",
+    "estimate_offset",
+];
 
 fn build(r: &SpecReader<'_>, input: Option<&Input>) -> Result<AnySignal, SignalError> {
     let params = named_numbers(r, "params")?;

@@ -100,6 +100,10 @@ fn input_name(name: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// The level's keys, which every kind takes ([`super::level`]).
+const LEVEL: &str = "level";
+const ESTIMATE: &str = "estimate_level";
+
 fn parse_input(
     cx: &Source,
     r: &RawInput,
@@ -109,11 +113,44 @@ fn parse_input(
     let kind = cx.required(S, "kind", &r.kind, &format!("expected kind = {KINDS}"))?;
     let name = kind.get_ref().as_str();
     let allowed: &[&str] = match name {
-        "random-binary" => &["name", "kind", "mean_dwell", "low", "high", "history"],
-        "sine" => &["name", "kind", "frequency", "amplitude", "phase"],
-        "multisine" => &["name", "kind", "frequencies", "amplitudes", "phases"],
-        "piecewise" => &["name", "kind", "times", "values"],
-        "csv" => &["name", "kind", "path", "time_column", "value_column"],
+        "random-binary" => &[
+            "name",
+            "kind",
+            "mean_dwell",
+            "low",
+            "high",
+            "history",
+            LEVEL,
+            ESTIMATE,
+        ],
+        "sine" => &[
+            "name",
+            "kind",
+            "frequency",
+            "amplitude",
+            "phase",
+            LEVEL,
+            ESTIMATE,
+        ],
+        "multisine" => &[
+            "name",
+            "kind",
+            "frequencies",
+            "amplitudes",
+            "phases",
+            LEVEL,
+            ESTIMATE,
+        ],
+        "piecewise" => &["name", "kind", "times", "values", LEVEL, ESTIMATE],
+        "csv" => &[
+            "name",
+            "kind",
+            "path",
+            "time_column",
+            "value_column",
+            LEVEL,
+            ESTIMATE,
+        ],
         other => {
             return Err(cx.err(
                 S,

@@ -14,6 +14,7 @@ mod diagnostics;
 mod estimate;
 mod input;
 mod jitter;
+mod level;
 mod method;
 mod noise;
 mod overrides;
@@ -278,6 +279,7 @@ pub fn parse_with(
         channels::parse_channels(&cx, &r_systems, &r_inputs, &grid)?
     };
     system::output_keys(&cx, raw.output.as_ref(), &mut system)?;
+    level::level_keys(&cx, &r_inputs, &inputs, &mut system)?;
     let jitter = match &raw.jitter {
         Some(r) => jitter::parse_jitter(&cx, r, &grid)?,
         None => jitter::no_jitter(),

@@ -55,6 +55,8 @@ section!(RawInput, "table [input]" {
     time_column: String,
     value_column: String,
     history: f64,
+    level: f64,
+    estimate_level: bool,
 });
 
 section!(RawSystem, "table [system]" {
@@ -249,12 +251,22 @@ pub(super) fn docs_table_keys(heading: &str) -> Vec<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{docs_table_keys, RawOutput};
+    use super::{docs_table_keys, RawInput, RawOutput};
 
     /// The `[output]` table of `docs/experiments.md` lists exactly the keys the reader takes,
     /// in order: the reference cannot drift from the reader.
     #[test]
     fn the_docs_output_table_lists_the_reader_s_keys() {
         assert_eq!(docs_table_keys("### `[output]`"), RawOutput::KEYS);
+    }
+
+    /// The input's level table lists the reader's last two `[input]` keys.
+    #[test]
+    fn the_docs_level_table_lists_the_reader_s_keys() {
+        let keys = RawInput::KEYS;
+        assert_eq!(
+            docs_table_keys("#### The input's level"),
+            keys[keys.len() - 2..]
+        );
     }
 }

@@ -186,6 +186,13 @@ pub(crate) fn channels_selectable(exp: &super::Experiment) -> StudyResult<()> {
                 ),
             );
         }
+        if c.get("level").is_some() {
+            return Err(crate::study_err!(
+                "{}: [[input]] level: select over several inputs fits candidates without an input level (input {}); fit the system with its orders given (jitterid fit), or select on the deviation u − u₀ written as the input",
+                exp.file,
+                i + 1
+            ));
+        }
         for (key, what) in NOT_CARRIED {
             // `unstable = false` and `integrators = 0` are the defaults written out.
             let set = c

@@ -360,6 +360,15 @@ impl Experiment {
         Some((y0, estimated))
     }
 
+    /// The input's level of `[input]` for a single-input system: `(u₀, estimated)`, `None`
+    /// without one (the system's spec table holds it as the keys `level` and
+    /// `estimate_level`; a multi-input system's are in its channels' tables).
+    pub fn input_level(&self) -> Option<(f64, bool)> {
+        let u0 = self.system.kind.get("level")?.as_f64()?;
+        let estimated = self.system.kind.get("estimate_level") == Some(&true.into());
+        Some((u0, estimated))
+    }
+
     /// Whether `select` can run this experiment: its candidates are built from the `[select]`
     /// orders with the system's delay, free response and output offset; a multi-input system's
     /// from one transfer function per input, each estimated, without a delay or free response.

@@ -18,8 +18,15 @@ const S: &str = "system";
 const OWN_KEYS: &[&str] = &["estimate"];
 
 /// Keys of a kind's spec table that the command line sets itself: a free response starts at
-/// the record's first instant; the output offset comes from `[output]`.
-const SET_HERE: &[&str] = &["origin", "offset", "estimate_offset"];
+/// the record's first instant; the output offset comes from `[output]`, the input's level from
+/// `[input]`.
+const SET_HERE: &[&str] = &[
+    "origin",
+    "offset",
+    "estimate_offset",
+    "level",
+    "estimate_level",
+];
 
 /// The keys `[system]` takes for `kind`: `kind`, the kind's registry keys (but those set here)
 /// and the command line's own.
