@@ -80,10 +80,7 @@ impl Template {
     /// small change of a start that the fit then refines.
     pub(crate) fn write(&self, fit: &RationalFit, spec: &mut SpecTable) -> StudyResult<()> {
         let err = |e| study_err!("--init auto: the initializer's model: {e}");
-        let held = spec
-            .get("integrators")
-            .and_then(Value::as_u64)
-            .unwrap_or(0) as usize;
+        let held = spec.get("integrators").and_then(Value::as_u64).unwrap_or(0) as usize;
         match self {
             Self::Tf(t) => {
                 let g = t.with_fit(fit).map_err(err)?;
