@@ -10,7 +10,11 @@
 //!   (composite 16-point Gauss–Legendre on `[min s − 10σ_v, max s + 10σ_v]` over the jitter's
 //!   reach, 16 nodes per `8σ_v`) with the exact per-sample likelihood of
 //!   [`ExactMl`](super::ExactMl): scores analytic in the signal's parameters and `σ_v`, central
-//!   differences in the jitter's. Its inverse is the Cramér–Rao bound.
+//!   differences in the jitter's. Its inverse is the Cramér–Rao bound. What of each sample's
+//!   likelihood does not depend on `y` (the signal and its gradient at the quadrature nodes
+//!   over the jitter, the rule itself) is computed once per sample, not once per node in `y`
+//!   (`exact::cached`: the same information to about `1e-12` relative, five to six times
+//!   faster on the Table 2 setup).
 //!
 //! The parameters are the likelihood's ([`likelihood_param_names`](super::likelihood_param_names)):
 //! the structure's free ones, then `σ_v` if the structure does not fix it.
@@ -446,9 +450,11 @@ mod tests {
         assert_eq!(cached.names, fresh.names);
         let (a, b) = (&cached.matrix, &fresh.matrix);
         let p = a.len();
+        let mut worst: f64 = 0.0;
         for i in 0..p {
             for j in 0..p {
                 let scale = (b[i][i] * b[j][j]).sqrt();
+                worst = worst.max((a[i][j] - b[i][j]).abs() / scale);
                 assert!(
                     (a[i][j] - b[i][j]).abs() <= 1e-9 * scale,
                     "{:?} [{i}][{j}]: {} vs {}",
@@ -458,6 +464,10 @@ mod tests {
                 );
             }
         }
+        eprintln!(
+            "{:?}: largest difference {worst:e} of √(I_aa I_bb)",
+            structure.jitter
+        );
         let (ma, mb) = (
             cached.max_mass_error.unwrap(),
             fresh.max_mass_error.unwrap(),
