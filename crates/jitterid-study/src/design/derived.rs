@@ -26,7 +26,8 @@ pub enum Derived {
     /// The jitter's standard deviation (s).
     JitterStd,
     /// The natural frequency `|p|/2π` (Hz) of the `k`-th pole (from 0), a complex pair counted
-    /// once, the poles ordered by `|p|` (see [`pole_frequencies`]); named `pole{k+1}.frequency`.
+    /// once, the poles ordered by `|p|` (an order a small change of the parameters keeps);
+    /// named `pole{k+1}.frequency`.
     PoleFrequency(usize),
 }
 

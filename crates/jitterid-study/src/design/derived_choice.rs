@@ -135,9 +135,8 @@ pub(crate) fn check_defined(
 }
 
 /// The predicted standard deviation of each quantity of `requests` at `p`, named; `None`
-/// where it cannot be computed (a quantity that [`check_defined`] accepted at the prior model
-/// always has one there, but a finite difference can fail at a design or a baseline may
-/// differ).
+/// where it cannot be computed (a quantity that [`design`](super::design()) checked at the
+/// prior model has one there, but a finite difference can still fail at another design).
 pub fn requested_stds(p: &Prediction, requests: &[DerivedRequest]) -> Vec<PredictedStd> {
     quantities(requests, p.model())
         .into_iter()
