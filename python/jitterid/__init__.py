@@ -232,10 +232,11 @@ def select(experiment: Experiment, record: Record, *, validation: Optional[Recor
 
 
 def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: Optional[str] = None,
-           jitter_blind: bool = False, write_input: Optional[Union[str, os.PathLike]] = None) -> DesignResult:
+           jitter_blind: bool = False, write_input: Optional[Union[str, os.PathLike]] = None,
+           derived: Optional[Iterable[str]] = None) -> DesignResult:
     """The experiment that makes ``experiment``'s estimate most precise, over the free
     variables of its ``[design]`` section (see ``docs/experiments.md``), as ``jitterid design
-    --json [--criterion] [--budget] [--jitter-blind] [--write-input]``.
+    --json [--criterion] [--budget] [--jitter-blind] [--write-input] [--derived]``.
 
     * ``criterion``: ``"d"`` (log det of the predicted covariance), ``"a"`` (its trace) or
       ``"param:NAME"`` (one parameter's variance); the section's by default.
@@ -244,19 +245,31 @@ def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: O
     * ``jitter_blind``: also the design that ignores the jitter, predicted under the true prior.
     * ``write_input``: a path ``FILE.csv``: writes the designed input there and the experiment
       that reads it to ``FILE.toml``, ready for ``Experiment.from_toml`` and ``simulate``.
+    * ``derived``: the derived quantities whose predicted standard deviations are reported
+      (``result.derived``), replacing ``[design] derived``: ``"static_gain"``,
+      ``"pole_frequency"`` (every pole's ``|p|/2π``, named ``pole1.frequency``, … in increasing
+      order), ``"poleK.frequency"``, ``"gain@F"`` (``|G|`` at ``F`` Hz), ``"jitter.sigma"``.
 
     The search runs without the GIL. A ``[design]`` without a feasible point, a budget that
-    cannot be met or an unknown criterion raise ``ValueError`` naming the key."""
+    cannot be met, an unknown criterion or an unknown or undefined derived quantity raise
+    ``ValueError`` naming the key."""
     _experiment(experiment)
     for name, value in (("criterion", criterion), ("budget", budget)):
         if value is not None and not isinstance(value, str):
             raise TypeError(f"{name}: expected text such as 'd' or 'samples=400', found {type(value).__name__}")
+    names = None
+    if derived is not None:
+        if isinstance(derived, str):
+            raise TypeError("derived: expected a list of names such as ['static_gain', 'pole_frequency'], found a str")
+        names = list(derived)
+        if not all(isinstance(n, str) for n in names):
+            raise TypeError("derived: expected a list of names such as ['static_gain', 'pole_frequency']")
     target = None if write_input is None else os.fspath(write_input)
     if target is not None and not target.endswith(".csv"):
         raise ValueError(f"write_input: expected a path ending in .csv (the experiment goes beside it as .toml), "
                          f"found {target!r}")
     text, written = _jitterid.design(experiment, criterion, bool(jitter_blind), budget,
-                                     None if target is None else os.path.basename(target))
+                                     None if target is None else os.path.basename(target), names)
     if target is not None and written is not None:
         csv, toml = written
         with open(target, "w") as out:

@@ -1,7 +1,7 @@
 """Type stubs of the compiled core (the public API is in ``jitterid`` and ``jitterid.jitter``)."""
 
 from os import PathLike
-from typing import Any, Callable, Optional, Tuple, Union
+from typing import Any, Callable, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -121,7 +121,7 @@ class Validated:
 
 def design(
     experiment: Experiment, criterion: Optional[str], jitter_blind_design: bool, budget: Optional[str],
-    input_name: Optional[str],
+    input_name: Optional[str], derived: Optional[List[str]] = None,
 ) -> Tuple[str, Optional[Tuple[str, str]]]:
     """``design --json``'s text, and with ``input_name`` the designed input's CSV and experiment texts."""
 def validate(

@@ -5,7 +5,7 @@
 use crate::errors::value_error;
 use crate::experiment::Experiment;
 use jitterid_study::design::{design as run_design, designed_input, jitter_blind, Plan};
-use jitterid_study::experiment::{budget_edit, DesignCriterion, ReadOptions};
+use jitterid_study::experiment::{budget_edit, derived_edit, DesignCriterion, ReadOptions};
 use jitterid_study::Registries;
 use pyo3::prelude::*;
 
@@ -14,8 +14,9 @@ use pyo3::prelude::*;
 /// `"samples=N"`, replacing the section's), with the jitter-blind design beside it when
 /// `jitter_blind`: `design --json`'s text. With `input_name`, also the designed input's CSV
 /// text and the experiment text that reads it from a file of that name (`--write-input`).
+/// With `derived`, the derived quantities reported (`--derived`, `[design] derived`).
 #[pyfunction]
-#[pyo3(signature = (experiment, criterion, jitter_blind_design, budget, input_name))]
+#[pyo3(signature = (experiment, criterion, jitter_blind_design, budget, input_name, derived=None))]
 pub fn design(
     py: Python<'_>,
     experiment: &Experiment,
@@ -23,6 +24,7 @@ pub fn design(
     jitter_blind_design: bool,
     budget: Option<String>,
     input_name: Option<String>,
+    derived: Option<Vec<String>>,
 ) -> PyResult<(String, Option<(String, String)>)> {
     let criterion = criterion
         .map(|c| DesignCriterion::parse(&c).map_err(|e| value_error(format!("criterion: {e}"))))
@@ -35,6 +37,10 @@ pub fn design(
         options
             .overrides
             .push(budget_edit(&b).map_err(value_error)?);
+    }
+    if let Some(names) = derived {
+        let origin = format!("derived={names:?}");
+        options.overrides.push(derived_edit(&names, origin));
     }
     let (file, text, dir) = experiment.source();
     let plan = Plan::parse(

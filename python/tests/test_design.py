@@ -40,6 +40,22 @@ def test_design_equals_the_command_line_s(tmp_path):
     assert result.to_dict() == json.loads(out.stdout)
 
 
+def test_derived_quantities_are_chosen_as_on_the_command_line(tmp_path):
+    path = table2_with_design(tmp_path)
+    exp = jitterid.Experiment.from_toml(str(path))
+    result = jitterid.design(exp, derived=["pole_frequency", "gain@0.05"])
+    assert list(result.derived) == ["pole1.frequency", "|G|@0.05Hz"]
+    assert all(v > 0 for v in result.derived.values())
+    with pytest.raises(TypeError, match="derived"):
+        jitterid.design(exp, derived="static_gain")
+    binary = os.environ.get("JITTERID_BIN")
+    if binary is None:
+        pytest.skip("JITTERID_BIN is not set (the command line to compare with)")
+    out = subprocess.run([binary, "design", str(path), "--derived", "pole_frequency,gain@0.05", "--json"],
+                         capture_output=True, text=True, check=True)
+    assert result.to_dict() == json.loads(out.stdout)
+
+
 def test_the_designed_input_is_written_and_runs(tmp_path):
     exp = jitterid.Experiment.from_toml(str(table2_with_design(tmp_path)))
     target = tmp_path / "designed.csv"
@@ -56,6 +72,8 @@ def test_the_designed_input_is_written_and_runs(tmp_path):
     ({"budget": "samples=0"}, "a budget that cannot be met"),
     ({"budget": "time=5"}, "expected duration="),
     ({"write_input": "designed.txt"}, "ending in .csv"),
+    ({"derived": ["bogus"]}, "unknown derived quantity"),
+    ({"derived": ["pole2.frequency"]}, r"\[design\] derived"),
 ])
 def test_bad_design_arguments_raise_value_error(tmp_path, kwargs, words):
     exp = jitterid.Experiment.from_toml(str(table2_with_design(tmp_path)))

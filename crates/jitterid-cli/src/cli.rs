@@ -66,6 +66,11 @@ pub struct DesignArgs {
     /// designed sampling, to FILE.toml, ready for simulate and fit.
     #[arg(long, value_name = "FILE.csv")]
     pub write_input: Option<PathBuf>,
+    /// The derived quantities whose predicted standard deviations are reported, comma-separated:
+    /// static_gain, pole_frequency (every pole's |p|/2π), poleK.frequency, gain@F (|G| at F Hz),
+    /// jitter.sigma [default: [design] derived, else static_gain and an estimated jitter's σ].
+    #[arg(long, value_name = "QUANTITY,...", value_delimiter = ',')]
+    pub derived: Option<Vec<String>>,
     /// Also design with the jitter ignored (γ ≡ 1, no jitter noise) and report that design's
     /// precision under the true, jittered prior beside the jitter-aware one.
     #[arg(long)]
@@ -392,6 +397,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             experiment: a.experiment,
             criterion: a.criterion,
             budget: a.budget,
+            derived: a.derived,
             jitter_blind: a.jitter_blind,
             write_input: a.write_input,
             json: a.json,

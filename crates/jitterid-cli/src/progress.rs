@@ -1,8 +1,9 @@
 //! Progress on stderr, drawn by [`indicatif`] only when stderr is a terminal: a bar for Monte
-//! Carlo runs, the elapsed time of a single long fit.
+//! Carlo runs, the elapsed time of a single long fit, the designs a design search evaluated.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use jitterid::estimate::solver::{Progress as SolverProgress, ProgressHook};
+use jitterid_study::design::{DesignObserver, DesignProgress};
 use std::io::IsTerminal;
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::Duration;
@@ -153,6 +154,68 @@ impl Drop for Ticker {
         }
         if let Ok(mut active) = ACTIVE.lock() {
             *active = None;
+        }
+    }
+}
+
+/// The progress of `jitterid design` on stderr, only when stderr is a terminal: a spinner with
+/// the designs evaluated, the grid's size, a robust design's prior draws and the elapsed
+/// time, `design: 23 designs evaluated (grid 9), prior draw 3/8, 4.2 s` (`jitter-blind
+/// design: …` during that search); the line is cleared when the design ends.
+#[derive(Debug)]
+pub struct DesignTicker {
+    bar: Option<ProgressBar>,
+}
+
+impl DesignTicker {
+    /// Starts the spinner (nothing unless stderr is a terminal).
+    pub fn start() -> Self {
+        if !std::io::stderr().is_terminal() {
+            return Self { bar: None };
+        }
+        let style = ProgressStyle::with_template("{spinner} {msg}, {seconds}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner())
+            .with_key("seconds", seconds);
+        let bar = ProgressBar::with_draw_target(None, stderr_target(10))
+            .with_style(style)
+            .with_message("design: starting");
+        bar.enable_steady_tick(TICKER_PERIOD);
+        Self { bar: Some(bar) }
+    }
+
+    /// The observer that updates the spinner (a no-op when nothing is drawn).
+    pub fn observer(&self) -> DesignObserver {
+        let bar = self.bar.clone();
+        // What the last evaluation said, so that a prior draw's line keeps it.
+        let last = Mutex::new(String::from("design"));
+        DesignObserver::new(move |p| {
+            let Some(bar) = &bar else { return };
+            let Ok(mut last) = last.lock() else { return };
+            match *p {
+                DesignProgress::Evaluated {
+                    jitter_blind,
+                    evaluations,
+                    grid_points,
+                } => {
+                    *last = format!(
+                        "{}design: {evaluations} design{} evaluated (grid {grid_points})",
+                        if jitter_blind { "jitter-blind " } else { "" },
+                        if evaluations == 1 { "" } else { "s" }
+                    );
+                    bar.set_message(last.clone());
+                }
+                DesignProgress::PriorDraw { done, total } => {
+                    bar.set_message(format!("{last}, prior draw {done}/{total}"));
+                }
+            }
+        })
+    }
+}
+
+impl Drop for DesignTicker {
+    fn drop(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
         }
     }
 }

@@ -266,3 +266,45 @@ fn a_budget_on_the_command_line_replaces_the_file_s() {
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(v["design"]["samples"], 150, "{v}");
 }
+
+/// `--derived` chooses the derived quantities (the pole pair's natural frequency, `|G|` at a
+/// frequency, the known jitter's σ as 0), in the order asked; without a terminal the progress
+/// spinner draws nothing, so stderr stays empty; an unknown or undefined quantity exits 2
+/// naming the flag or the key.
+#[test]
+fn derived_flag_chooses_the_quantities_and_bad_ones_exit_2() {
+    let o = cheap_table2(&[
+        "--derived",
+        "pole_frequency,gain@0.05,jitter.sigma",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "", "no progress without a terminal");
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let names: Vec<&str> = v["derived"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["pole1.frequency", "|G|@0.05Hz", "jitter.sigma"]);
+    assert!(v["derived"][0]["std"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["derived"][2]["std"].as_f64(), Some(0.0));
+    assert_eq!(v["baseline"]["derived"].as_array().unwrap().len(), 3);
+    // The table has the rows too.
+    let t = cheap_table2(&["--derived", "pole1.frequency"]);
+    assert_eq!(t.status.code(), Some(0), "{}", stderr(&t));
+    assert!(stdout(&t).contains("pole1.frequency"), "{}", stdout(&t));
+    for (args, want) in [
+        (vec!["--derived", "bogus"], "--derived bogus"),
+        (vec!["--derived", "pole2.frequency"], "[design] derived"),
+        (
+            vec!["--set", "design.derived=[\"static_gain\", \"gain@-1\"]"],
+            "derived",
+        ),
+    ] {
+        let mut all = vec!["--set", DWELL];
+        all.extend(args.iter().copied());
+        refused(&all, want);
+    }
+}

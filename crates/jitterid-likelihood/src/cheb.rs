@@ -62,6 +62,21 @@ impl<const N: usize> ChebTables<N> {
     }
 }
 
+impl<const N: usize> ChebTables<N> {
+    /// Row `j` of the transform: `c_j = row · values`.
+    #[inline]
+    pub(crate) fn row(&self, j: usize) -> &[f64; N] {
+        &self.dct[j]
+    }
+
+    /// The weights `w_i = Σ_j dct[j][i] μ_j` with `Σ_j c_j μ_j = Σ_i w_i v_i` for the
+    /// coefficients `c` of any values `v`: the integral of the interpolant against moments `μ`
+    /// as one dot product with the values (equal to the coefficients' sum up to rounding).
+    pub(crate) fn weights(&self, mu: &[f64; N]) -> [f64; N] {
+        std::array::from_fn(|i| (0..N).map(|j| self.dct[j][i] * mu[j]).sum())
+    }
+}
+
 /// The tables of [`CHEB_POINTS`] points, computed once.
 pub(crate) fn tables16() -> &'static ChebTables<CHEB_POINTS> {
     static T: OnceLock<ChebTables<CHEB_POINTS>> = OnceLock::new();

@@ -7,11 +7,12 @@
 use crate::commands::{fmt_num, name_width};
 use crate::exit::Outcome;
 use crate::output::OutputSet;
+use crate::progress::DesignTicker;
 use jitterid_study::design::{
-    derived_stds, design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
+    design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
 };
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{budget_edit, DesignCriterion, ReadOptions};
+use jitterid_study::experiment::{budget_edit, derived_edit, DesignCriterion, ReadOptions};
 use jitterid_study::study_err;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -27,6 +28,8 @@ pub struct DesignOptions {
     pub criterion: Option<String>,
     /// The budget (`duration=SECONDS` or `samples=N`), replacing `[design] duration`/`samples`.
     pub budget: Option<String>,
+    /// The derived quantities reported (`--derived`), replacing `[design] derived`.
+    pub derived: Option<Vec<String>>,
     /// Also design with the jitter ignored, evaluated under the true prior.
     pub jitter_blind: bool,
     /// Write the designed input (CSV) to this file and the experiment reading it beside it
@@ -80,11 +83,19 @@ pub fn design(o: &DesignOptions) -> StudyResult<Outcome> {
     if let Some(b) = &o.budget {
         read.overrides.push(budget_edit(b)?);
     }
-    let plan = Plan::read(&o.experiment, &read)?;
+    if let Some(names) = &o.derived {
+        let origin = format!("--derived {}", names.join(","));
+        read.overrides.push(derived_edit(names, origin));
+    }
+    // The spinner watches the searches (the jitter-blind one too) and is cleared before
+    // anything is printed; the numbers do not depend on it.
+    let ticker = DesignTicker::start();
+    let plan = Plan::read(&o.experiment, &read)?.with_observer(ticker.observer());
     let mut report = run_design(&plan, criterion.as_ref())?;
     if o.jitter_blind {
         report.jitter_blind = Some(jitter_blind(&plan, &report.criterion)?);
     }
+    drop(ticker);
     let mut outputs = OutputSet::new();
     let mut wrote = Vec::new();
     if let (Some(path), Some((name, experiment))) = (&o.write_input, &written_names) {
@@ -139,7 +150,7 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
             design_text(&b.design)
         );
     }
-    let derived_names: Vec<String> = derived_stds(p).into_iter().map(|d| d.name).collect();
+    let derived_names: Vec<String> = report.derived_of(p).into_iter().map(|d| d.name).collect();
     let w = name_width(p.names.iter().chain(&derived_names).map(String::as_str));
     let blind_head = if blind.is_some() {
         format!("  {:>14}", "jitter-blind")
@@ -171,9 +182,9 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
             .find(|d| d.name == name)
             .and_then(|d| d.std)
     };
-    for d in derived_stds(p) {
-        let b = base.and_then(|(bp, _)| named(derived_stds(bp), &d.name));
-        let j = blind.and_then(|bl| named(derived_stds(&bl.prediction), &d.name));
+    for d in report.derived_of(p) {
+        let b = base.and_then(|(bp, _)| named(report.derived_of(bp), &d.name));
+        let j = blind.and_then(|bl| named(report.derived_of(&bl.prediction), &d.name));
         let _ = writeln!(
             out,
             "{:<w$}  {:>14}  {:>14}{}",

@@ -191,11 +191,14 @@ pub(crate) struct JitterPrep {
     moments: Option<Moments>,
 }
 
-/// `E[T_j((2τ − lo − hi)/(hi − lo))]` for `j < 16` and `j < 32`.
+/// `E[T_j((2τ − lo − hi)/(hi − lo))]` for `j < 16` and `j < 32`, and the node weights they
+/// give ([`ChebTables::weights`]), which the Fisher information's cached route integrates with.
 #[derive(Debug, Clone)]
 struct Moments {
     narrow: [f64; CHEB_POINTS],
     wide: [f64; 32],
+    narrow_weights: [f64; CHEB_POINTS],
+    wide_weights: [f64; 32],
 }
 
 /// `E[T_j(x(τ))]`, `j < N`, over `rule`, `x` mapping `[lo, hi]` onto `[−1, 1]`.
@@ -267,9 +270,13 @@ impl JitterPrep {
         let atoms = jitter.atoms();
         let moments = (hi > lo && lo.is_finite() && hi.is_finite()).then(|| {
             let wide_rate = WIDE_MOMENT_PANELS * MAX_RATE_WIDTH / (hi - lo);
+            let narrow = chebyshev_moments(&jitter.rule(&[], 0.0), lo, hi);
+            let wide = chebyshev_moments(&jitter.rule(&[], wide_rate), lo, hi);
             Moments {
-                narrow: chebyshev_moments(&jitter.rule(&[], 0.0), lo, hi),
-                wide: chebyshev_moments(&jitter.rule(&[], wide_rate), lo, hi),
+                narrow_weights: tables16().weights(&narrow),
+                wide_weights: tables32().weights(&wide),
+                narrow,
+                wide,
             }
         });
         JitterPrep {
@@ -389,12 +396,27 @@ impl<S: Signal + ?Sized> SignalEval<'_, S> {
     }
 }
 
-/// Per-thread working storage of one sample's rule.
-#[derive(Debug, Default)]
-pub(crate) struct Scratch {
+/// A sample's quadrature rule over the jitter: the nodes `τ_i`, their weights (the density
+/// folded in) and the signal `s(t + τ_i)` at them.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Rule {
     tau: Vec<f64>,
     w: Vec<f64>,
     s: Vec<f64>,
+}
+
+/// The signal at the shortcut's `N` nodes (in the basis' order) and its total variation over
+/// them.
+#[derive(Debug, Clone)]
+pub(crate) struct ShortcutNodes<const N: usize> {
+    s: [f64; N],
+    tv: f64,
+}
+
+/// Per-thread working storage of one sample's rule.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    rule: Rule,
     steep: Vec<Steep>,
     cut: Vec<(f64, f64)>,
     ch: Vec<f64>,
@@ -476,7 +498,10 @@ crate::simd::baseline_or_avx2! {
     }
 }
 
+mod cached;
 mod sample;
+
+pub(crate) use cached::SampleCache;
 
 #[cfg(test)]
 mod tests;

@@ -43,8 +43,11 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 }
             }
         }
-        self.build_rule(t, y, &local, scratch)?;
-        Ok(self.sum(t, y, grad, scratch))
+        self.build_rule(t, y, &local, false, scratch)?;
+        let rule = std::mem::take(&mut scratch.rule);
+        let v = self.sum(t, y, grad, &rule, None, scratch);
+        scratch.rule = rule;
+        Ok(v)
     }
 
     /// The range of `s(t + τ)` over the coarse nodes of the jitter (for the Fisher
@@ -84,10 +87,25 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         grad_len: Option<usize>,
         scratch: &mut Scratch,
     ) -> Result<f64, f64> {
+        let nodes = self.shortcut_nodes(t, tables, &mut scratch.sig_hint)?;
+        if !(nodes.tv <= max_tv * self.sigma) {
+            return Err(f64::INFINITY);
+        }
+        self.shortcut_at(t, y, &nodes, tables, mu, None, grad_len, None, scratch)
+    }
+
+    /// The signal at the shortcut's `N` Chebyshev nodes over the reach of the sample requested
+    /// at `t`, in the basis' order, with its total variation over them; `Err(∞)` if they cannot
+    /// be formed.
+    pub(super) fn shortcut_nodes<const N: usize>(
+        &self,
+        t: f64,
+        tables: &ChebTables<N>,
+        hint: &mut usize,
+    ) -> Result<ShortcutNodes<N>, f64> {
         let jp = self.jitter;
         let nodes = tables.basis().nodes();
         let (mid, half) = (0.5 * (jp.lo + jp.hi), 0.5 * (jp.hi - jp.lo));
-        let sigma = self.sigma;
         // The Chebyshev nodes in increasing order (the basis stores them decreasing).
         let mut taus = [0.0; N];
         for i in 0..N {
@@ -101,21 +119,64 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             else {
                 return Err(f64::INFINITY);
             };
-            self.signal.values16(t, tc, sc, &mut scratch.sig_hint);
+            self.signal.values16(t, tc, sc, hint);
         }
         let tv: f64 = sv.windows(2).map(|w| (w[1] - w[0]).abs()).sum();
-        if !(tv <= max_tv * sigma) {
-            return Err(f64::INFINITY);
-        }
         // Back to the basis' order.
         let mut s = [0.0; N];
         for i in 0..N {
             s[i] = sv[N - 1 - i];
         }
+        Ok(ShortcutNodes { s, tv })
+    }
+
+    /// `[s, ∂s/∂θ…]` at the shortcut's `N` nodes, node-major, in the basis' order (what the
+    /// shortcut's gradient reads at every node).
+    pub(super) fn shortcut_channels<const N: usize>(
+        &self,
+        t: f64,
+        tables: &ChebTables<N>,
+        hint: &mut usize,
+    ) -> Vec<f64> {
+        let jp = self.jitter;
+        let (mid, half) = (0.5 * (jp.lo + jp.hi), 0.5 * (jp.hi - jp.lo));
+        let c = 1 + self.signal.grad_channels;
+        let mut out = vec![0.0; N * c];
+        for (x, chans) in tables.basis().nodes().iter().zip(out.chunks_exact_mut(c)) {
+            self.signal.all(t + mid + half * x, chans, hint);
+        }
+        out
+    }
+
+    /// The shortcut at `y` from the signal at its nodes (whose total variation is within the
+    /// shortcut's limit), with the nodes' channels from `channels` when given (node-major, as
+    /// [`Self::shortcut_channels`]) or evaluated here. With `weights` (the moments' node
+    /// weights, [`ChebTables::weights`]) each integral against the moments is one dot product
+    /// with the node values instead of the coefficients' (equal up to rounding; only the two
+    /// coefficients of the convergence test are formed).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn shortcut_at<const N: usize>(
+        &self,
+        t: f64,
+        y: f64,
+        nodes: &ShortcutNodes<N>,
+        tables: &ChebTables<N>,
+        mu: &[f64; N],
+        weights: Option<&[f64; N]>,
+        grad_len: Option<usize>,
+        channels: Option<&[f64]>,
+        scratch: &mut Scratch,
+    ) -> Result<f64, f64> {
+        let jp = self.jitter;
+        let basis_nodes = tables.basis().nodes();
+        let (mid, half) = (0.5 * (jp.lo + jp.hi), 0.5 * (jp.hi - jp.lo));
+        let sigma = self.sigma;
+        let tv = nodes.tv;
+        let s = &nodes.s;
         let inv2 = 0.5 / (sigma * sigma);
         let mut e = [0.0; N];
         let mut d0 = f64::INFINITY;
-        for (ei, si) in e.iter_mut().zip(&s) {
+        for (ei, si) in e.iter_mut().zip(s) {
             *ei = y - si;
             d0 = d0.min(*ei * *ei);
         }
@@ -125,10 +186,27 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             let v = exp_nonpositive(q);
             *hi = if q >= EXP_FLOOR { v } else { 0.0 };
         }
-        let c = tables.coefficients(&h);
-        let total: f64 = c.iter().zip(mu).map(|(c, m)| c * m).sum();
-        if !(total > 0.0) || c[N - 2].abs() + c[N - 1].abs() > self.opts.shortcut_tolerance * total
-        {
+        let row_dot = |r: &[f64; N], v: &[f64; N]| -> f64 {
+            let mut acc = 0.0;
+            for i in 0..N {
+                acc += v[i] * r[i];
+            }
+            acc
+        };
+        let (total, tail) = match weights {
+            Some(w) => (
+                row_dot(w, &h),
+                row_dot(tables.row(N - 2), &h).abs() + row_dot(tables.row(N - 1), &h).abs(),
+            ),
+            None => {
+                let c = tables.coefficients(&h);
+                (
+                    c.iter().zip(mu).map(|(c, m)| c * m).sum(),
+                    c[N - 2].abs() + c[N - 1].abs(),
+                )
+            }
+        };
+        if !(total > 0.0) || tail > self.opts.shortcut_tolerance * total {
             return Err(tv / sigma);
         }
         let log_p = -d0 * inv2 + total.ln() - sigma.ln() - HALF_LN_2PI;
@@ -137,26 +215,38 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             scratch.ch.clear();
             scratch.ch.resize(len, 0.0);
             let dot = |v: &[f64; N]| -> f64 {
-                tables
-                    .coefficients(v)
-                    .iter()
-                    .zip(mu)
-                    .map(|(c, m)| c * m)
-                    .sum::<f64>()
-                    / total
+                match weights {
+                    Some(w) => row_dot(w, v) / total,
+                    None => {
+                        tables
+                            .coefficients(v)
+                            .iter()
+                            .zip(mu)
+                            .map(|(c, m)| c * m)
+                            .sum::<f64>()
+                            / total
+                    }
+                }
             };
             if ns > 0 {
+                let width = 1 + self.signal.grad_channels;
                 let mut chans = std::mem::take(&mut scratch.chans);
-                chans.resize(1 + self.signal.grad_channels, 0.0);
+                chans.resize(width, 0.0);
                 // `h e ∂s/∂θ_j` at the nodes, parameter-major.
                 let mut g = std::mem::take(&mut scratch.node_gradients);
                 g.clear();
                 g.resize(ns * N, 0.0);
-                for (i, &x) in nodes.iter().enumerate() {
-                    self.signal
-                        .all(t + mid + half * x, &mut chans, &mut scratch.sig_hint);
+                for (i, &x) in basis_nodes.iter().enumerate() {
+                    let at: &[f64] = match channels {
+                        Some(all) => &all[i * width..(i + 1) * width],
+                        None => {
+                            self.signal
+                                .all(t + mid + half * x, &mut chans, &mut scratch.sig_hint);
+                            &chans
+                        }
+                    };
                     for j in 0..ns {
-                        g[j * N + i] = h[i] * e[i] * chans[1 + j];
+                        g[j * N + i] = h[i] * e[i] * at[1 + j];
                     }
                 }
                 for j in 0..ns {
@@ -192,9 +282,9 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         for i in 0..16 {
             let wi = half * w[i] * p[i];
             if wi > 0.0 {
-                scratch.tau.push(taus[i]);
-                scratch.w.push(wi);
-                scratch.s.push(sv[i]);
+                scratch.rule.tau.push(taus[i]);
+                scratch.rule.w.push(wi);
+                scratch.rule.s.push(sv[i]);
             }
         }
     }
@@ -243,9 +333,9 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             };
             for i in 0..16 {
                 if ws[i] > 0.0 {
-                    scratch.tau.push(nodes[i]);
-                    scratch.w.push(ws[i]);
-                    scratch.s.push(sv[i]);
+                    scratch.rule.tau.push(nodes[i]);
+                    scratch.rule.w.push(ws[i]);
+                    scratch.rule.s.push(sv[i]);
                     near |= (y - sv[i]).abs() <= reach;
                 }
             }
@@ -290,18 +380,24 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         near
     }
 
-    fn build_rule(
+    /// The rule of the sample requested at `t` for the value at `y` into `scratch` (`tau`, `w`,
+    /// `s`). With `refine_all`, every sub-interval of a steep interval gets its own rule, as
+    /// when no node comes near `y`: the rule then does not depend on `y` (it differs from the
+    /// rule at `y` only by splitting the runs farther than the window from `y`, which carry at
+    /// most `e^{−window²/2}` of the peak).
+    pub(super) fn build_rule(
         &self,
         t: f64,
         y: f64,
         local: &[f64],
+        refine_all: bool,
         scratch: &mut Scratch,
     ) -> Result<(), RuleTooLarge> {
         let jp = self.jitter;
         let res = self.opts.resolution * self.sigma;
-        scratch.tau.clear();
-        scratch.w.clear();
-        scratch.s.clear();
+        scratch.rule.tau.clear();
+        scratch.rule.w.clear();
+        scratch.rule.s.clear();
         scratch.steep.clear();
         let mut near = false;
         if local.is_empty() {
@@ -333,18 +429,18 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         // Refine the steep intervals.
         let steep = std::mem::take(&mut scratch.steep);
         for st in &steep {
-            self.refine(t, st, !near, res, scratch);
-            if scratch.tau.len() > MAX_SAMPLE_NODES {
+            self.refine(t, st, refine_all || !near, res, scratch);
+            if scratch.rule.tau.len() > MAX_SAMPLE_NODES {
                 scratch.steep = steep;
                 return Err(RuleTooLarge);
             }
         }
         scratch.steep = steep;
         for atom in &jp.atoms {
-            scratch.tau.push(atom.position);
-            scratch.w.push(atom.mass);
+            scratch.rule.tau.push(atom.position);
+            scratch.rule.w.push(atom.mass);
             let s = self.signal.value(t + atom.position, &mut scratch.sig_hint);
-            scratch.s.push(s);
+            scratch.rule.s.push(s);
         }
         Ok(())
     }
@@ -404,11 +500,20 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         }
     }
 
-    /// Log-sum-exp of the collected rule, with the gradient.
-    fn sum(&self, t: f64, y: f64, grad: Option<&mut [f64]>, scratch: &mut Scratch) -> f64 {
+    /// Log-sum-exp of `rule`, with the gradient; the signal's channels at the nodes from
+    /// `channels` when given (node-major, one row per node of `rule`), else evaluated here.
+    pub(super) fn sum(
+        &self,
+        t: f64,
+        y: f64,
+        grad: Option<&mut [f64]>,
+        rule: &Rule,
+        channels: Option<&[f64]>,
+        scratch: &mut Scratch,
+    ) -> f64 {
         let sigma = self.sigma;
         let inv2 = 0.5 / (sigma * sigma);
-        let lmax = max_exponent(&scratch.s, y, inv2);
+        let lmax = max_exponent(&rule.s, y, inv2);
         if !lmax.is_finite() {
             if let Some(g) = grad {
                 g.fill(f64::NAN);
@@ -416,20 +521,20 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
             return f64::NEG_INFINITY;
         }
         scratch.terms.clear();
-        scratch.terms.resize(scratch.s.len(), 0.0);
-        let mut total = weighted_terms(&scratch.s, &scratch.w, (y, inv2, lmax), &mut scratch.terms);
+        scratch.terms.resize(rule.s.len(), 0.0);
+        let mut total = weighted_terms(&rule.s, &rule.w, (y, inv2, lmax), &mut scratch.terms);
         let mut shift = lmax;
         let mut use_logs = false;
         if !(total > 1e-280) {
             // The largest exponent sits on negligible weights: include the weights' logs.
             use_logs = true;
             shift = f64::NEG_INFINITY;
-            for (&s, &w) in scratch.s.iter().zip(&scratch.w) {
+            for (&s, &w) in rule.s.iter().zip(&rule.w) {
                 let e = y - s;
                 shift = shift.max(w.ln() - e * e * inv2);
             }
             total = 0.0;
-            for (&s, &w) in scratch.s.iter().zip(&scratch.w) {
+            for (&s, &w) in rule.s.iter().zip(&rule.w) {
                 let e = y - s;
                 total += (w.ln() - e * e * inv2 - shift).exp();
             }
@@ -438,12 +543,13 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
         if let Some(g) = grad {
             let ns = g.len() - 1;
             g.fill(0.0);
+            let width = 1 + self.signal.grad_channels;
             let mut chans = std::mem::take(&mut scratch.chans);
-            chans.resize(1 + self.signal.grad_channels, 0.0);
-            for i in 0..scratch.s.len() {
-                let e = y - scratch.s[i];
+            chans.resize(width, 0.0);
+            for i in 0..rule.s.len() {
+                let e = y - rule.s[i];
                 let r = if use_logs {
-                    (scratch.w[i].ln() - e * e * inv2 - shift).exp() / total
+                    (rule.w[i].ln() - e * e * inv2 - shift).exp() / total
                 } else {
                     scratch.terms[i] / total
                 };
@@ -452,10 +558,16 @@ impl<S: Signal + ?Sized> SampleModel<'_, S> {
                 }
                 g[ns] += r * e * e;
                 if ns > 0 {
-                    self.signal
-                        .all(t + scratch.tau[i], &mut chans, &mut scratch.sig_hint);
+                    let at: &[f64] = match channels {
+                        Some(all) => &all[i * width..(i + 1) * width],
+                        None => {
+                            self.signal
+                                .all(t + rule.tau[i], &mut chans, &mut scratch.sig_hint);
+                            &chans
+                        }
+                    };
                     for j in 0..ns {
-                        g[j] += r * e * chans[1 + j];
+                        g[j] += r * e * at[1 + j];
                     }
                 }
             }

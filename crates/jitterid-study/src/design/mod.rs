@@ -11,7 +11,8 @@
 //! - [`predict`]: the expected covariance of BCLS (the fit's own sandwich at the truth on the
 //!   expected record) or of exact ML (the inverse exact Fisher information), averaged over
 //!   seeded draws of a random input; [`derived_std`] for the static gain, a gain at one
-//!   frequency and the jitter's σ by the delta method.
+//!   frequency, a pole's natural frequency and the jitter's σ by the delta method, the ones a
+//!   report gives chosen by [`DerivedRequest`] (`[design] derived`).
 //! - [`criterion_value`]: D-, A- or one parameter's optimality.
 //! - [`Plan`], [`Design`]: the experiment file as a document that each candidate design edits
 //!   and reads again, so every candidate is validated like a written file.
@@ -23,15 +24,19 @@
 //!   file that reads it, ready for `simulate` and `fit`.
 //! - [`optimise`], [`design()`]: the seeded, deterministic search over the `[design]` ranges and
 //!   the report that sets the result beside the file's own design.
+//! - [`DesignProgress`]: what the searches report while they run, to the observer a plan
+//!   carries ([`Plan::with_observer`]).
 
 mod blind;
 mod candidate;
 mod check;
 mod criterion;
 mod derived;
+mod derived_choice;
 mod plan;
 mod predict;
 mod prior;
+mod progress;
 mod realization;
 mod report;
 mod search;
@@ -42,9 +47,11 @@ pub use candidate::Design;
 pub use check::{monte_carlo, MonteCarloCheck};
 pub use criterion::{covariance_criterion, criterion_value};
 pub use derived::{derived_std, Derived};
+pub use derived_choice::{requested_stds, DerivedRequest, DERIVED_EXPECTED};
 pub use plan::Plan;
 pub use predict::{predict, Prediction};
 pub use prior::prior_experiments;
+pub use progress::{DesignObserver, DesignProgress};
 pub use report::{
     derived_stds, design, BlindJson, DesignJson, DesignReport, PredictedDesign, PredictedStd,
 };

@@ -6,6 +6,7 @@ use super::candidate::Design;
 use super::criterion::criterion_value;
 use super::predict::{predict, Prediction};
 use super::prior::{prior_draws, PriorDraw};
+use super::progress::{DesignObserver, DesignProgress};
 use crate::error::StudyResult;
 use crate::experiment::{
     directory_of, parse_edited, read_text, DesignCriterion, DesignSpec, Experiment, Purpose,
@@ -34,6 +35,8 @@ pub struct Plan {
     /// A robust design's prior draws (empty without a prior spread), drawn once: they move
     /// the truth alone, the same at every design.
     prior: Vec<PriorDraw>,
+    /// Who is told of the search's progress (a front end's display), if anyone.
+    observer: Option<DesignObserver>,
 }
 
 impl Plan {
@@ -87,6 +90,7 @@ impl Plan {
             spec,
             blind: false,
             prior,
+            observer: None,
         };
         // A budget on a fixed interval is one record: it must be one the experiment allows
         // (the jitter's reach within it, the input's switches), or no design can meet it.
@@ -140,6 +144,22 @@ impl Plan {
         Ok(plan)
     }
 
+    /// The same plan reporting its searches' progress to `observer` (the plans derived from
+    /// it, such as [`Plan::jitter_blind`], too); the numbers do not depend on it.
+    pub fn with_observer(&self, observer: DesignObserver) -> Plan {
+        Plan {
+            observer: Some(observer),
+            ..self.clone()
+        }
+    }
+
+    /// Tells the observer, if any, of `p`.
+    pub(crate) fn observe(&self, p: DesignProgress) {
+        if let Some(o) = &self.observer {
+            o.report(&p);
+        }
+    }
+
     /// Whether this is the jitter-blind plan.
     pub fn is_jitter_blind(&self) -> bool {
         self.blind
@@ -176,10 +196,14 @@ impl Plan {
         }
         let exp = self.experiment(design)?;
         let mut sum = 0.0;
-        for draw in &self.prior {
+        for (i, draw) in self.prior.iter().enumerate() {
             let e = draw.apply(&exp);
             let p = predict(&e, self.spec.estimator, self.spec.draws, self.spec.seed)?;
             sum += criterion_value(criterion, &p)?;
+            self.observe(DesignProgress::PriorDraw {
+                done: i + 1,
+                total: self.prior.len(),
+            });
         }
         Ok(sum / self.prior.len() as f64)
     }

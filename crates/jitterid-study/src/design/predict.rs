@@ -99,6 +99,25 @@ fn truth_structure(
     Ok(s)
 }
 
+/// The model at the experiment's truth for `estimator`, driven by input draw 0 of master seed
+/// `seed` (the model a prediction's derived quantities are functions of), without predicting.
+///
+/// # Errors
+///
+/// Those of [`predict`] that come before the information matrix.
+pub(crate) fn prior_model(
+    exp: &Experiment,
+    estimator: DesignEstimator,
+    seed: u64,
+) -> StudyResult<Structure> {
+    let mut outs = mc_run(seed, 0..1, |_, rng| {
+        let signal = realized_signal(exp, rng)?;
+        truth_structure(exp, signal, estimator)
+    });
+    outs.pop()
+        .ok_or_else(|| study_err!("{}: no input draw", exp.file))?
+}
+
 /// One draw's covariance and names.
 fn one_draw(
     exp: &Experiment,

@@ -5,8 +5,9 @@ use super::blind::JitterBlind;
 use super::candidate::Design;
 use super::criterion::criterion_value;
 use super::derived::{derived_std, Derived};
+use super::derived_choice::{check_defined, requested_stds, DerivedRequest};
 use super::plan::Plan;
-use super::predict::{predict, Prediction};
+use super::predict::{predict, prior_model, Prediction};
 use super::search::optimise;
 use crate::error::StudyResult;
 use crate::experiment::{DesignCriterion, DesignEstimator, PriorSpread};
@@ -117,6 +118,8 @@ pub struct DesignReport {
     /// A robust design's prior spread (`value` and the baseline's are then averaged over its
     /// draws).
     pub prior: Option<PriorSpread>,
+    /// The derived quantities asked for (`[design] derived`), `None` for [`derived_stds`]'s.
+    pub derived: Option<Vec<DerivedRequest>>,
 }
 
 /// The derived quantities a design report gives beside the parameters, by the delta method:
@@ -148,10 +151,19 @@ fn stds(p: &Prediction) -> Vec<PredictedStd> {
 }
 
 impl DesignReport {
+    /// The derived quantities' predicted standard deviations at `p` (any of the report's
+    /// predictions): those asked for ([`requested_stds`]) or by default [`derived_stds`].
+    pub fn derived_of(&self, p: &Prediction) -> Vec<PredictedStd> {
+        match &self.derived {
+            Some(requests) => requested_stds(p, requests),
+            None => derived_stds(p),
+        }
+    }
+
     /// The command's JSON.
     pub fn json(&self) -> DesignJson {
         let baseline_derived = match &self.baseline_prediction {
-            Ok((p, _)) => derived_stds(p),
+            Ok((p, _)) => self.derived_of(p),
             Err(_) => Vec::new(),
         };
         let baseline = match &self.baseline_prediction {
@@ -170,7 +182,7 @@ impl DesignReport {
             criterion: self.criterion.to_string(),
             design: self.design,
             predicted: stds(&self.prediction),
-            derived: derived_stds(&self.prediction),
+            derived: self.derived_of(&self.prediction),
             baseline: PredictedDesign {
                 design: self.baseline,
                 predicted: baseline,
@@ -200,10 +212,15 @@ impl DesignReport {
 /// # Errors
 ///
 /// Those of [`optimise`]: an unknown parameter in the criterion, a range without a feasible
-/// design.
+/// design; a derived quantity asked for (`[design] derived`) that the prior model does not
+/// define (checked before the search).
 pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<DesignReport> {
     let spec = &plan.spec;
     let criterion = criterion.unwrap_or(&spec.criterion).clone();
+    if let Some(requests) = &spec.derived {
+        let model = prior_model(&plan.baseline, spec.estimator, spec.seed)?;
+        check_defined(&plan.baseline.file, requests, &model)?;
+    }
     let optimum = optimise(plan, &criterion)?;
     let baseline = plan.baseline_design();
     let baseline_prediction = predict(&plan.baseline, spec.estimator, spec.draws, spec.seed)
@@ -225,5 +242,6 @@ pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<D
         evaluations: optimum.evaluations,
         jitter_blind: None,
         prior: spec.prior,
+        derived: spec.derived.clone(),
     })
 }

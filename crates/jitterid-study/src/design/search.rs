@@ -15,6 +15,7 @@ use super::candidate::Design;
 use super::criterion::criterion_value;
 use super::plan::Plan;
 use super::predict::Prediction;
+use super::progress::DesignProgress;
 use crate::error::{StudyError, StudyResult};
 use crate::experiment::DesignCriterion;
 use crate::study_err;
@@ -57,6 +58,8 @@ struct Search<'a> {
     memo: Mutex<Vec<(Design, Evaluated)>>,
     /// A criterion that cannot be evaluated at all (an unknown parameter's name).
     fatal: Mutex<Option<StudyError>>,
+    /// Points of the grid, for the progress reports.
+    grid_points: usize,
 }
 
 impl Search<'_> {
@@ -97,10 +100,16 @@ impl Search<'_> {
             Ok((v, _)) if !v.is_nan() => *v,
             _ => f64::INFINITY,
         };
-        self.memo
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push((*d, out));
+        let evaluations = {
+            let mut memo = self.memo.lock().unwrap_or_else(|e| e.into_inner());
+            memo.push((*d, out));
+            memo.len()
+        };
+        self.plan.observe(DesignProgress::Evaluated {
+            jitter_blind: self.plan.is_jitter_blind(),
+            evaluations,
+            grid_points: self.grid_points,
+        });
         v
     }
 
@@ -156,12 +165,6 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
         ranges.push((lo.ln(), hi.ln()));
     }
     let base = plan.budget_design();
-    let search = Search {
-        plan,
-        criterion,
-        memo: Mutex::new(Vec::new()),
-        fatal: Mutex::new(None),
-    };
     // The grid: every combination of `spec.grid` log-spaced points per variable.
     let g = spec.grid;
     let axis = |(lo, hi): (f64, f64)| -> Vec<f64> {
@@ -171,6 +174,13 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
     };
     let axes: Vec<Vec<f64>> = ranges.iter().map(|&r| axis(r)).collect();
     let total: usize = axes.iter().map(Vec::len).product();
+    let search = Search {
+        plan,
+        criterion,
+        memo: Mutex::new(Vec::new()),
+        fatal: Mutex::new(None),
+        grid_points: total,
+    };
     let mut best: Option<(f64, Vec<f64>)> = None;
     for flat in 0..total {
         let mut rest = flat;

@@ -9,6 +9,7 @@ use super::diagnostics::Source;
 use super::range::{MAX_INTERVAL, MIN_INTERVAL};
 use super::raw::RawDesign;
 use super::sampling::MAX_SAMPLES;
+use crate::design::DerivedRequest;
 use crate::error::StudyResult;
 use jitterid::signal::{SampleGrid, MAX_SWITCHES};
 use std::fmt;
@@ -169,6 +170,9 @@ pub struct DesignSpec {
     /// The prior spread of a robust design (`prior_spread`, `prior_jitter_spread`,
     /// `prior_draws`), `None` for a design at the prior's values alone.
     pub prior: Option<PriorSpread>,
+    /// The derived quantities reported (`derived`), `None` for the default (the static gain,
+    /// and the jitter's σ when it is estimated).
+    pub derived: Option<Vec<DerivedRequest>>,
 }
 
 /// Largest number of prior draws a robust design averages over.
@@ -490,6 +494,7 @@ pub(super) fn parse_design(
         crate::montecarlo::DEFAULT_SEED as i64,
     )? as u64;
     let prior = parse_prior(cx, r)?;
+    let derived = parse_derived(cx, r)?;
     Ok(DesignSpec {
         mean_dwell,
         interval,
@@ -502,7 +507,32 @@ pub(super) fn parse_design(
         grid: points,
         seed,
         prior,
+        derived,
     })
+}
+
+/// `[design] derived`: each entry a quantity [`DerivedRequest::parse`] knows.
+fn parse_derived(cx: &Source, r: &RawDesign) -> StudyResult<Option<Vec<DerivedRequest>>> {
+    let Some(list) = &r.derived else {
+        return Ok(None);
+    };
+    list.get_ref()
+        .iter()
+        .map(|t| DerivedRequest::parse(t).map_err(|e| cx.err(S, "derived", &list.span(), e)))
+        .collect::<StudyResult<Vec<_>>>()
+        .map(Some)
+}
+
+/// The edit that sets `[design] derived` to `names` (the command line's `--derived`, Python's
+/// `derived=`), named `origin` in messages, so that the list is checked as the key written in
+/// the file is.
+pub fn derived_edit(names: &[String], origin: String) -> super::Override {
+    let value: toml_edit::Value = names
+        .iter()
+        .map(String::as_str)
+        .collect::<toml_edit::Array>()
+        .into();
+    super::Override::from_source(&[S, "derived"], value, origin)
 }
 
 #[cfg(test)]

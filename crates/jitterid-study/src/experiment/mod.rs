@@ -27,8 +27,8 @@ mod spec;
 mod system;
 
 pub use design::{
-    budget_edit, Budget, DesignCriterion, DesignEstimator, DesignSpec, Hold, PriorSpread,
-    MAX_DRAWS, MAX_GRID, MAX_PRIOR_DRAWS,
+    budget_edit, derived_edit, Budget, DesignCriterion, DesignEstimator, DesignSpec, Hold,
+    PriorSpread, MAX_DRAWS, MAX_GRID, MAX_PRIOR_DRAWS,
 };
 pub use input::MAX_SWITCHES;
 pub use overrides::Override;

@@ -127,6 +127,7 @@ section!(RawDesign, "table [design]" {
     prior_spread: f64,
     prior_jitter_spread: f64,
     prior_draws: i64,
+    derived: Vec<String>,
 });
 
 #[derive(Debug, Deserialize)]

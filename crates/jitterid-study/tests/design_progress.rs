@@ -1,0 +1,106 @@
+//! The design searches' progress observer ([`Plan::with_observer`]): it sees every design the
+//! search evaluates, numbered in order, and every prior draw of a robust design, and the
+//! report with an observer is the report without one, to the byte.
+
+mod common;
+
+use common::plan as read_plan;
+use jitterid_study::design::{design, jitter_blind, DesignObserver, DesignProgress};
+use std::sync::{Arc, Mutex};
+
+/// The Table 2 setup, shortened, with a cheap robust dwell search.
+fn table2_robust() -> String {
+    r#"
+[sampling]
+interval = 1.0
+samples = 100
+[input]
+kind = "random-binary"
+mean_dwell = 8.0
+[system]
+kind = "zpk"
+gain = 0.2
+zeros = [-0.5]
+poles = [[-0.25, 0.3]]
+estimate = true
+[jitter]
+family = "uniform-sum"
+n = 2
+a = 0.28867513459481287
+[noise]
+std = 0.01
+[design]
+mean_dwell = [2.0, 20.0]
+draws = 2
+grid = 3
+prior_spread = 0.05
+prior_draws = 2
+"#
+    .to_string()
+}
+
+/// The events of one run, recorded in order.
+fn recorder() -> (DesignObserver, Arc<Mutex<Vec<DesignProgress>>>) {
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let into = Arc::clone(&seen);
+    let observer = DesignObserver::new(move |p| into.lock().unwrap().push(*p));
+    (observer, seen)
+}
+
+#[test]
+fn the_observer_sees_every_evaluation_and_changes_nothing() {
+    let plan = read_plan(&table2_robust()).unwrap();
+    let quiet = design(&plan, None).unwrap();
+    let quiet_blind = jitter_blind(&plan, &quiet.criterion).unwrap();
+    let (observer, seen) = recorder();
+    let watched_plan = plan.with_observer(observer);
+    let watched = design(&watched_plan, None).unwrap();
+    let watched_blind = jitter_blind(&watched_plan, &watched.criterion).unwrap();
+    let mut quiet_report = quiet.clone();
+    quiet_report.jitter_blind = Some(quiet_blind);
+    let mut watched_report = watched.clone();
+    watched_report.jitter_blind = Some(watched_blind);
+    // The JSON the command prints is the same to the byte.
+    assert_eq!(
+        serde_json::to_string_pretty(&quiet_report.json()).unwrap(),
+        serde_json::to_string_pretty(&watched_report.json()).unwrap()
+    );
+    let seen = seen.lock().unwrap().clone();
+    let evaluated = |blind: bool| -> Vec<(usize, usize)> {
+        seen.iter()
+            .filter_map(|p| match *p {
+                DesignProgress::Evaluated {
+                    jitter_blind,
+                    evaluations,
+                    grid_points,
+                } if jitter_blind == blind => Some((evaluations, grid_points)),
+                _ => None,
+            })
+            .collect()
+    };
+    // One report per evaluated design, numbered 1, 2, …, with the grid's size (3 points).
+    let aware = evaluated(false);
+    assert_eq!(aware.len(), watched.evaluations);
+    for (i, &(n, grid)) in aware.iter().enumerate() {
+        assert_eq!((n, grid), (i + 1, 3));
+    }
+    let blind = evaluated(true);
+    assert!(!blind.is_empty());
+    for (i, &(n, grid)) in blind.iter().enumerate() {
+        assert_eq!((n, grid), (i + 1, 3));
+    }
+    // Every evaluated design of the jitter-aware search and the baseline average the
+    // criterion over both prior draws, each reported as 1/2 then 2/2; so do the blind
+    // search's designs and its design under the true prior.
+    let draws: Vec<(usize, usize)> = seen
+        .iter()
+        .filter_map(|p| match *p {
+            DesignProgress::PriorDraw { done, total } => Some((done, total)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(draws.len(), 2 * (aware.len() + 1 + blind.len() + 1));
+    for pair in draws.chunks(2) {
+        assert_eq!(pair, [(1, 2), (2, 2)]);
+    }
+}
