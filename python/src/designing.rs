@@ -1,11 +1,12 @@
 //! Experiment design from Python: the study layer's design search
 //! ([`jitterid_study::design`]) on an experiment's `[design]` section, the numbers of
-//! `jitterid design --json [--criterion] [--budget] [--jitter-blind] [--write-input]`.
+//! `jitterid design --json [--criterion] [--budget] [--jitter-blind] [--write-input]
+//! [--dac-rate]`.
 
 use crate::errors::value_error;
 use crate::experiment::Experiment;
 use jitterid_study::design::{design as run_design, designed_input, jitter_blind, Plan};
-use jitterid_study::experiment::{budget_edit, DesignCriterion, ReadOptions};
+use jitterid_study::experiment::{budget_edit, dac_rate_edit, DesignCriterion, ReadOptions};
 use jitterid_study::Registries;
 use pyo3::prelude::*;
 
@@ -13,9 +14,11 @@ use pyo3::prelude::*;
 /// `"param:NAME"`; the section's by default) on the record `budget` (`"duration=SECONDS"` or
 /// `"samples=N"`, replacing the section's), with the jitter-blind design beside it when
 /// `jitter_blind`: `design --json`'s text. With `input_name`, also the designed input's CSV
-/// text and the experiment text that reads it from a file of that name (`--write-input`).
+/// text and the experiment text that reads it from a file of that name (`--write-input`); a
+/// designed multisine's CSV is its sample sequence at `dac_rate` Hz (`--dac-rate`, replacing
+/// `[design] dac_rate`).
 #[pyfunction]
-#[pyo3(signature = (experiment, criterion, jitter_blind_design, budget, input_name))]
+#[pyo3(signature = (experiment, criterion, jitter_blind_design, budget, input_name, dac_rate=None))]
 pub fn design(
     py: Python<'_>,
     experiment: &Experiment,
@@ -23,6 +26,7 @@ pub fn design(
     jitter_blind_design: bool,
     budget: Option<String>,
     input_name: Option<String>,
+    dac_rate: Option<f64>,
 ) -> PyResult<(String, Option<(String, String)>)> {
     let criterion = criterion
         .map(|c| DesignCriterion::parse(&c).map_err(|e| value_error(format!("criterion: {e}"))))
@@ -35,6 +39,9 @@ pub fn design(
         options
             .overrides
             .push(budget_edit(&b).map_err(value_error)?);
+    }
+    if let Some(rate) = dac_rate {
+        options.overrides.push(dac_rate_edit(rate));
     }
     let (file, text, dir) = experiment.source();
     let plan = Plan::parse(

@@ -11,7 +11,7 @@ use jitterid_study::design::{
     derived_stds, design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
 };
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{budget_edit, DesignCriterion, ReadOptions};
+use jitterid_study::experiment::{budget_edit, dac_rate_edit, DesignCriterion, ReadOptions};
 use jitterid_study::study_err;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -32,6 +32,9 @@ pub struct DesignOptions {
     /// Write the designed input (CSV) to this file and the experiment reading it beside it
     /// (the same name with `.toml`).
     pub write_input: Option<PathBuf>,
+    /// The DAC rate (Hz) of a designed multisine's sample sequence, replacing `[design]
+    /// dac_rate`.
+    pub dac_rate: Option<f64>,
     /// Print JSON instead of a table.
     pub json: bool,
     /// Write the JSON to this file instead of standard output.
@@ -49,6 +52,38 @@ fn design_text(d: &Design) -> String {
         fmt_num(d.interval),
         d.samples
     );
+    if let Some(m) = &d.multisine {
+        let _ = write!(
+            s,
+            ", multisine of {} tones: power = {}, crest factor = {}, peak = {}",
+            m.frequencies.len(),
+            fmt_num(m.power),
+            fmt_num(m.crest_factor),
+            fmt_num(m.peak())
+        );
+    }
+    s
+}
+
+/// The tones of a design's multisine, one line each, indented.
+fn tones_text(d: &Design) -> String {
+    let mut s = String::new();
+    if let Some(m) = &d.multisine {
+        let _ = writeln!(
+            s,
+            "  {:>14}  {:>14}  {:>14}",
+            "frequency (Hz)", "amplitude", "phase (rad)"
+        );
+        for t in m.tones() {
+            let _ = writeln!(
+                s,
+                "  {:>14}  {:>14}  {:>14}",
+                fmt_num(t.frequency),
+                fmt_num(t.amplitude),
+                fmt_num(t.phase)
+            );
+        }
+    }
     s
 }
 
@@ -79,6 +114,9 @@ pub fn design(o: &DesignOptions) -> StudyResult<Outcome> {
     let mut read = o.read.clone();
     if let Some(b) = &o.budget {
         read.overrides.push(budget_edit(b)?);
+    }
+    if let Some(rate) = o.dac_rate {
+        read.overrides.push(dac_rate_edit(rate));
     }
     let plan = Plan::read(&o.experiment, &read)?;
     let mut report = run_design(&plan, criterion.as_ref())?;
@@ -130,7 +168,9 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
         report.evaluations
     );
     let _ = writeln!(out, "designed: {}", design_text(&report.design));
+    out += &tones_text(&report.design);
     let _ = writeln!(out, "baseline: {}", design_text(&report.baseline));
+    out += &tones_text(&report.baseline);
     let blind = report.jitter_blind.as_ref();
     if let Some(b) = blind {
         let _ = writeln!(
