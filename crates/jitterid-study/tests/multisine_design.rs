@@ -212,7 +212,7 @@ fn bad_multisine_keys_name_the_key() {
         ),
         ("band = [0.01, 0.45]\ndac_rate = 0.5", "dac_rate"),
         ("band = [0.01, 0.45]\ninterval = [0.5, 2.0]", "band"),
-        ("tones = 3\nmean_dwell = [1.0, 2.0]", "tones"),
+        ("tones = 3\ninterval = [0.5, 2.0]", "tones"),
         ("peak = 1.0\ninterval = [0.5, 2.0]", "peak"),
     ];
     for (section, words) in cases {
