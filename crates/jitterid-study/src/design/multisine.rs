@@ -7,10 +7,12 @@
 //! under an amplitude constraint alone. Without jitter the information would be linear in `w`
 //! and the classical multiplicative algorithms would apply; with jitter the noise after every
 //! slope (`σ_τ² s′(t)²`) makes it nonlinear, so every candidate is judged by the exact
-//! prediction ([`evaluate`]), and `w` moves by an exponentiated-gradient (multiplicative)
-//! step on the simplex, `wᵢ ← wᵢ exp(−η gᵢ/max|g|)`, with `gᵢ` the criterion's derivative in
-//! `log wᵢ` by forward differences, `η` grown on success and cut on failure: a deterministic
-//! descent that keeps `w` on the simplex and positive.
+//! prediction ([`evaluate`]). `w` is the softmax of unconstrained coordinates `x`
+//! (`wᵢ = e^{xᵢ} / Σ e^{xⱼ}`, `x₀ = 0`), which keeps it on the simplex and positive, and the
+//! criterion is minimised over `x` by the solvers' BFGS ([`Bfgs`], which takes an infeasible
+//! candidate as `+∞`) from the flat spectrum, with central differences whose components are
+//! evaluated in parallel: a deterministic descent that accepts only steps that lower the
+//! criterion.
 //!
 //! During the descent the phases are Schroeder's for the current `w` (a smooth function of
 //! it, so the differences are smooth); at the end the clipping algorithm lowers the crest
@@ -27,18 +29,21 @@ use super::search::Optimum;
 use crate::error::StudyResult;
 use crate::experiment::{harmonics_in, DesignCriterion, ToneDesignSpec};
 use crate::study_err;
+use jitterid::estimate::solver::{Bfgs, Objective, Solver};
 use jitterid::signal::Tone;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Descent steps on the power distribution.
-const STEPS: usize = 16;
+/// BFGS iterations on the power distribution.
+const ITERATIONS: u64 = 40;
 
-/// Step in `log wᵢ` of the forward differences.
-const DIFFERENCE: f64 = 1e-3;
+/// Step in `xᵢ = log wᵢ + const` of the central differences.
+const DIFFERENCE: f64 = 1e-4;
 
-/// Relative improvement of the criterion below which the descent stops.
-const STOP: f64 = 1e-6;
+/// Predicted decrease of the criterion below which the descent stops (the criterion's Monte
+/// Carlo error is orders of magnitude larger).
+const DECREMENT: f64 = 1e-7;
 
 /// A designed multisine `u(t) = Σ aᵢ sin(2π fᵢ t + φᵢ)`, as `[input] kind = "multisine"`
 /// writes it, with its crest factor and power.
@@ -171,11 +176,59 @@ fn value_at(
     (!v.is_nan() && v < f64::INFINITY).then_some((d, v, p))
 }
 
-/// `w ⊙ exp(x)`, normalised to the simplex.
-fn moved(w: &[f64], x: &[f64]) -> Vec<f64> {
-    let v: Vec<f64> = w.iter().zip(x).map(|(wi, xi)| wi * xi.exp()).collect();
-    let s: f64 = v.iter().sum();
-    v.iter().map(|vi| (vi / s).max(1e-12)).collect()
+/// The power shares of coordinates `x`: the softmax of `(0, x₁, …)`.
+fn shares(x: &[f64]) -> Vec<f64> {
+    let top = x.iter().copied().fold(0.0, f64::max);
+    let e: Vec<f64> = std::iter::once(0.0)
+        .chain(x.iter().copied())
+        .map(|xi| (xi - top).exp())
+        .collect();
+    let sum: f64 = e.iter().sum();
+    e.iter().map(|ei| ei / sum).collect()
+}
+
+/// The criterion as a function of the softmax coordinates of the power shares.
+struct Shares<'s, 'a> {
+    plan: &'s Plan,
+    criterion: &'s DesignCriterion,
+    tones: &'s Tones<'a>,
+    evaluations: AtomicUsize,
+}
+
+impl Objective for Shares<'_, '_> {
+    fn num_params(&self) -> usize {
+        self.tones.k.len() - 1
+    }
+
+    fn cost(&self, x: &[f64]) -> f64 {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        value_at(self.plan, self.criterion, self.tones, &shares(x), None)
+            .map_or(f64::INFINITY, |c| c.1)
+    }
+
+    /// Central differences, the components in parallel (one-sided beside an infeasible
+    /// point).
+    fn cost_gradient(&self, x: &[f64]) -> (f64, Vec<f64>) {
+        let f = self.cost(x);
+        let g = (0..x.len())
+            .into_par_iter()
+            .map(|j| {
+                let at = |h: f64| {
+                    let mut y = x.to_vec();
+                    y[j] += h;
+                    self.cost(&y)
+                };
+                let (up, down) = (at(DIFFERENCE), at(-DIFFERENCE));
+                match (up.is_finite(), down.is_finite()) {
+                    (true, true) => (up - down) / (2.0 * DIFFERENCE),
+                    (true, false) => (up - f) / DIFFERENCE,
+                    (false, true) => (f - down) / DIFFERENCE,
+                    (false, false) => 0.0,
+                }
+            })
+            .collect();
+        (f, g)
+    }
 }
 
 /// The multisine design of `plan` under `criterion` (see the module docs).
@@ -204,11 +257,10 @@ pub(crate) fn optimise_tones(
     };
     let file = &plan.baseline.file;
     let n = tones.k.len();
-    let mut w = vec![1.0 / n as f64; n];
-    let mut evaluations = 1;
+    let flat_shares = vec![1.0 / n as f64; n];
     // The flat spectrum: where the descent starts, and what tells a criterion that cannot be
     // evaluated at all.
-    let flat = tones.multisine(&w, None).ok_or_else(|| {
+    let flat = tones.multisine(&flat_shares, None).ok_or_else(|| {
         study_err!(
             "{file}: [design] peak: cannot hold the power {} with the flat spectrum's Schroeder phases over the band; expected a larger peak or a smaller power",
             spec.power.unwrap_or_default()
@@ -217,45 +269,32 @@ pub(crate) fn optimise_tones(
     let (p, v) = evaluate(plan, &tones.design(flat.clone()), criterion)
         .map_err(|e| study_err!("{file}: [design] band: the flat spectrum over the band: {e}"))?;
     let mut best: Candidate = (tones.design(flat), v, p);
-    let mut eta = 1.0;
-    for _ in 0..STEPS {
-        if n < 2 {
-            break;
-        }
-        // The criterion's derivative in each log wᵢ, the components in parallel.
-        let g: Vec<f64> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let mut x = vec![0.0; n];
-                x[i] = DIFFERENCE;
-                value_at(plan, criterion, &tones, &moved(&w, &x), None)
-                    .map_or(f64::INFINITY, |c| (c.1 - best.1) / DIFFERENCE)
-            })
-            .collect();
-        evaluations += n;
-        let scale = g.iter().fold(0.0_f64, |m, gi| m.max(gi.abs()));
-        if !(scale.is_finite() && scale > 0.0) {
-            break;
-        }
-        let mut stepped = false;
-        for _ in 0..4 {
-            let x: Vec<f64> = g.iter().map(|gi| -eta * gi / scale).collect();
-            let next = moved(&w, &x);
-            evaluations += 1;
-            if let Some(c) = value_at(plan, criterion, &tones, &next, None) {
+    let mut w = flat_shares;
+    let mut evaluations = 1;
+    if n > 1 {
+        let objective = Shares {
+            plan,
+            criterion,
+            tones: &tones,
+            evaluations: AtomicUsize::new(0),
+        };
+        let bfgs = Bfgs {
+            max_iters: ITERATIONS,
+            decrement_tol: DECREMENT,
+            initial_step: 0.5,
+            ..Bfgs::default()
+        };
+        // A descent that fails leaves the flat spectrum, which is already evaluated.
+        let report = bfgs.minimize(&objective as &dyn Objective, &vec![0.0; n - 1]);
+        evaluations += objective.evaluations.load(Ordering::Relaxed);
+        if let Ok(r) = report {
+            let moved = shares(&r.params);
+            if let Some(c) = value_at(plan, criterion, &tones, &moved, None) {
                 if c.1 < best.1 {
-                    let gain = (best.1 - c.1) / best.1.abs().max(1e-300);
-                    w = next;
+                    w = moved;
                     best = c;
-                    eta *= 1.5;
-                    stepped = gain > STOP;
-                    break;
                 }
             }
-            eta /= 4.0;
-        }
-        if !stepped {
-            break;
         }
     }
     // The phases that lower the crest factor, at the chosen power shares.
