@@ -47,10 +47,10 @@ pub fn peak(tones: &[Tone], (a, b): (f64, f64)) -> f64 {
         .collect();
     let grid_max = values.iter().copied().fold(0.0, f64::max);
     let mut best = grid_max;
-    for m in 0..=points {
+    for (m, &v) in values.iter().enumerate() {
         let left = if m > 0 { values[m - 1] } else { 0.0 };
         let right = values.get(m + 1).copied().unwrap_or(0.0);
-        if values[m] < 0.99 * grid_max || values[m] < left || values[m] < right {
+        if v < 0.99 * grid_max || v < left || v < right {
             continue;
         }
         let t0 = a + h * m as f64;
@@ -162,7 +162,7 @@ pub fn low_crest_phases(k: &[u64], amplitudes: &[f64]) -> Vec<f64> {
                     re += x * c;
                     im -= x * s;
                 }
-                (re).atan2(-im)
+                re.atan2(-im)
             })
             .collect();
         let p = grid_peak(&synth(&phases));

@@ -31,7 +31,7 @@ pub fn dac_samples(
         ));
     }
     let count = (duration * rate).round();
-    if !(count >= 1.0 && count <= MAX_DAC_SAMPLES) {
+    if !(1.0..=MAX_DAC_SAMPLES).contains(&count) {
         return Err(study_err!(
             "[design] dac_rate: {rate} Hz over the record of {duration} s gives {count} samples; expected 1 to {MAX_DAC_SAMPLES:e}"
         ));
