@@ -38,8 +38,14 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// BFGS iterations on the power distribution.
 const ITERATIONS: u64 = 40;
 
-/// Step in `xᵢ = log wᵢ + const` of the central differences.
-const DIFFERENCE: f64 = 1e-4;
+/// Step in `xᵢ = log wᵢ + const` of the central differences: large enough that a criterion
+/// computed by quadrature (exact ML's Fisher information) does not turn the gradient into
+/// noise, small enough that the differences' own error (second order) is negligible.
+const DIFFERENCE: f64 = 1e-3;
+
+/// BFGS restarts from its own result (a fresh inverse Hessian), while a restart still lowers
+/// the criterion: a quasi-Newton run can stall on a stale curvature estimate.
+const RESTARTS: usize = 3;
 
 /// Predicted decrease of the criterion below which the descent stops (the criterion's Monte
 /// Carlo error is orders of magnitude larger).
@@ -284,18 +290,23 @@ pub(crate) fn optimise_tones(
             initial_step: 0.5,
             ..Bfgs::default()
         };
-        // A descent that fails leaves the flat spectrum, which is already evaluated.
-        let report = bfgs.minimize(&objective as &dyn Objective, &vec![0.0; n - 1]);
-        evaluations += objective.evaluations.load(Ordering::Relaxed);
-        if let Ok(r) = report {
+        // A descent that fails leaves the best point so far, which is already evaluated.
+        let mut x = vec![0.0; n - 1];
+        for _ in 0..=RESTARTS {
+            let Ok(r) = bfgs.minimize(&objective as &dyn Objective, &x) else {
+                break;
+            };
             let moved = shares(&r.params);
-            if let Some(c) = value_at(plan, criterion, &tones, &moved, None) {
-                if c.1 < best.1 {
+            match value_at(plan, criterion, &tones, &moved, None) {
+                Some(c) if c.1 < best.1 => {
                     w = moved;
                     best = c;
+                    x = r.params;
                 }
+                _ => break,
             }
         }
+        evaluations += objective.evaluations.load(Ordering::Relaxed);
     }
     // The phases that lower the crest factor, at the chosen power shares.
     let amplitudes: Vec<f64> = w.iter().map(|wi| wi.sqrt()).collect();
