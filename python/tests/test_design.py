@@ -106,7 +106,7 @@ def test_a_multisine_design_reports_its_tones_and_writes_its_samples(tmp_path):
 
 @pytest.mark.parametrize("extra, kwargs, words", [
     ("power = -1.0\n", {}, r"\[design\] power"),
-    ("peak = 0.1\n", {}, "cannot hold the power"),
+    ("power = 1.0\npeak = 0.5\n", {}, "cannot hold the power"),
     ("", {"write_input": "x.csv", "dac_rate": 0.5}, "dac_rate"),
 ])
 def test_bad_multisine_keys_raise_value_error(tmp_path, extra, kwargs, words):
