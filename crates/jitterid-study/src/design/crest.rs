@@ -187,8 +187,8 @@ mod tests {
             let t = harmonic_tones(1.0, &k, &a, ph);
             peak(&t, (0.0, 1.0)) / rms(&t)
         };
-        let zero = crest(&vec![0.0; 16]);
-        let schroeder = crest(&schroeder_phases(&k, &vec![1.0 / 16.0; 16]));
+        let zero = crest(&[0.0; 16]);
+        let schroeder = crest(&schroeder_phases(&k, &[1.0 / 16.0; 16]));
         let clipped = crest(&low_crest_phases(&k, &a));
         assert!(schroeder < 0.5 * zero, "{schroeder} vs {zero}");
         assert!(clipped < schroeder, "{clipped} vs {schroeder}");
