@@ -34,7 +34,7 @@ fn value3(tones: &[Tone], t: f64) -> (f64, f64, f64) {
     out
 }
 
-/// The peak `max |u(t)|` of the tones over `[a, b]`: a grid of [`POINTS_PER_PERIOD`] points per
+/// The peak `max |u(t)|` of the tones over `[a, b]`: a grid of 32 points per
 /// period of the highest tone, then Newton's method on `u′ = 0` from every grid maximum within
 /// a percent of the largest (the continuous maximum lies within a grid step of one of them).
 pub fn peak(tones: &[Tone], (a, b): (f64, f64)) -> f64 {
@@ -113,7 +113,7 @@ pub fn harmonic_tones(f0: f64, k: &[u64], amplitudes: &[f64], phases: &[f64]) ->
 }
 
 /// Phases of the harmonics `k` with `amplitudes` that lower the crest factor: Schroeder's,
-/// then [`CLIP_ITERATIONS`] of the clipping algorithm on one period sampled at `M` points
+/// then 60 iterations of the clipping algorithm on one period sampled at `M` points
 /// (`M > 2 max k`, so the tones are exact on the grid), keeping the best phases by the grid's
 /// peak. Deterministic.
 pub fn low_crest_phases(k: &[u64], amplitudes: &[f64]) -> Vec<f64> {
