@@ -233,7 +233,7 @@ def select(experiment: Experiment, record: Record, *, validation: Optional[Recor
 
 def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: Optional[str] = None,
            jitter_blind: bool = False, write_input: Optional[Union[str, os.PathLike]] = None,
-           derived: Optional[Iterable[str]] = None) -> DesignResult:
+           derived: Optional[Iterable[str]] = None, dac_rate: Optional[float] = None) -> DesignResult:
     """The experiment that makes ``experiment``'s estimate most precise, over the free
     variables of its ``[design]`` section (see ``docs/experiments.md``), as ``jitterid design
     --json [--criterion] [--budget] [--jitter-blind] [--write-input] [--derived]``.
@@ -244,7 +244,10 @@ def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: O
       replacing the section's.
     * ``jitter_blind``: also the design that ignores the jitter, predicted under the true prior.
     * ``write_input``: a path ``FILE.csv``: writes the designed input there and the experiment
-      that reads it to ``FILE.toml``, ready for ``Experiment.from_toml`` and ``simulate``.
+      that reads it to ``FILE.toml``, ready for ``Experiment.from_toml`` and ``simulate``; for a
+      designed multisine (``[design] band``), the experiment with its tones to ``FILE.toml`` and
+      its sample sequence at ``dac_rate`` Hz (``[design] dac_rate`` by default) to ``FILE.csv``.
+    * ``dac_rate``: the DAC rate of a designed multisine's sample sequence, as ``--dac-rate``.
     * ``derived``: the derived quantities whose predicted standard deviations are reported
       (``result.derived``), replacing ``[design] derived``: ``"static_gain"``,
       ``"pole_frequency"`` (every pole's ``|p|/2π``, named ``pole1.frequency``, … in increasing
@@ -264,12 +267,15 @@ def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: O
         names = list(derived)
         if not all(isinstance(n, str) for n in names):
             raise TypeError("derived: expected a list of names such as ['static_gain', 'pole_frequency']")
+    if dac_rate is not None and (isinstance(dac_rate, bool) or not isinstance(dac_rate, (int, float))):
+        raise TypeError(f"dac_rate: expected a number of Hz, found {type(dac_rate).__name__}")
     target = None if write_input is None else os.fspath(write_input)
     if target is not None and not target.endswith(".csv"):
         raise ValueError(f"write_input: expected a path ending in .csv (the experiment goes beside it as .toml), "
                          f"found {target!r}")
     text, written = _jitterid.design(experiment, criterion, bool(jitter_blind), budget,
-                                     None if target is None else os.path.basename(target), names)
+                                     None if target is None else os.path.basename(target), names,
+                                     None if dac_rate is None else float(dac_rate))
     if target is not None and written is not None:
         csv, toml = written
         with open(target, "w") as out:

@@ -121,9 +121,10 @@ class Validated:
 
 def design(
     experiment: Experiment, criterion: Optional[str], jitter_blind_design: bool, budget: Optional[str],
-    input_name: Optional[str], derived: Optional[List[str]] = None,
+    input_name: Optional[str], derived: Optional[List[str]] = None, dac_rate: Optional[float] = None,
 ) -> Tuple[str, Optional[Tuple[str, str]]]:
-    """``design --json``'s text, and with ``input_name`` the designed input's CSV and experiment texts."""
+    """``design --json``'s text, and with ``input_name`` the designed input's CSV and experiment texts
+    (a designed multisine's CSV: its sample sequence at ``dac_rate`` Hz)."""
 def validate(
     experiment: Experiment,
     y: npt.ArrayLike,

@@ -332,6 +332,9 @@ class DesignResult(_CommandJson):
     as the static gain), the same for the experiment file's own design (``baseline``,
     ``baseline_predicted``), and with ``jitter_blind=True`` the design that ignores the jitter
     (``jitter_blind``: its design and its standard deviations under the true, jittered prior).
+    A designed multisine (``[design] band``) is ``multisine`` (``frequencies``, ``amplitudes``,
+    ``phases``, ``crest_factor``, ``power``; also ``design["multisine"]``) beside the file's own,
+    ``baseline_multisine``; both are ``None`` for other designs.
     """
 
     def __init__(self, data: Dict[str, Any]) -> None:
@@ -345,8 +348,12 @@ class DesignResult(_CommandJson):
         self.baseline: Optional[Dict[str, Any]] = base.get("design")
         self.baseline_predicted: Dict[str, float] = {p["name"]: p["std"] for p in base.get("predicted", [])}
         self.jitter_blind: Optional[Dict[str, Any]] = data.get("jitter_blind")
+        self.multisine: Optional[Dict[str, Any]] = self.design.get("multisine")
+        self.baseline_multisine: Optional[Dict[str, Any]] = (self.baseline or {}).get("multisine")
 
 
     def __repr__(self) -> str:
-        design = ", ".join(f"{k}={v:.6g}" for k, v in self.design.items())
+        design = ", ".join(f"{k}={v:.6g}" for k, v in self.design.items() if isinstance(v, (int, float)))
+        if self.multisine is not None:
+            design += f", multisine of {len(self.multisine['frequencies'])} tones"
         return f"DesignResult(criterion {self.criterion}: {design})"

@@ -85,3 +85,53 @@ def test_an_experiment_without_a_design_section_is_refused():
     exp = jitterid.Experiment.from_toml(str(REPO / "examples/experiments/table2.toml"))
     with pytest.raises(ValueError, match=r"no \[design\] section"):
         jitterid.design(exp)
+
+
+def multisine_with(tmp_path: Path, extra: str = "") -> Path:
+    """``design-multisine.toml`` with four tones (a cheap search), then ``extra`` keys."""
+    path = tmp_path / "ms.toml"
+    text = (REPO / "examples/experiments/design-multisine.toml").read_text()
+    path.write_text(text.replace("tones = 8 ", "tones = 4 ") + extra)
+    return path
+
+
+def test_a_multisine_design_reports_its_tones_and_writes_its_samples(tmp_path):
+    exp = jitterid.Experiment.from_toml(str(multisine_with(tmp_path)))
+    target = tmp_path / "designed.csv"
+    result = jitterid.design(exp, write_input=target, dac_rate=2.0)
+    m = result.multisine
+    assert m is not None and result.design["multisine"] == m
+    assert set(m) == {"frequencies", "amplitudes", "phases", "crest_factor", "power"}
+    assert len(m["frequencies"]) == 4
+    # The power constraint: the file's own, exactly.
+    assert result.baseline_multisine is not None
+    assert abs(sum(a * a / 2 for a in m["amplitudes"]) - result.baseline_multisine["power"]) < 1e-12
+    assert "multisine of 4 tones" in repr(result)
+    # The written experiment is the designed multisine; the CSV its samples at 2 Hz over 200 s.
+    designed = jitterid.Experiment.from_toml(str(tmp_path / "designed.toml"))
+    assert designed.samples == 200
+    rows = target.read_text().splitlines()
+    assert rows[0] == "t,u" and len(rows) == 1 + 400
+    fit = designed.fit(designed.simulate(seed=3))
+    assert fit.converged
+    binary = os.environ.get("JITTERID_BIN")
+    if binary is None:
+        pytest.skip("JITTERID_BIN is not set (the command line to compare with)")
+    out = subprocess.run([binary, "design", str(tmp_path / "ms.toml"), "--json"], capture_output=True, text=True,
+                         check=True)
+    assert result.to_dict() == json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("extra, kwargs, words", [
+    ("power = -1.0\n", {}, r"\[design\] power"),
+    ("power = 1.0\npeak = 0.5\n", {}, "cannot hold the power"),
+    ("", {"write_input": "x.csv", "dac_rate": 0.5}, "dac_rate"),
+])
+def test_bad_multisine_keys_raise_value_error(tmp_path, extra, kwargs, words):
+    path = multisine_with(tmp_path, extra)
+    exp_text = path.read_text().replace("dac_rate = 20.0 ", "")
+    path.write_text(exp_text)
+    if "write_input" in kwargs:
+        kwargs = dict(kwargs, write_input=tmp_path / kwargs["write_input"])
+    with pytest.raises(ValueError, match=words):
+        jitterid.design(jitterid.Experiment.from_toml(str(path)), **kwargs)

@@ -27,7 +27,7 @@ const USAGE: &str = "usage:
   cargo xtask memory [N] [--out DIR]
       peak memory of the release binary's simulate, fit and montecarlo at N samples (default 10^7)
   cargo xtask reproduce <case> [--runs R] [--seed S] [--shard i/n] [--json FILE] [--out DIR]
-      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate, design, design-bcls, all";
+      cases: table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate, design, design-bcls, design-multisine, all";
 
 /// Options of `reproduce`.
 #[derive(Debug, Clone)]

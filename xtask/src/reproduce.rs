@@ -84,6 +84,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
         "validate" => crate::reproduce_validate::validate_case(o),
         "design" => crate::reproduce_design::design(o),
         "design-bcls" => crate::reproduce_design::design_bcls(o),
+        "design-multisine" => crate::reproduce_design::design_multisine(o),
         "all" => {
             for c in [
                 "table2",
@@ -104,7 +105,7 @@ pub fn run(case: &str, o: &Options) -> Result<(), String> {
             Ok(())
         }
         other => Err(format!(
-            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate, design, design-bcls or all)"
+            "unknown case `{other}` (expected table1, table2, ls-bias, alias, table1-ml, sine, starts, initial, models, select, validate, design, design-bcls, design-multisine or all)"
         )),
     }
 }

@@ -63,7 +63,9 @@ pub struct DesignArgs {
     pub budget: Option<String>,
     /// Write the designed experiment's input (a random binary input's realisation 0 of the
     /// [design] seed, columns t,u) to FILE.csv and the experiment file that reads it, with the
-    /// designed sampling, to FILE.toml, ready for simulate and fit.
+    /// designed sampling, to FILE.toml, ready for simulate and fit; for a designed multisine,
+    /// the experiment with its tones to FILE.toml and its sample sequence at --dac-rate to
+    /// FILE.csv.
     #[arg(long, value_name = "FILE.csv")]
     pub write_input: Option<PathBuf>,
     /// The derived quantities whose predicted standard deviations are reported, comma-separated:
@@ -71,6 +73,10 @@ pub struct DesignArgs {
     /// jitter.sigma [default: [design] derived, else static_gain and an estimated jitter's σ].
     #[arg(long, value_name = "QUANTITY,...", value_delimiter = ',')]
     pub derived: Option<Vec<String>>,
+    /// The DAC rate (Hz) of a designed multisine's sample sequence, which --write-input
+    /// writes to FILE.csv (columns t,u, one record) [default: [design] dac_rate].
+    #[arg(long, value_name = "HZ")]
+    pub dac_rate: Option<f64>,
     /// Also design with the jitter ignored (γ ≡ 1, no jitter noise) and report that design's
     /// precision under the true, jittered prior beside the jitter-aware one.
     #[arg(long)]
@@ -400,6 +406,7 @@ fn dispatch(cli: Cli) -> StudyResult<Outcome> {
             derived: a.derived,
             jitter_blind: a.jitter_blind,
             write_input: a.write_input,
+            dac_rate: a.dac_rate,
             json: a.json,
             out: a.out,
         }),

@@ -12,7 +12,9 @@ use jitterid_study::design::{
     design as run_design, designed_input, jitter_blind, Design, DesignReport, Plan,
 };
 use jitterid_study::error::StudyResult;
-use jitterid_study::experiment::{budget_edit, derived_edit, DesignCriterion, ReadOptions};
+use jitterid_study::experiment::{
+    budget_edit, dac_rate_edit, derived_edit, DesignCriterion, ReadOptions,
+};
 use jitterid_study::study_err;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -35,6 +37,9 @@ pub struct DesignOptions {
     /// Write the designed input (CSV) to this file and the experiment reading it beside it
     /// (the same name with `.toml`).
     pub write_input: Option<PathBuf>,
+    /// The DAC rate (Hz) of a designed multisine's sample sequence, replacing `[design]
+    /// dac_rate`.
+    pub dac_rate: Option<f64>,
     /// Print JSON instead of a table.
     pub json: bool,
     /// Write the JSON to this file instead of standard output.
@@ -52,6 +57,38 @@ fn design_text(d: &Design) -> String {
         fmt_num(d.interval),
         d.samples
     );
+    if let Some(m) = &d.multisine {
+        let _ = write!(
+            s,
+            ", multisine of {} tones: power = {}, crest factor = {}, peak = {}",
+            m.frequencies.len(),
+            fmt_num(m.power),
+            fmt_num(m.crest_factor),
+            fmt_num(m.peak())
+        );
+    }
+    s
+}
+
+/// The tones of a design's multisine, one line each, indented.
+fn tones_text(d: &Design) -> String {
+    let mut s = String::new();
+    if let Some(m) = &d.multisine {
+        let _ = writeln!(
+            s,
+            "  {:>14}  {:>14}  {:>14}",
+            "frequency (Hz)", "amplitude", "phase (rad)"
+        );
+        for t in m.tones() {
+            let _ = writeln!(
+                s,
+                "  {:>14}  {:>14}  {:>14}",
+                fmt_num(t.frequency),
+                fmt_num(t.amplitude),
+                fmt_num(t.phase)
+            );
+        }
+    }
     s
 }
 
@@ -86,6 +123,9 @@ pub fn design(o: &DesignOptions) -> StudyResult<Outcome> {
     if let Some(names) = &o.derived {
         let origin = format!("--derived {}", names.join(","));
         read.overrides.push(derived_edit(names, origin));
+    }
+    if let Some(rate) = o.dac_rate {
+        read.overrides.push(dac_rate_edit(rate));
     }
     // The spinner watches the searches (the jitter-blind one too) and is cleared before
     // anything is printed; the numbers do not depend on it.
@@ -141,7 +181,9 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
         report.evaluations
     );
     let _ = writeln!(out, "designed: {}", design_text(&report.design));
+    out += &tones_text(&report.design);
     let _ = writeln!(out, "baseline: {}", design_text(&report.baseline));
+    out += &tones_text(&report.baseline);
     let blind = report.jitter_blind.as_ref();
     if let Some(b) = blind {
         let _ = writeln!(

@@ -2,16 +2,18 @@
 //! the experiment file that make it.
 //!
 //! A design is applied as edits of the experiment's document (`input.mean_dwell`,
-//! `sampling.interval`, `sampling.samples`), which is then read again: every candidate meets
+//! `sampling.interval`, `sampling.samples`, a multisine's `input.frequencies`,
+//! `input.amplitudes` and `input.phases`), which is then read again: every candidate meets
 //! the same validation as a file written by hand (the jitter's reach within the record, the
 //! input's switch limit), and nothing in the design layer has to know how an experiment holds
 //! its input or grid.
 
+use super::multisine::MultisineDesign;
 use crate::experiment::{Experiment, Override};
 use serde::Serialize;
 
 /// The design variables of one experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Design {
     /// The random binary input's mean dwell (s), for such an input.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -20,6 +22,9 @@ pub struct Design {
     pub interval: f64,
     /// The number of samples `N`.
     pub samples: usize,
+    /// A multisine input's tones, when they are designed (`[design] band`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub multisine: Option<MultisineDesign>,
 }
 
 impl Design {
@@ -29,6 +34,7 @@ impl Design {
             mean_dwell: super::realization::mean_dwell_of(exp),
             interval: exp.grid.interval(),
             samples: exp.grid.len(),
+            multisine: None,
         }
     }
 
@@ -45,6 +51,12 @@ impl Design {
         }
         out.push(edit(&["sampling", "interval"], self.interval.into()));
         out.push(edit(&["sampling", "samples"], (self.samples as i64).into()));
+        if let Some(m) = &self.multisine {
+            let list = |xs: &[f64]| toml_edit::Value::Array(xs.iter().copied().collect());
+            out.push(edit(&["input", "frequencies"], list(&m.frequencies)));
+            out.push(edit(&["input", "amplitudes"], list(&m.amplitudes)));
+            out.push(edit(&["input", "phases"], list(&m.phases)));
+        }
         out
     }
 }

@@ -22,6 +22,8 @@
 //!   Carlo's standard errors.
 //! - [`designed_input`]: a design's input realisation as a CSV input file and the experiment
 //!   file that reads it, ready for `simulate` and `fit`.
+//! - [`MultisineDesign`]: a multisine input's tones designed over a band under a power or
+//!   peak constraint, with phases that lower the crest factor ([`low_crest_phases`]).
 //! - [`optimise`], [`design()`]: the seeded, deterministic search over the `[design]` ranges and
 //!   the report that sets the result beside the file's own design.
 //! - [`DesignProgress`]: what the searches report while they run, to the observer a plan
@@ -30,9 +32,12 @@
 mod blind;
 mod candidate;
 mod check;
+mod crest;
 mod criterion;
+mod dac;
 mod derived;
 mod derived_choice;
+mod multisine;
 mod plan;
 mod predict;
 mod prior;
@@ -45,9 +50,12 @@ mod written;
 pub use blind::{evaluate, jitter_blind, JitterBlind};
 pub use candidate::Design;
 pub use check::{monte_carlo, MonteCarloCheck};
+pub use crest::{low_crest_phases, peak, rms, schroeder_phases};
 pub use criterion::{covariance_criterion, criterion_value};
+pub use dac::dac_samples;
 pub use derived::{derived_std, Derived};
 pub use derived_choice::{requested_stds, DerivedRequest, DERIVED_EXPECTED};
+pub use multisine::{log_spaced_harmonics, MultisineDesign};
 pub use plan::Plan;
 pub use predict::{predict, Prediction};
 pub use prior::prior_experiments;

@@ -220,7 +220,15 @@ impl Plan {
 
     /// The baseline's design.
     pub fn baseline_design(&self) -> Design {
-        Design::of(&self.baseline)
+        let mut d = Design::of(&self.baseline);
+        // Under a multisine design the file's own tones are part of the baseline's design.
+        if self.spec.multisine.is_some() {
+            let start = self.baseline.grid.start();
+            let span = (start, start + d.samples as f64 * d.interval);
+            d.multisine = super::realization::tones_of(&self.baseline)
+                .map(|t| super::multisine::MultisineDesign::of_tones(&t, span));
+        }
+        d
     }
 
     /// The experiment of `design`: the document with the design's edits, read again.

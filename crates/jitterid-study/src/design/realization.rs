@@ -37,3 +37,14 @@ pub(crate) fn mean_dwell_of(exp: &Experiment) -> Option<f64> {
         _ => None,
     }
 }
+
+/// The multisine input's tones, `None` for another input or several inputs.
+pub(crate) fn tones_of(exp: &Experiment) -> Option<Vec<jitterid::signal::Tone>> {
+    match exp.inputs.as_slice() {
+        [c] => match &c.spec {
+            InputSpec::Known(jitterid::signal::Input::Tones(m)) => Some(m.tones().to_vec()),
+            _ => None,
+        },
+        _ => None,
+    }
+}

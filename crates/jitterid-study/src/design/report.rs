@@ -180,16 +180,16 @@ impl DesignReport {
         };
         DesignJson {
             criterion: self.criterion.to_string(),
-            design: self.design,
+            design: self.design.clone(),
             predicted: stds(&self.prediction),
             derived: self.derived_of(&self.prediction),
             baseline: PredictedDesign {
-                design: self.baseline,
+                design: self.baseline.clone(),
                 predicted: baseline,
                 derived: baseline_derived,
             },
             jitter_blind: self.jitter_blind.as_ref().map(|b| BlindJson {
-                design: b.design,
+                design: b.design.clone(),
                 predicted: stds(&b.prediction),
                 criterion_value: b.value,
                 predicted_blind: stds(&b.blind_prediction),

@@ -65,7 +65,7 @@ struct Search<'a> {
 impl Search<'_> {
     /// The design at log-coordinates `u` of `vars`, the other variables at `base`.
     fn design(&self, base: &Design, vars: &[Var], u: &[f64]) -> Design {
-        let mut d = *base;
+        let mut d = base.clone();
         for (v, &x) in vars.iter().zip(u) {
             match v {
                 Var::MeanDwell => d.mean_dwell = Some(x.exp()),
@@ -102,7 +102,7 @@ impl Search<'_> {
         };
         let evaluations = {
             let mut memo = self.memo.lock().unwrap_or_else(|e| e.into_inner());
-            memo.push((*d, out));
+            memo.push((d.clone(), out));
             memo.len()
         };
         self.plan.observe(DesignProgress::Evaluated {
@@ -153,6 +153,10 @@ impl Objective for Line<'_, '_> {
 /// A criterion that names no estimated parameter; no design in the ranges that can be
 /// evaluated (the message gives the first reason and names the `[design]` keys).
 pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum> {
+    // A multisine's tones are a power distribution, searched on the simplex instead.
+    if let Some(tones) = &plan.spec.multisine {
+        return super::multisine::optimise_tones(plan, criterion, tones);
+    }
     let spec = &plan.spec;
     let mut vars = Vec::new();
     let mut ranges = Vec::new();

@@ -6,8 +6,15 @@
 //! 0 sees), and the experiment written beside it is the planned one with the design's sampling
 //! and `[input] kind = "csv"` reading that file, so `jitterid simulate` and `jitterid fit` take
 //! the designed experiment as they take any other.
+//!
+//! A designed multisine is a signal the experiment file states exactly: the experiment
+//! written keeps `[input] kind = "multisine"` with the designed frequencies, amplitudes and
+//! phases, and the CSV beside it is the sample sequence a DAC plays at its rate
+//! ([`dac_samples`]).
 
 use super::candidate::Design;
+use super::dac::dac_samples;
+use super::multisine::MultisineDesign;
 use super::plan::Plan;
 use crate::csvio::input_to_csv;
 use crate::error::StudyResult;
@@ -34,9 +41,14 @@ pub struct DesignedInput {
 /// # Errors
 ///
 /// The experiment has several inputs or an input that is not random binary (its input is
-/// already a signal the file fixes); the design's experiment is invalid; the document cannot
-/// be edited.
+/// already a signal the file fixes) and no designed multisine; the design's experiment is
+/// invalid; the document cannot be edited; a designed multisine without `[design] dac_rate`
+/// (which `--dac-rate` sets), or with one that cannot reproduce its tones ([`dac_samples`]).
 pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResult<DesignedInput> {
+    if let Some(m) = &design.multisine {
+        let rate = plan.spec.multisine.as_ref().and_then(|s| s.dac_rate);
+        return designed_multisine(plan, design, m, csv_name, rate);
+    }
     let exp = plan.experiment(design)?;
     if exp.inputs.len() != 1 || !exp.random_input() {
         return Err(study_err!(
@@ -86,6 +98,45 @@ pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResu
     );
     Ok(DesignedInput {
         csv: input_to_csv(u),
+        experiment: header + &doc.to_string(),
+    })
+}
+
+/// The designed multisine's experiment (the file with the design's sampling and tones, its
+/// kind unchanged) and its sample sequence at `rate` Hz.
+fn designed_multisine(
+    plan: &Plan,
+    design: &Design,
+    m: &MultisineDesign,
+    csv_name: &str,
+    rate: Option<f64>,
+) -> StudyResult<DesignedInput> {
+    let exp = plan.experiment(design)?;
+    let rate = rate.ok_or_else(|| {
+        study_err!(
+            "{}: [design] dac_rate: a designed multisine is written as its sample sequence, which needs a DAC rate; expected --dac-rate HZ or [design] dac_rate",
+            exp.file
+        )
+    })?;
+    let start = exp.grid.start();
+    let csv = dac_samples(m, rate, start, design.samples as f64 * design.interval)?;
+    let mut edits = plan.edits().to_vec();
+    edits.extend(design.edits());
+    let text = edited_text(&exp.file, plan.text(), &edits)?;
+    let mut doc: toml_edit::DocumentMut = text
+        .parse()
+        .map_err(|e| study_err!("{}: the edited document: {e}", exp.file))?;
+    doc.remove("design");
+    let header = format!(
+        "# Designed by `jitterid design` from {}: a multisine of {} tones, power {}, crest factor\n\
+         # {}; its sample sequence at {rate} Hz (one record, t,u) in {csv_name}.\n",
+        exp.file,
+        m.frequencies.len(),
+        m.power,
+        m.crest_factor
+    );
+    Ok(DesignedInput {
+        csv,
         experiment: header + &doc.to_string(),
     })
 }

@@ -9,6 +9,7 @@ use super::diagnostics::Source;
 use super::range::{MAX_INTERVAL, MIN_INTERVAL};
 use super::raw::RawDesign;
 use super::sampling::MAX_SAMPLES;
+use super::tone_design::{parse_tone_design, ToneDesignSpec};
 use crate::design::DerivedRequest;
 use crate::error::StudyResult;
 use jitterid::signal::{SampleGrid, MAX_SWITCHES};
@@ -142,6 +143,13 @@ pub fn budget_edit(text: &str) -> StudyResult<super::Override> {
     ))
 }
 
+/// The edit of the command line's `--dac-rate HZ`: the `[design] dac_rate` key, named
+/// `--dac-rate …` in messages, so that the rate is checked exactly as the key written in the
+/// file is.
+pub fn dac_rate_edit(rate: f64) -> super::Override {
+    super::Override::from_source(&[S, "dac_rate"], rate.into(), format!("--dac-rate {rate}"))
+}
+
 /// The validated `[design]` section.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DesignSpec {
@@ -173,6 +181,9 @@ pub struct DesignSpec {
     /// The derived quantities reported (`derived`), `None` for the default (the static gain,
     /// and the jitter's σ when it is estimated).
     pub derived: Option<Vec<DerivedRequest>>,
+    /// A multisine input's free tones (`band`, `tones`, `power`, `peak`, `dac_rate`), `None`
+    /// when its frequencies, amplitudes and phases are the file's.
+    pub multisine: Option<ToneDesignSpec>,
 }
 
 /// Largest number of prior draws a robust design averages over.
@@ -338,6 +349,7 @@ pub(super) fn parse_design(
     cx: &Source,
     r: &RawDesign,
     input_kind: Option<&str>,
+    file_tones: Option<&[jitterid::signal::Tone]>,
     grid: &SampleGrid,
     history: f64,
 ) -> StudyResult<DesignSpec> {
@@ -456,11 +468,19 @@ pub(super) fn parse_design(
         }
     }
     let mean_dwell = mean_dwell.map(|(_, r)| r);
-    if mean_dwell.is_none() && interval.is_none() {
+    let multisine = parse_tone_design(
+        cx,
+        r,
+        file_tones,
+        grid.interval(),
+        budget.samples_at(grid.interval()),
+        r.interval.is_some(),
+    )?;
+    if mean_dwell.is_none() && interval.is_none() && multisine.is_none() {
         return Err(cx.err_section(
             S,
             "mean_dwell",
-            "the section names no free variable; expected mean_dwell = [min, max] or interval = [min, max]",
+            "the section names no free variable; expected mean_dwell = [min, max], interval = [min, max] or band = [fmin, fmax]",
         ));
     }
     let criterion = match &r.criterion {
@@ -508,6 +528,7 @@ pub(super) fn parse_design(
         seed,
         prior,
         derived,
+        multisine,
     })
 }
 

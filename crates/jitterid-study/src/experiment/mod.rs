@@ -25,10 +25,11 @@ mod sampling;
 mod select;
 mod spec;
 mod system;
+mod tone_design;
 
 pub use design::{
-    budget_edit, derived_edit, Budget, DesignCriterion, DesignEstimator, DesignSpec, Hold,
-    PriorSpread, MAX_DRAWS, MAX_GRID, MAX_PRIOR_DRAWS,
+    budget_edit, dac_rate_edit, derived_edit, Budget, DesignCriterion, DesignEstimator, DesignSpec,
+    Hold, PriorSpread, MAX_DRAWS, MAX_GRID, MAX_PRIOR_DRAWS,
 };
 pub use input::MAX_SWITCHES;
 pub use overrides::Override;
@@ -37,6 +38,9 @@ pub use sampling::MAX_SAMPLES;
 pub use spec::{
     name_table, EstimateSpec, Experiment, InputChannel, InputSpec, JitterSpec, LikelihoodStart,
     Method, NoiseSpec, SolverName, SystemSpec,
+};
+pub use tone_design::{
+    harmonics_in, ToneDesignSpec, DEFAULT_TONES, MAX_DAC_SAMPLES, MAX_DESIGN_TONES,
 };
 
 use crate::csvio;
@@ -342,7 +346,15 @@ pub fn parse_with(
             };
             let kind = one.and_then(|(i, _)| i.kind.as_ref().map(|k| k.get_ref().as_str()));
             let history = one.map_or(0.0, |(_, h)| h);
-            Some(design::parse_design(&cx, r, kind, &grid, history)?)
+            // A multisine design starts from the file's own tones.
+            let tones = match inputs.as_slice() {
+                [c] if one.is_some() => match &c.spec {
+                    InputSpec::Known(jitterid::signal::Input::Tones(m)) => Some(m.tones()),
+                    _ => None,
+                },
+                _ => None,
+            };
+            Some(design::parse_design(&cx, r, kind, tones, &grid, history)?)
         }
         None => None,
     };

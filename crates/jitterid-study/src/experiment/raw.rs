@@ -128,6 +128,11 @@ section!(RawDesign, "table [design]" {
     prior_jitter_spread: f64,
     prior_draws: i64,
     derived: Vec<String>,
+    band: Vec<f64>,
+    tones: i64,
+    power: f64,
+    peak: f64,
+    dac_rate: f64,
 });
 
 #[derive(Debug, Deserialize)]
