@@ -197,8 +197,13 @@ impl DesignTicker {
                     evaluations,
                     grid_points,
                 } => {
+                    // A multisine's descent has no grid to show.
+                    let grid = match grid_points {
+                        0 => String::new(),
+                        g => format!(" (grid {g})"),
+                    };
                     *last = format!(
-                        "{}design: {evaluations} design{} evaluated (grid {grid_points})",
+                        "{}design: {evaluations} design{} evaluated{grid}",
                         if jitter_blind { "jitter-blind " } else { "" },
                         if evaluations == 1 { "" } else { "s" }
                     );

@@ -104,3 +104,57 @@ fn the_observer_sees_every_evaluation_and_changes_nothing() {
         assert_eq!(pair, [(1, 2), (2, 2)]);
     }
 }
+
+/// A multisine's descent reports each design it evaluates too (without a grid), numbered
+/// `1 … evaluations` in some order (its gradient's components run in parallel), and the report
+/// with the observer is the report without it.
+#[test]
+fn a_multisine_search_reports_every_evaluation() {
+    let text = r#"
+[sampling]
+interval = 1.0
+samples = 100
+[input]
+kind = "multisine"
+frequencies = [0.03, 0.1, 0.3]
+amplitudes = [0.3, 0.3, 0.3]
+[system]
+kind = "zpk"
+gain = 0.2
+zeros = [-0.5]
+poles = [[-0.25, 0.3]]
+estimate = true
+[jitter]
+family = "uniform-sum"
+n = 2
+a = 0.28867513459481287
+[noise]
+std = 0.01
+[design]
+band = [0.01, 0.4]
+tones = 3
+"#;
+    let plan = read_plan(text).unwrap();
+    let quiet = design(&plan, None).unwrap();
+    let (observer, seen) = recorder();
+    let watched = design(&plan.with_observer(observer), None).unwrap();
+    assert_eq!(
+        serde_json::to_string_pretty(&quiet.json()).unwrap(),
+        serde_json::to_string_pretty(&watched.json()).unwrap()
+    );
+    let mut numbers: Vec<usize> = seen
+        .lock()
+        .unwrap()
+        .iter()
+        .map(|p| match *p {
+            DesignProgress::Evaluated {
+                jitter_blind: false,
+                evaluations,
+                grid_points: 0,
+            } => evaluations,
+            other => panic!("unexpected {other:?}"),
+        })
+        .collect();
+    numbers.sort_unstable();
+    assert_eq!(numbers, (1..=watched.evaluations).collect::<Vec<_>>());
+}

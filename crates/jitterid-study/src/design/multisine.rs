@@ -25,6 +25,7 @@ use super::candidate::Design;
 use super::crest::{harmonic_tones, low_crest_phases, peak, rms, schroeder_phases};
 use super::plan::Plan;
 use super::predict::Prediction;
+use super::progress::DesignProgress;
 use super::search::Optimum;
 use crate::error::StudyResult;
 use crate::experiment::{harmonics_in, DesignCriterion, ToneDesignSpec};
@@ -198,7 +199,27 @@ struct Shares<'s, 'a> {
     plan: &'s Plan,
     criterion: &'s DesignCriterion,
     tones: &'s Tones<'a>,
-    evaluations: AtomicUsize,
+    evaluations: &'s Evaluations<'s>,
+}
+
+/// The designs the search has evaluated, each reported to the plan's observer as it starts
+/// (from the thread that evaluates it: the gradient's components run in parallel).
+struct Evaluations<'p> {
+    plan: &'p Plan,
+    count: AtomicUsize,
+}
+
+impl Evaluations<'_> {
+    /// Counts and reports one more evaluation.
+    fn tick(&self) {
+        let evaluations = self.count.fetch_add(1, Ordering::Relaxed) + 1;
+        self.plan.observe(DesignProgress::Evaluated {
+            jitter_blind: self.plan.is_jitter_blind(),
+            evaluations,
+            // A multisine search has no grid: its size is not known before it runs.
+            grid_points: 0,
+        });
+    }
 }
 
 impl Objective for Shares<'_, '_> {
@@ -207,7 +228,7 @@ impl Objective for Shares<'_, '_> {
     }
 
     fn cost(&self, x: &[f64]) -> f64 {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        self.evaluations.tick();
         value_at(self.plan, self.criterion, self.tones, &shares(x), None)
             .map_or(f64::INFINITY, |c| c.1)
     }
@@ -274,15 +295,19 @@ pub(crate) fn optimise_tones(
     })?;
     let (p, v) = evaluate(plan, &tones.design(flat.clone()), criterion)
         .map_err(|e| study_err!("{file}: [design] band: the flat spectrum over the band: {e}"))?;
+    let evaluations = Evaluations {
+        plan,
+        count: AtomicUsize::new(0),
+    };
+    evaluations.tick();
     let mut best: Candidate = (tones.design(flat), v, p);
     let mut w = flat_shares;
-    let mut evaluations = 1;
     if n > 1 {
         let objective = Shares {
             plan,
             criterion,
             tones: &tones,
-            evaluations: AtomicUsize::new(0),
+            evaluations: &evaluations,
         };
         let bfgs = Bfgs {
             max_iters: ITERATIONS,
@@ -306,12 +331,11 @@ pub(crate) fn optimise_tones(
                 _ => break,
             }
         }
-        evaluations += objective.evaluations.load(Ordering::Relaxed);
     }
     // The phases that lower the crest factor, at the chosen power shares.
     let amplitudes: Vec<f64> = w.iter().map(|wi| wi.sqrt()).collect();
     let phases = low_crest_phases(&tones.k, &amplitudes);
-    evaluations += 1;
+    evaluations.tick();
     // The delivered design has these phases (the constraint is on power or peak, and the
     // phases are chosen for the crest factor), unless they break the peak bound.
     let mut chosen = value_at(plan, criterion, &tones, &w, Some(&phases)).unwrap_or(best);
@@ -322,7 +346,7 @@ pub(crate) fn optimise_tones(
         let meets_peak = spec.peak.is_none_or(|a| m.peak() <= a);
         let same_record = own.samples == chosen.0.samples && own.interval == chosen.0.interval;
         if meets_power && meets_peak && same_record {
-            evaluations += 1;
+            evaluations.tick();
             if let Ok((p, v)) = evaluate(plan, &own, criterion) {
                 if v < chosen.1 {
                     chosen = (own, v, p);
@@ -334,7 +358,7 @@ pub(crate) fn optimise_tones(
         design: chosen.0,
         value: chosen.1,
         prediction: chosen.2,
-        evaluations,
+        evaluations: evaluations.count.into_inner(),
     })
 }
 

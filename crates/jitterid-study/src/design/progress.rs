@@ -20,7 +20,8 @@ pub enum DesignProgress {
         /// Designs this search has evaluated so far, this one included.
         evaluations: usize,
         /// Points of the search's grid (the part of the search whose size is known before it
-        /// runs; the refinement and the file's own design follow).
+        /// runs; the refinement and the file's own design follow); 0 for a search without a
+        /// grid (a multisine's descent).
         grid_points: usize,
     },
     /// A robust design's evaluation predicted one more of its prior draws.
@@ -33,7 +34,8 @@ pub enum DesignProgress {
 }
 
 /// A shared observer of [`DesignProgress`]: called on the thread that runs the search, in the
-/// order of the steps.
+/// order of the steps, except in a multisine's descent, whose gradient evaluates its
+/// components in parallel and reports each from its own thread (numbered as they start).
 #[derive(Clone)]
 pub struct DesignObserver(Arc<dyn Fn(&DesignProgress) + Send + Sync>);
 
