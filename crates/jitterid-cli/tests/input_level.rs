@@ -12,14 +12,7 @@ use serde_json::Value;
 /// Simulates run `run_no` of `exp` into `dir` (`d.csv`, and the input's side file
 /// `d.input.csv`) and fits it; the fit's JSON.
 fn simulate_and_fit(dir: &std::path::Path, exp: &str, run_no: &str, extra: &[&str]) -> Value {
-    let data = dir.join("d.csv");
-    let o = run(&["simulate", exp, "--run", run_no, "--out", s(&data)]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let mut args = vec!["fit", exp, "--data", s(&data), "--json"];
-    args.extend(extra);
-    let o = run(&args);
-    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
-    serde_json::from_str(&stdout(&o)).unwrap()
+    common::simulate_and_fit_in(dir, exp, run_no, extra)
 }
 
 #[test]
@@ -166,14 +159,7 @@ fn init_auto_fits_the_deviation_and_reaches_the_same_optimum() {
 
 /// `simulate` of `text`: exit 2, one line holding every one of `expect`, no data written.
 fn refused_text(name: &str, text: &str, expect: &[&str]) {
-    let (o, out) = simulate_text("jitterid-level-door", name, text);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
-    assert!(!out.exists(), "{name}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
-    for e in expect {
-        assert!(err.contains(e), "{name}: expected {e:?} in {err}");
-    }
+    common::refused_text("jitterid-level-door", name, text, expect);
 }
 
 fn refused(name: &str, from: &str, to: &str, expect: &[&str]) {

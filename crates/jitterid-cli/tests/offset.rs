@@ -4,19 +4,12 @@
 
 mod common;
 
-use common::{example, example_with, param, run, s, scratch_in, simulate_text, stderr, stdout};
+use common::{example, example_with, param, run, s, scratch_in, stderr, stdout};
 use serde_json::Value;
 
-/// Simulates run `run` of `exp` into `dir` and fits it; the fit's JSON.
+/// Simulates run `run_no` of `exp` into `dir` and fits it; the fit's JSON.
 fn simulate_and_fit(dir: &std::path::Path, exp: &str, run_no: &str, extra: &[&str]) -> Value {
-    let data = dir.join("d.csv");
-    let o = run(&["simulate", exp, "--run", run_no, "--out", s(&data)]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let mut args = vec!["fit", exp, "--data", s(&data), "--json"];
-    args.extend(extra);
-    let o = run(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    serde_json::from_str(&stdout(&o)).unwrap()
+    common::simulate_and_fit_in(dir, exp, run_no, extra)
 }
 
 #[test]
@@ -110,18 +103,12 @@ fn find_number(v: &Value, key: &str) -> Option<f64> {
 /// `simulate` of the offset example with one line replaced: exit 2, one line holding
 /// every one of `expect`, no data written.
 fn refused(name: &str, from: &str, to: &str, expect: &[&str]) {
-    let (o, out) = simulate_text(
+    common::refused_text(
         "jitterid-offset-door",
         name,
         &example_with("offset.toml", from, to),
+        expect,
     );
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
-    assert!(!out.exists(), "{name}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
-    for e in expect {
-        assert!(err.contains(e), "{name}: expected {e:?} in {err}");
-    }
 }
 
 #[test]

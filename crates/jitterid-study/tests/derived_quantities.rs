@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::plan;
+use common::{plan, table2};
 use jitterid::estimate::ml::delta_method_std;
 use jitterid::rand::rngs::StdRng;
 use jitterid::rand::{Rng, SeedableRng};
@@ -13,33 +13,6 @@ use jitterid_study::design::{derived_std, derived_stds, design, predict, Derived
 use jitterid_study::experiment::{self, DesignEstimator, Experiment, Purpose};
 use std::f64::consts::TAU;
 use std::path::Path;
-
-/// The Table 2 setup, `G = k (s − z)/((s − re)² + im²)`, with `extra` appended.
-fn table2(extra: &str) -> String {
-    format!(
-        r#"
-[sampling]
-interval = 1.0
-samples = 200
-[input]
-kind = "random-binary"
-mean_dwell = 8.0
-[system]
-kind = "zpk"
-gain = 0.2
-zeros = [-0.5]
-poles = [[-0.25, 0.3]]
-estimate = true
-[jitter]
-family = "uniform-sum"
-n = 2
-a = 0.28867513459481287
-[noise]
-std = 0.01
-{extra}
-"#
-    )
-}
 
 fn parse(text: &str) -> Experiment {
     experiment::parse("exp.toml", text, Path::new("."), Purpose::Simulate).unwrap()

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::plan;
+use common::{plan, table2};
 use faer::linalg::solvers::DenseSolveCore;
 use jitterid::estimate::ml::delta_method_std;
 use jitterid::signal::Signal;
@@ -28,36 +28,6 @@ fn example(file: &str) -> Experiment {
 fn parse(text: &str) -> Result<Experiment, String> {
     experiment::parse("exp.toml", text, Path::new("."), Purpose::Simulate)
         .map_err(|e| e.to_string())
-}
-
-/// The Table 2 setup (as `examples/experiments/table2.toml`), with `extra` appended.
-fn table2(extra: &str) -> String {
-    format!(
-        r#"
-[sampling]
-interval = 1.0
-samples = 200
-[input]
-kind = "random-binary"
-mean_dwell = 8.0
-low = 0.0
-high = 1.0
-[system]
-kind = "zpk"
-gain = 0.2
-zeros = [-0.5]
-poles = [[-0.25, 0.3]]
-estimate = true
-[jitter]
-family = "uniform-sum"
-n = 2
-a = 0.28867513459481287
-estimate = false
-[noise]
-std = 0.01
-{extra}
-"#
-    )
 }
 
 /// The predicted BCLS standard deviations of the Table 2 setup agree with a Monte Carlo of 64
@@ -355,9 +325,10 @@ fn infeasible_designs_are_refused_naming_the_key() {
         assert!(e.contains(want), "{section}: {e}");
     }
     // A dwell range needs a random binary input.
-    let sine = table2("[design]\nmean_dwell = [1.0, 2.0]").replace(
-        "kind = \"random-binary\"\nmean_dwell = 8.0\nlow = 0.0\nhigh = 1.0",
+    let sine = common::setup(
+        200,
         "kind = \"sine\"\nfrequency = 0.05\namplitude = 1.0",
+        "[design]\nmean_dwell = [1.0, 2.0]",
     );
     let e = parse(&sine).unwrap_err();
     assert!(

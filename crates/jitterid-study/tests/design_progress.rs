@@ -4,39 +4,17 @@
 
 mod common;
 
-use common::plan as read_plan;
+use common::{plan as read_plan, setup, RANDOM_BINARY};
 use jitterid_study::design::{design, jitter_blind, DesignObserver, DesignProgress};
 use std::sync::{Arc, Mutex};
 
 /// The Table 2 setup, shortened, with a cheap robust dwell search.
 fn table2_robust() -> String {
-    r#"
-[sampling]
-interval = 1.0
-samples = 100
-[input]
-kind = "random-binary"
-mean_dwell = 8.0
-[system]
-kind = "zpk"
-gain = 0.2
-zeros = [-0.5]
-poles = [[-0.25, 0.3]]
-estimate = true
-[jitter]
-family = "uniform-sum"
-n = 2
-a = 0.28867513459481287
-[noise]
-std = 0.01
-[design]
-mean_dwell = [2.0, 20.0]
-draws = 2
-grid = 3
-prior_spread = 0.05
-prior_draws = 2
-"#
-    .to_string()
+    setup(
+        100,
+        RANDOM_BINARY,
+        "[design]\nmean_dwell = [2.0, 20.0]\ndraws = 2\ngrid = 3\nprior_spread = 0.05\nprior_draws = 2",
+    )
 }
 
 /// The events of one run, recorded in order.
@@ -110,31 +88,12 @@ fn the_observer_sees_every_evaluation_and_changes_nothing() {
 /// with the observer is the report without it.
 #[test]
 fn a_multisine_search_reports_every_evaluation() {
-    let text = r#"
-[sampling]
-interval = 1.0
-samples = 100
-[input]
-kind = "multisine"
-frequencies = [0.03, 0.1, 0.3]
-amplitudes = [0.3, 0.3, 0.3]
-[system]
-kind = "zpk"
-gain = 0.2
-zeros = [-0.5]
-poles = [[-0.25, 0.3]]
-estimate = true
-[jitter]
-family = "uniform-sum"
-n = 2
-a = 0.28867513459481287
-[noise]
-std = 0.01
-[design]
-band = [0.01, 0.4]
-tones = 3
-"#;
-    let plan = read_plan(text).unwrap();
+    let text = setup(
+        100,
+        "kind = \"multisine\"\nfrequencies = [0.03, 0.1, 0.3]\namplitudes = [0.3, 0.3, 0.3]",
+        "[design]\nband = [0.01, 0.4]\ntones = 3",
+    );
+    let plan = read_plan(&text).unwrap();
     let quiet = design(&plan, None).unwrap();
     let (observer, seen) = recorder();
     let watched = design(&plan.with_observer(observer), None).unwrap();

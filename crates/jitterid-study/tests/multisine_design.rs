@@ -15,31 +15,10 @@ use std::path::Path;
 /// A second-order system (Table 2's, `N = 100`) driven by a three-tone multisine with zero
 /// phases, with `design` as its `[design]` section.
 fn setup(design: &str) -> String {
-    format!(
-        r#"
-[sampling]
-interval = 1.0
-samples = 100
-[input]
-kind = "multisine"
-frequencies = [0.03, 0.1, 0.3]
-amplitudes = [0.3, 0.3, 0.3]
-[system]
-kind = "zpk"
-gain = 0.2
-zeros = [-0.5]
-poles = [[-0.25, 0.3]]
-estimate = true
-[jitter]
-family = "uniform-sum"
-n = 2
-a = 0.28867513459481287
-estimate = false
-[noise]
-std = 0.01
-[design]
-{design}
-"#
+    common::setup(
+        100,
+        "kind = \"multisine\"\nfrequencies = [0.03, 0.1, 0.3]\namplitudes = [0.3, 0.3, 0.3]",
+        &format!("[design]\n{design}"),
     )
 }
 

@@ -114,3 +114,34 @@ pub fn param(fit: &serde_json::Value, name: &str) -> (f64, f64) {
         p["stderr"].as_f64().unwrap_or(f64::NAN),
     )
 }
+
+/// Simulates run `run_no` of the experiment file `exp` into `dir` (`d.csv`, with its side
+/// files) and fits it with the arguments `extra` added: the fit's JSON.
+pub fn simulate_and_fit_in(
+    dir: &Path,
+    exp: &str,
+    run_no: &str,
+    extra: &[&str],
+) -> serde_json::Value {
+    let data = dir.join("d.csv");
+    let o = run(&["simulate", exp, "--run", run_no, "--out", s(&data)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut args = vec!["fit", exp, "--data", s(&data), "--json"];
+    args.extend(extra);
+    let o = run(&args);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    serde_json::from_str(&stdout(&o)).unwrap()
+}
+
+/// `simulate` of the experiment `text` (in scratch directory `name` of `group`): exit 2, one
+/// line holding every one of `expect`, no data written.
+pub fn refused_text(group: &str, name: &str, text: &str, expect: &[&str]) {
+    let (o, out) = simulate_text(group, name, text);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+    assert!(!out.exists(), "{name}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+    for e in expect {
+        assert!(err.contains(e), "{name}: expected {e:?} in {err}");
+    }
+}
