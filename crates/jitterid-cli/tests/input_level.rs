@@ -103,21 +103,14 @@ fn select_carries_the_level_into_every_candidate() {
         "[input]\nlevel = 0.3\nestimate_level = true\n",
         1,
     );
-    let exp = dir.join("e.toml");
-    std::fs::write(&exp, format!("{text}\n[select]\npoles = [1, 2]\n")).unwrap();
-    let data = dir.join("d.csv");
-    let o = run(&["simulate", s(&exp), "--run", "4", "--out", s(&data)]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = run(&["select", s(&exp), "--data", s(&data), "--json"]);
-    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
-    let sel: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let sel = common::select_poles_1_to_2(&dir, &text, "4");
     let best = &sel["best"];
     assert_eq!(
         (best["poles"].as_u64(), best["zeros"].as_u64()),
         (Some(2), Some(1)),
         "{best}"
     );
-    let fit = simulate_and_fit(&dir, s(&exp), "4", &[]);
+    let fit = simulate_and_fit(&dir, s(&dir.join("e.toml")), "4", &[]);
     let (_, se) = param(&fit, "level");
     let u0 = best["estimates"]["level"].as_f64().unwrap();
     assert!((u0 - 0.3).abs() < 4.0 * se, "level {u0} ± {se}");

@@ -232,14 +232,7 @@ fn init_auto_starts_the_offset_from_the_record() {
 fn select_carries_the_offset_into_every_candidate() {
     let dir = scratch_in("jitterid-offset", "select");
     let text = std::fs::read_to_string(example("offset.toml")).unwrap();
-    let exp = dir.join("e.toml");
-    std::fs::write(&exp, format!("{text}\n[select]\npoles = [1, 2]\n")).unwrap();
-    let data = dir.join("d.csv");
-    let o = run(&["simulate", s(&exp), "--run", "4", "--out", s(&data)]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = run(&["select", s(&exp), "--data", s(&data), "--json"]);
-    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
-    let sel: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let sel = common::select_poles_1_to_2(&dir, &text, "4");
     let best = &sel["best"];
     assert_eq!(
         (best["poles"].as_u64(), best["zeros"].as_u64()),

@@ -121,6 +121,33 @@ impl Template {
     }
 }
 
+/// `input` as the rational part of the system in `spec` sees it, what the initializer fits a
+/// response to: around the input's level (`u − u₀` over its span, the file's `u₀`, the start of
+/// an estimated one), then delayed by the system's delay, so that the rational model does not
+/// carry the delay's phase a second time. `file` and `at` (the system's section) name the keys
+/// in messages.
+///
+/// # Errors
+///
+/// A level or delay the input cannot take (a tone input's delay).
+pub(crate) fn driven_input(
+    input: &Input,
+    spec: &SpecTable,
+    file: &str,
+    at: &str,
+) -> StudyResult<Input> {
+    let around = match spec.get("level").and_then(Value::as_f64) {
+        Some(u0) => input
+            .deviation(u0)
+            .map_err(|e| study_err!("{file}: [input] level: {e}"))?,
+        None => input.clone(),
+    };
+    match spec.get("delay").and_then(Value::as_f64) {
+        Some(d) if d > 0.0 => around.delayed(d).map_err(|e| study_err!("{at} delay: {e}")),
+        _ => Ok(around),
+    }
+}
+
 /// The multi-input system `signal` (a `superposition`) with each estimated channel's model
 /// replaced by the multi-input initializer's ([`fit_channels`], the jitter's damping
 /// compensated with the experiment's jitter) on the record `y` less the fixed channels'
@@ -171,13 +198,7 @@ pub(crate) fn channels_start(
         }
         let kind = c.get("kind").and_then(Value::as_str).unwrap_or("");
         let template = Template::of(kind, &c, &at)?;
-        let around = crate::select::around_level(input, &c, &exp.file)?;
-        let driven = match c.get("delay").and_then(Value::as_f64) {
-            Some(d) if d > 0.0 => around
-                .delayed(d)
-                .map_err(|e| study_err!("{at} delay: {e}"))?,
-            _ => around,
-        };
+        let driven = driven_input(input, &c, &exp.file, &at)?;
         free.push((i, template, driven));
     }
     let record = fit::record(&exp.grid, rest).map_err(|e| study_err!("{data}: {e}"))?;

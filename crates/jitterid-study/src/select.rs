@@ -10,7 +10,7 @@
 use crate::error::StudyResult;
 use crate::experiment::Experiment;
 use crate::fit;
-use crate::rational_start::Template;
+use crate::rational_start::{driven_input, Template};
 use crate::records::{read_data, read_input};
 use crate::study_err;
 use jitterid::estimate::selection::{
@@ -244,21 +244,6 @@ impl InitChoice {
     }
 }
 
-/// `input` around the level of the system's spec table `spec` (`u − u₀` over its span), or
-/// `input` itself without a level: what the initializer fits a response to.
-pub(crate) fn around_level(
-    input: &Input,
-    spec: &jitterid::signal::registry::SpecTable,
-    file: &str,
-) -> StudyResult<Input> {
-    match spec.get("level").and_then(Value::as_f64) {
-        Some(u0) => input
-            .deviation(u0)
-            .map_err(|e| study_err!("{file}: [input] level: {e}")),
-        None => Ok(input.clone()),
-    }
-}
-
 /// `input` delayed by `delay` seconds: what drives the rational part of a system with an input
 /// delay. The initializer fits the frequency response from this input to the output, so that
 /// the rational model it returns does not carry the delay's phase a second time.
@@ -301,11 +286,7 @@ pub fn auto_start(
         offset: spec.get("estimate_offset") == Some(&Value::Bool(true)),
         ..InitOptions::default()
     };
-    // The initializer fits the response to the input as the system sees it: around its
-    // level (the file's, the start of an estimated one), delayed.
-    let around = around_level(input, &spec, &exp.file)?;
-    let driven = delayed_input(&around, spec.get("delay").and_then(Value::as_f64))
-        .map_err(|e| study_err!("{}: [system] delay: {e}", exp.file))?;
+    let driven = driven_input(input, &spec, &exp.file, &format!("{}: [system]", exp.file))?;
     let template = Template::of(signal.kind(), &spec, &format!("{}: [system]", exp.file))?;
     let (zeros, poles) = template.orders();
     let g = fit_rational(&record, &driven, Some(jitter), zeros, poles, &opts)

@@ -145,3 +145,16 @@ pub fn refused_text(group: &str, name: &str, text: &str, expect: &[&str]) {
         assert!(err.contains(e), "{name}: expected {e:?} in {err}");
     }
 }
+
+/// `select` on run `run_no` of the experiment `text` with `[select] poles = [1, 2]` appended,
+/// written to `dir` (`e.toml`, the record `d.csv`): the selection's JSON.
+pub fn select_poles_1_to_2(dir: &Path, text: &str, run_no: &str) -> serde_json::Value {
+    let exp = dir.join("e.toml");
+    std::fs::write(&exp, format!("{text}\n[select]\npoles = [1, 2]\n")).unwrap();
+    let data = dir.join("d.csv");
+    let o = run(&["simulate", s(&exp), "--run", run_no, "--out", s(&data)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["select", s(&exp), "--data", s(&data), "--json"]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    serde_json::from_str(&stdout(&o)).unwrap()
+}

@@ -41,10 +41,10 @@ pub(super) fn level_keys(
     let multi = system.kind.get(KIND_KEY) == Some(&Value::from(SUPERPOSITION_KIND));
     let shared = system.kind.get("shared") == Some(&Value::Bool(true));
     let offset_estimated = system.kind.get("estimate_offset") == Some(&Value::Bool(true));
-    let mut constants: Vec<(String, &'static str)> = Vec::new();
-    if offset_estimated {
-        constants.push(("the output offset".into(), "[output] estimate_offset"));
-    }
+    // The constant in the output estimated so far (what a further one would be confounded
+    // with), and the key that asked for it.
+    let mut constant: Option<(String, &'static str)> =
+        offset_estimated.then(|| ("the output offset".into(), "[output] estimate_offset"));
     for (index, raw) in inputs.iter().enumerate() {
         if raw.level.is_none() && raw.estimate_level.is_none() {
             continue;
@@ -105,12 +105,12 @@ pub(super) fn level_keys(
             return Err(refuse(cx, &level, key, format!("input \"{name}\" is a sine or multisine, on at all times, and the system has an integrator: its steady-state response to a constant level is unbounded; remove the level or use an input made of steps")));
         }
         if level.estimated && model.rational().settles() {
-            if let Some((other, other_key)) = constants.first() {
+            if let Some((other, other_key)) = &constant {
                 return Err(refuse(cx, &level, "estimate_level", format!(
                     "input \"{name}\"'s level is confounded with {other} ({other_key}): the system's step response settles to G(0), so the level moves the output by the constant −G(0)·u₀, as {other} does; estimate one of them and give the other as known (a level is estimated on its own with an integrator, whose response to it is a ramp)"
                 )));
             }
-            constants.push((
+            constant = Some((
                 format!("input \"{name}\"'s level"),
                 "[input] estimate_level",
             ));
