@@ -7,18 +7,34 @@
 //! under an amplitude constraint alone. Without jitter the information would be linear in `w`
 //! and the classical multiplicative algorithms would apply; with jitter the noise after every
 //! slope (`σ_τ² s′(t)²`) makes it nonlinear, so every candidate is judged by the exact
-//! prediction ([`evaluate`]). `w` is the softmax of unconstrained coordinates `x`
-//! (`wᵢ = e^{xᵢ} / Σ e^{xⱼ}`, `x₀ = 0`), which keeps it on the simplex and positive, and the
-//! criterion is minimised over `x` by the solvers' BFGS ([`Bfgs`], which takes an infeasible
-//! candidate as `+∞`) from the flat spectrum, with central differences whose components are
-//! evaluated in parallel: a deterministic descent that accepts only steps that lower the
-//! criterion.
+//! prediction ([`evaluate`]). On a support `S` of the tones, `w` is parametrised by the
+//! squares of unconstrained coordinates (`wᵢ = zᵢ² / Σ_{j∈S} zⱼ²` for `i ∈ S`, 0 elsewhere),
+//! which keeps it on the simplex and lets a share reach exactly 0 at a regular point (a
+//! softmax only approaches a face of the simplex asymptotically, and the best designs lie on
+//! faces: most tones get no power). The criterion is minimised over `z` by the solvers' BFGS
+//! ([`Bfgs`], which takes an infeasible candidate as `+∞`) from the flat spectrum, with central
+//! differences whose components are evaluated in parallel: a deterministic descent that
+//! accepts only steps that lower the criterion.
+//!
+//! A tone whose share reaches 0 cannot come back by the gradient (`∂w/∂zᵢ = 0` at `zᵢ = 0`),
+//! and a tone the descent leaves a little power may be better without any, so an exchange
+//! step follows (the vertex exchange of classical optimal design): the support is changed by
+//! dropping a tone (its power shared out over the rest) or adding one (a share of
+//! [`ADD_SHARE`] moved to it), whichever change lowers the criterion most, and the descent is
+//! run again on the new support, until no single change lowers it.
+//!
+//! Where the descent starts matters (the criterion under jitter is not convex in the shares):
+//! it starts from the flat spectrum and from the jitter-blind design's shares (cheap to find:
+//! its information has no jitter noise), and the better end is kept.
 //!
 //! During the descent the phases are Schroeder's for the current `w` (a smooth function of
-//! it, so the differences are smooth); at the end the clipping algorithm lowers the crest
-//! factor ([`low_crest_phases`]) and the result is evaluated again. The file's own multisine,
-//! when it meets the constraint, is a candidate beside it, so the result is never worse than
-//! the baseline it is compared with.
+//! it, so the differences are smooth). At the end the phases are chosen as `[design] phases`
+//! says: for the criterion (the default), BFGS on the phases of the tones with power from the
+//! better of Schroeder's and the clipping algorithm's low-crest phases ([`low_crest_phases`]),
+//! a phase set that breaks a peak bound being infeasible; or for the lowest crest factor
+//! alone (`"crest"`). Tones left without power are not part of the design. The file's own
+//! multisine, when it meets the constraint, is a candidate beside the result, so the result
+//! is never worse than the baseline it is compared with.
 
 use super::blind::evaluate;
 use super::candidate::Design;
@@ -28,7 +44,7 @@ use super::predict::Prediction;
 use super::progress::DesignProgress;
 use super::search::Optimum;
 use crate::error::StudyResult;
-use crate::experiment::{harmonics_in, DesignCriterion, ToneDesignSpec};
+use crate::experiment::{harmonics_in, DesignCriterion, PhaseChoice, ToneDesignSpec};
 use crate::study_err;
 use jitterid::estimate::solver::{Bfgs, Objective, Solver};
 use jitterid::signal::Tone;
@@ -39,10 +55,40 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// BFGS iterations on the power distribution.
 const ITERATIONS: u64 = 40;
 
-/// Step in `xᵢ = log wᵢ + const` of the central differences: large enough that a criterion
-/// computed by quadrature (exact ML's Fisher information) does not turn the gradient into
-/// noise, small enough that the differences' own error (second order) is negligible.
+/// Step in the coordinates `zᵢ` (about `√wᵢ`, so of order `1/√tones`) of the central
+/// differences: large enough that a criterion computed by quadrature (exact ML's Fisher
+/// information) does not turn the gradient into noise, small enough that the differences' own
+/// error (second order) is negligible.
 const DIFFERENCE: f64 = 1e-3;
+
+/// The share a tone outside the support is given when the exchange step tries adding it
+/// (the others scaled down to make room): large enough that the criterion's change is far
+/// above the prediction's rounding, small enough to say where the criterion goes from the
+/// face.
+const ADD_SHARE: f64 = 0.02;
+
+/// A share below which a tone is dropped at the end when that costs nothing (`1e-6` of the
+/// power is an amplitude `10⁻³` of the others').
+const NEGLIGIBLE_SHARE: f64 = 1e-6;
+
+/// Rounds of the exchange step per candidate tone, at most.
+const EXCHANGES: usize = 2;
+
+/// BFGS iterations of a scouting descent (one that the exchange step may follow).
+const SCOUT_ITERATIONS: u64 = 8;
+
+/// How far a descent goes.
+#[derive(Debug, Clone, Copy)]
+enum Depth {
+    /// [`SCOUT_ITERATIONS`], no restarts: enough to say which tones matter.
+    Scout,
+    /// [`ITERATIONS`] and [`RESTARTS`]: the shares on a settled support.
+    Full,
+}
+
+/// BFGS iterations on the phases (a multimodal function of them: a local descent from good
+/// phases, not a global search).
+const PHASE_ITERATIONS: u64 = 20;
 
 /// BFGS restarts from its own result (a fresh inverse Hessian), while a restart still lowers
 /// the criterion: a quasi-Newton run can stall on a stale curvature estimate.
@@ -78,6 +124,21 @@ impl MultisineDesign {
             phases: tones.iter().map(|t| t.phase).collect(),
             crest_factor: if r > 0.0 { peak(tones, span) / r } else { 0.0 },
             power: r * r,
+        }
+    }
+
+    /// The same multisine without its tones of amplitude 0 (they add nothing to the signal,
+    /// and a signal generator need not be told of them).
+    pub fn without_silent_tones(&self) -> Self {
+        let keep: Vec<usize> = (0..self.amplitudes.len())
+            .filter(|&i| self.amplitudes[i] != 0.0)
+            .collect();
+        let pick = |xs: &[f64]| keep.iter().map(|&i| xs[i]).collect();
+        MultisineDesign {
+            frequencies: pick(&self.frequencies),
+            amplitudes: pick(&self.amplitudes),
+            phases: pick(&self.phases),
+            ..self.clone()
         }
     }
 
@@ -183,23 +244,27 @@ fn value_at(
     (!v.is_nan() && v < f64::INFINITY).then_some((d, v, p))
 }
 
-/// The power shares of coordinates `x`: the softmax of `(0, x₁, …)`.
-fn shares(x: &[f64]) -> Vec<f64> {
-    let top = x.iter().copied().fold(0.0, f64::max);
-    let e: Vec<f64> = std::iter::once(0.0)
-        .chain(x.iter().copied())
-        .map(|xi| (xi - top).exp())
-        .collect();
-    let sum: f64 = e.iter().sum();
-    e.iter().map(|ei| ei / sum).collect()
+/// The power shares of coordinates `z` on `support` (`n` tones in all): `zᵢ² / Σ zⱼ²` on the
+/// support, 0 elsewhere; `None` when every coordinate is 0.
+fn shares(n: usize, support: &[usize], z: &[f64]) -> Option<Vec<f64>> {
+    let sum: f64 = z.iter().map(|zi| zi * zi).sum();
+    if !(sum > 0.0 && sum.is_finite()) {
+        return None;
+    }
+    let mut w = vec![0.0; n];
+    for (&i, zi) in support.iter().zip(z) {
+        w[i] = zi * zi / sum;
+    }
+    Some(w)
 }
 
-/// The criterion as a function of the softmax coordinates of the power shares.
+/// The criterion as a function of the coordinates of the power shares on a support.
 struct Shares<'s, 'a> {
     plan: &'s Plan,
     criterion: &'s DesignCriterion,
     tones: &'s Tones<'a>,
     evaluations: &'s Evaluations<'s>,
+    support: &'s [usize],
 }
 
 /// The designs the search has evaluated, each reported to the plan's observer as it starts
@@ -224,37 +289,327 @@ impl Evaluations<'_> {
 
 impl Objective for Shares<'_, '_> {
     fn num_params(&self) -> usize {
-        self.tones.k.len() - 1
+        self.support.len()
     }
 
-    fn cost(&self, x: &[f64]) -> f64 {
+    fn cost(&self, z: &[f64]) -> f64 {
         self.evaluations.tick();
-        value_at(self.plan, self.criterion, self.tones, &shares(x), None)
+        shares(self.tones.k.len(), self.support, z)
+            .and_then(|w| value_at(self.plan, self.criterion, self.tones, &w, None))
             .map_or(f64::INFINITY, |c| c.1)
     }
 
-    /// Central differences, the components in parallel (one-sided beside an infeasible
-    /// point).
-    fn cost_gradient(&self, x: &[f64]) -> (f64, Vec<f64>) {
-        let f = self.cost(x);
-        let g = (0..x.len())
-            .into_par_iter()
-            .map(|j| {
-                let at = |h: f64| {
-                    let mut y = x.to_vec();
-                    y[j] += h;
-                    self.cost(&y)
-                };
-                let (up, down) = (at(DIFFERENCE), at(-DIFFERENCE));
-                match (up.is_finite(), down.is_finite()) {
-                    (true, true) => (up - down) / (2.0 * DIFFERENCE),
-                    (true, false) => (up - f) / DIFFERENCE,
-                    (false, true) => (f - down) / DIFFERENCE,
-                    (false, false) => 0.0,
+    fn cost_gradient(&self, z: &[f64]) -> (f64, Vec<f64>) {
+        central_differences(self, z)
+    }
+}
+
+/// The cost and its central differences at `x`, the components in parallel (one-sided beside
+/// an infeasible point).
+fn central_differences<O: Objective + Sync + ?Sized>(objective: &O, x: &[f64]) -> (f64, Vec<f64>) {
+    let f = objective.cost(x);
+    let g = (0..x.len())
+        .into_par_iter()
+        .map(|j| {
+            let at = |h: f64| {
+                let mut y = x.to_vec();
+                y[j] += h;
+                objective.cost(&y)
+            };
+            let (up, down) = (at(DIFFERENCE), at(-DIFFERENCE));
+            match (up.is_finite(), down.is_finite()) {
+                (true, true) => (up - down) / (2.0 * DIFFERENCE),
+                (true, false) => (up - f) / DIFFERENCE,
+                (false, true) => (f - down) / DIFFERENCE,
+                (false, false) => 0.0,
+            }
+        })
+        .collect();
+    (f, g)
+}
+
+/// The criterion as a function of the phases of the tones with power, at fixed shares.
+struct PhaseObjective<'s, 'a> {
+    plan: &'s Plan,
+    criterion: &'s DesignCriterion,
+    tones: &'s Tones<'a>,
+    evaluations: &'s Evaluations<'s>,
+    w: &'s [f64],
+    support: &'s [usize],
+    /// The phases of the tones without power (they do not change the signal).
+    rest: &'s [f64],
+}
+
+impl PhaseObjective<'_, '_> {
+    fn phases(&self, phi: &[f64]) -> Vec<f64> {
+        let mut all = self.rest.to_vec();
+        for (&i, &p) in self.support.iter().zip(phi) {
+            all[i] = p;
+        }
+        all
+    }
+
+    fn candidate(&self, phi: &[f64]) -> Option<Candidate> {
+        value_at(
+            self.plan,
+            self.criterion,
+            self.tones,
+            self.w,
+            Some(&self.phases(phi)),
+        )
+    }
+}
+
+impl Objective for PhaseObjective<'_, '_> {
+    fn num_params(&self) -> usize {
+        self.support.len()
+    }
+
+    fn cost(&self, phi: &[f64]) -> f64 {
+        self.evaluations.tick();
+        self.candidate(phi).map_or(f64::INFINITY, |c| c.1)
+    }
+
+    fn cost_gradient(&self, phi: &[f64]) -> (f64, Vec<f64>) {
+        central_differences(self, phi)
+    }
+}
+
+/// The phases at shares `w`, chosen as `spec.phases` says, and the design they make:
+/// for the criterion, BFGS on the phases of the tones with power from the better of the
+/// search's phases (`searched`, evaluated) and the low-crest phases, under the constraint
+/// (a phase set that breaks a peak bound is infeasible); for the crest factor, the low-crest
+/// phases (the search's, when those break the bound).
+fn choose_phases(
+    plan: &Plan,
+    criterion: &DesignCriterion,
+    tones: &Tones,
+    evaluations: &Evaluations,
+    w: &[f64],
+    searched: Candidate,
+) -> Candidate {
+    let amplitudes: Vec<f64> = w.iter().map(|wi| wi.sqrt()).collect();
+    let crest = low_crest_phases(&tones.k, &amplitudes);
+    evaluations.tick();
+    let low_crest = value_at(plan, criterion, tones, w, Some(&crest));
+    if tones.spec.phases == PhaseChoice::Crest {
+        return low_crest.unwrap_or(searched);
+    }
+    let start = match low_crest {
+        Some(c) if c.1 < searched.1 => c,
+        _ => searched,
+    };
+    let Some(m) = &start.0.multisine else {
+        return start;
+    };
+    let rest = m.phases.clone();
+    let support: Vec<usize> = (0..w.len()).filter(|&i| w[i] > 0.0).collect();
+    let phi: Vec<f64> = support.iter().map(|&i| rest[i]).collect();
+    let objective = PhaseObjective {
+        plan,
+        criterion,
+        tones,
+        evaluations,
+        w,
+        support: &support,
+        rest: &rest,
+    };
+    let bfgs = Bfgs {
+        max_iters: PHASE_ITERATIONS,
+        decrement_tol: DECREMENT,
+        initial_step: 0.5,
+        ..Bfgs::default()
+    };
+    // A descent that fails, or ends no lower, leaves the start.
+    match bfgs.minimize(&objective as &dyn Objective, &phi) {
+        Ok(r) => match objective.candidate(&r.params) {
+            Some(c) if c.1 < start.1 => c,
+            _ => start,
+        },
+        Err(_) => start,
+    }
+}
+
+/// The power shares of the jitter-blind design on the same tones (its amplitudes squared,
+/// normalised), or `None` when that search fails or settles on other tones (the file's own
+/// multisine).
+fn blind_shares(
+    plan: &Plan,
+    criterion: &DesignCriterion,
+    spec: &ToneDesignSpec,
+    tones: &Tones,
+) -> Option<Vec<f64>> {
+    let blind = plan.jitter_blind().ok()?;
+    let m = optimise_tones(&blind, criterion, spec)
+        .ok()?
+        .design
+        .multisine?;
+    let total: f64 = m.amplitudes.iter().map(|a| a * a).sum();
+    if !(total > 0.0) {
+        return None;
+    }
+    let mut w = vec![0.0; tones.k.len()];
+    for (f, a) in m.frequencies.iter().zip(&m.amplitudes) {
+        let i = tones
+            .k
+            .iter()
+            .position(|&k| (f - k as f64 * tones.f0).abs() <= 1e-9 * f.abs())?;
+        w[i] = a * a / total;
+    }
+    Some(w)
+}
+
+/// The descent on the power shares and the exchange of tones around it: the best design so
+/// far (`best`, evaluated) and its shares (`w`).
+struct Descent<'s, 'a> {
+    plan: &'s Plan,
+    criterion: &'s DesignCriterion,
+    tones: &'s Tones<'a>,
+    evaluations: &'s Evaluations<'s>,
+    best: Candidate,
+    w: Vec<f64>,
+}
+
+impl Descent<'_, '_> {
+    /// BFGS on the shares of `support` from the current `w` (restarted from its own result
+    /// while a restart still lowers the criterion); keeps any point that lowers it.
+    fn descend(&mut self, support: &[usize], depth: Depth) {
+        if support.len() < 2 {
+            return;
+        }
+        let objective = Shares {
+            plan: self.plan,
+            criterion: self.criterion,
+            tones: self.tones,
+            evaluations: self.evaluations,
+            support,
+        };
+        let (iterations, restarts) = match depth {
+            Depth::Scout => (SCOUT_ITERATIONS, 0),
+            Depth::Full => (ITERATIONS, RESTARTS),
+        };
+        let bfgs = Bfgs {
+            max_iters: iterations,
+            decrement_tol: DECREMENT,
+            initial_step: 0.5,
+            ..Bfgs::default()
+        };
+        let n = self.tones.k.len();
+        let mut z: Vec<f64> = support.iter().map(|&i| self.w[i].sqrt()).collect();
+        for _ in 0..=restarts {
+            // A descent that fails leaves the best point so far, which is already evaluated.
+            let Ok(r) = bfgs.minimize(&objective as &dyn Objective, &z) else {
+                break;
+            };
+            let Some(moved) = shares(n, support, &r.params) else {
+                break;
+            };
+            match value_at(self.plan, self.criterion, self.tones, &moved, None) {
+                Some(c) if c.1 < self.best.1 - DECREMENT => {
+                    self.w = moved;
+                    self.best = c;
+                    z = r.params;
+                }
+                _ => break,
+            }
+        }
+    }
+
+    /// The exchange step (see the module docs): while dropping or adding one tone lowers the
+    /// criterion, make the change that lowers it most and descend again on the new support.
+    /// `support` becomes the tones with power.
+    fn exchange(&mut self, support: &mut Vec<usize>, depth: Depth) {
+        let n = self.tones.k.len();
+        // A tone the descent left without power is outside the support.
+        support.retain(|&i| self.w[i] > 0.0);
+        // Each accepted change lowers the criterion, so a support never returns; the bound
+        // only caps the work on a criterion that keeps finding tiny improvements.
+        for _ in 0..EXCHANGES * n {
+            let mut moves: Vec<(Vec<usize>, Vec<f64>)> = Vec::new();
+            if support.len() > 1 {
+                for &j in support.iter() {
+                    let rest = 1.0 - self.w[j];
+                    if !(rest > 0.0) {
+                        continue;
+                    }
+                    let w: Vec<f64> = (0..n)
+                        .map(|i| if i == j { 0.0 } else { self.w[i] / rest })
+                        .collect();
+                    let s: Vec<usize> = support.iter().copied().filter(|&i| i != j).collect();
+                    moves.push((s, w));
+                }
+            }
+            for j in (0..n).filter(|j| !support.contains(j)) {
+                let mut w: Vec<f64> = self.w.iter().map(|wi| wi * (1.0 - ADD_SHARE)).collect();
+                w[j] = ADD_SHARE;
+                let mut s = support.clone();
+                s.push(j);
+                s.sort_unstable();
+                moves.push((s, w));
+            }
+            let values: Vec<Option<Candidate>> = moves
+                .par_iter()
+                .map(|(_, w)| {
+                    self.evaluations.tick();
+                    value_at(self.plan, self.criterion, self.tones, w, None)
+                })
+                .collect();
+            // The change that lowers the criterion most (ties to the first: deterministic).
+            let mut chosen: Option<(usize, Candidate)> = None;
+            for (m, c) in values.into_iter().enumerate() {
+                let Some(c) = c else { continue };
+                let bar = chosen.as_ref().map_or(self.best.1 - DECREMENT, |b| b.1 .1);
+                if c.1 < bar {
+                    chosen = Some((m, c));
+                }
+            }
+            let Some((m, c)) = chosen else {
+                break;
+            };
+            let (s, w) = moves.swap_remove(m);
+            *support = s;
+            self.w = w;
+            self.best = c;
+            self.descend(support, depth);
+            support.retain(|&i| self.w[i] > 0.0);
+        }
+        self.prune(support);
+    }
+
+    /// Tones the descent left a share below [`NEGLIGIBLE_SHARE`] get none, when that does not
+    /// raise the criterion by more than the descent's own resolution: a designed multisine
+    /// does not carry tones at amplitudes no generator would reproduce.
+    fn prune(&mut self, support: &mut Vec<usize>) {
+        let small: Vec<usize> = support
+            .iter()
+            .copied()
+            .filter(|&i| self.w[i] < NEGLIGIBLE_SHARE)
+            .collect();
+        let rest: f64 = support
+            .iter()
+            .filter(|i| !small.contains(i))
+            .map(|&i| self.w[i])
+            .sum();
+        if small.is_empty() || !(rest > 0.0) {
+            return;
+        }
+        let w: Vec<f64> = (0..self.w.len())
+            .map(|i| {
+                if small.contains(&i) {
+                    0.0
+                } else {
+                    self.w[i] / rest
                 }
             })
             .collect();
-        (f, g)
+        self.evaluations.tick();
+        if let Some(c) = value_at(self.plan, self.criterion, self.tones, &w, None) {
+            if c.1 <= self.best.1 + DECREMENT {
+                support.retain(|i| !small.contains(i));
+                self.w = w;
+                self.best = c;
+            }
+        }
     }
 }
 
@@ -300,45 +655,48 @@ pub(crate) fn optimise_tones(
         count: AtomicUsize::new(0),
     };
     evaluations.tick();
-    let mut best: Candidate = (tones.design(flat), v, p);
-    let mut w = flat_shares;
-    if n > 1 {
-        let objective = Shares {
+    // Where the descent starts: the flat spectrum, and the design of a user who ignores the
+    // jitter (cheap: its information has no jitter noise), whose support the jitter-aware
+    // criterion often keeps. The criterion under jitter is not convex in the shares, so each
+    // start is descended and exchanged and the best result is kept (ties to the first:
+    // deterministic).
+    let mut starts = vec![(flat_shares, (tones.design(flat), v, p))];
+    if !plan.is_jitter_blind() {
+        if let Some(w) = blind_shares(plan, criterion, spec, &tones) {
+            evaluations.tick();
+            if let Some(c) = value_at(plan, criterion, &tones, &w, None) {
+                starts.push((w, c));
+            }
+        }
+    }
+    let mut results = Vec::with_capacity(starts.len());
+    for (w, c) in starts {
+        let mut support: Vec<usize> = (0..n).filter(|&i| w[i] > 0.0).collect();
+        let mut search = Descent {
             plan,
             criterion,
             tones: &tones,
             evaluations: &evaluations,
+            best: c,
+            w,
         };
-        let bfgs = Bfgs {
-            max_iters: ITERATIONS,
-            decrement_tol: DECREMENT,
-            initial_step: 0.5,
-            ..Bfgs::default()
-        };
-        // A descent that fails leaves the best point so far, which is already evaluated.
-        let mut x = vec![0.0; n - 1];
-        for _ in 0..=RESTARTS {
-            let Ok(r) = bfgs.minimize(&objective as &dyn Objective, &x) else {
-                break;
-            };
-            let moved = shares(&r.params);
-            match value_at(plan, criterion, &tones, &moved, None) {
-                Some(c) if c.1 < best.1 => {
-                    w = moved;
-                    best = c;
-                    x = r.params;
-                }
-                _ => break,
-            }
-        }
+        // Scouting descents find the support (a full descent on a support that the exchange
+        // then changes is wasted work), full ones the shares on it.
+        search.descend(&support, Depth::Scout);
+        search.exchange(&mut support, Depth::Scout);
+        search.descend(&support, Depth::Full);
+        search.exchange(&mut support, Depth::Full);
+        results.push((search.w, search.best));
     }
-    // The phases that lower the crest factor, at the chosen power shares.
-    let amplitudes: Vec<f64> = w.iter().map(|wi| wi.sqrt()).collect();
-    let phases = low_crest_phases(&tones.k, &amplitudes);
-    evaluations.tick();
-    // The delivered design has these phases (the constraint is on power or peak, and the
-    // phases are chosen for the crest factor), unless they break the peak bound.
-    let mut chosen = value_at(plan, criterion, &tones, &w, Some(&phases)).unwrap_or(best);
+    let (w, best) = results
+        .into_iter()
+        .reduce(|a, b| if b.1 .1 < a.1 .1 { b } else { a })
+        .ok_or_else(|| study_err!("{file}: [design] band: no start for the search"))?;
+    let mut chosen = choose_phases(plan, criterion, &tones, &evaluations, &w, best);
+    // The tones the design gives no power are not part of it.
+    if let Some(m) = &mut chosen.0.multisine {
+        *m = m.without_silent_tones();
+    }
     // The file's own multisine, when it meets the constraint.
     let own = plan.baseline_design();
     if let Some(m) = &own.multisine {

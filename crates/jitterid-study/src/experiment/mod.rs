@@ -40,7 +40,7 @@ pub use spec::{
     Method, NoiseSpec, SolverName, SystemSpec,
 };
 pub use tone_design::{
-    harmonics_in, ToneDesignSpec, DEFAULT_TONES, MAX_DAC_SAMPLES, MAX_DESIGN_TONES,
+    harmonics_in, PhaseChoice, ToneDesignSpec, DEFAULT_TONES, MAX_DAC_SAMPLES, MAX_DESIGN_TONES,
 };
 
 use crate::csvio;

@@ -133,6 +133,7 @@ section!(RawDesign, "table [design]" {
     power: f64,
     peak: f64,
     dac_rate: f64,
+    phases: String,
 });
 
 #[derive(Debug, Deserialize)]

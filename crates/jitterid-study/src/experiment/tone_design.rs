@@ -1,5 +1,5 @@
 //! The multisine part of `[design]`: a `multisine` input whose frequencies, amplitudes and
-//! phases are free (`band`, `tones`, `power`, `peak`, `dac_rate`).
+//! phases are free (`band`, `tones`, `power`, `peak`, `phases`, `dac_rate`).
 //!
 //! The tones are harmonics of `1/(N T)`, so that the input is periodic over the record and
 //! its sample sequence loops on a signal generator. Everything that can be judged before a
@@ -41,6 +41,21 @@ pub struct ToneDesignSpec {
     pub peak: Option<f64>,
     /// The DAC rate (Hz) of the written sample sequence (`[design] dac_rate`), if given.
     pub dac_rate: Option<f64>,
+    /// What the phases are chosen for (`[design] phases`).
+    pub phases: PhaseChoice,
+}
+
+/// What a designed multisine's phases are chosen for (`[design] phases`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PhaseChoice {
+    /// The criterion, under the constraint (`"criterion"`, the default): the phases are
+    /// design variables like the powers, and a peak bound, when given, is what limits the
+    /// crest factor.
+    #[default]
+    Criterion,
+    /// The lowest crest factor the clipping algorithm reaches (`"crest"`): a signal
+    /// generator's or actuator's range used best, whatever the criterion says of the phases.
+    Crest,
 }
 
 /// The harmonics `k` of `f0 = 1/(N T)` with `k f0` in `[lo, hi]`: `(first, last)`, empty when
@@ -83,6 +98,7 @@ pub(super) fn parse_tone_design(
             ("power", r.power.as_ref().map(|v| v.span())),
             ("peak", r.peak.as_ref().map(|v| v.span())),
             ("dac_rate", r.dac_rate.as_ref().map(|v| v.span())),
+            ("phases", r.phases.as_ref().map(|v| v.span())),
         ];
         if let Some((key, Some(span))) = stray.into_iter().find(|(_, s)| s.is_some()) {
             return Err(cx.err(
@@ -220,11 +236,27 @@ pub(super) fn parse_tone_design(
             ));
         }
     }
+    let phases = match &r.phases {
+        None => PhaseChoice::default(),
+        Some(v) => match v.get_ref().as_str() {
+            "criterion" => PhaseChoice::Criterion,
+            "crest" => PhaseChoice::Crest,
+            other => {
+                return Err(cx.err(
+                    S,
+                    "phases",
+                    &v.span(),
+                    format!("expected \"criterion\" or \"crest\", found {other:?}"),
+                ))
+            }
+        },
+    };
     Ok(Some(ToneDesignSpec {
         band,
         tones,
         power,
         peak,
         dac_rate,
+        phases,
     }))
 }
