@@ -21,7 +21,8 @@
 use crate::outputs::write_outputs;
 use crate::Options;
 use jitterid_study::design::{
-    evaluate, jitter_blind, monte_carlo, optimise, Design, MonteCarloCheck, Plan,
+    criterion_difference, evaluate, jitter_blind, monte_carlo, optimise, Design, MonteCarloCheck,
+    Plan,
 };
 use jitterid_study::experiment::{Override, ReadOptions};
 use serde::Serialize;
@@ -50,7 +51,7 @@ const CASES: [(&str, &str, &[&str], &str); 3] = [
         "table2-multisine",
         "design-multisine.toml",
         &[],
-        "the Table 2 system and jitter driven by a multisine: eight tones in [0.005, 0.45] Hz at the file's power 0.125, against the file's four tones with zero phases",
+        "the Table 2 system and jitter driven by a multisine: up to eight tones in [0.005, 0.45] Hz at the file's power 0.125, against the file's four tones with zero phases",
     ),
 ];
 
@@ -71,6 +72,11 @@ struct Case {
     criterion_optimal_se: f64,
     criterion_baseline_se: f64,
     criterion_jitter_blind_se: f64,
+    /// The baseline's and the jitter-blind design's criterion minus the optimum's, over the
+    /// runs converged at both, with the paired jackknife's standard error (run `r` of every
+    /// design shares its jitter and noise streams); `null` with too few common runs.
+    paired_baseline: Option<PairedDifference>,
+    paired_jitter_blind: Option<PairedDifference>,
     /// The same criteria predicted (under the true prior).
     predicted_criterion_optimal: f64,
     predicted_criterion_baseline: f64,
@@ -86,6 +92,33 @@ struct Case {
     search_draws: usize,
     /// Wall time of the case: both searches, three predictions and three Monte Carlos (s).
     seconds: f64,
+}
+
+/// A criterion's difference between two designs by Monte Carlo, paired by run.
+#[derive(Debug, Clone, Serialize)]
+struct PairedDifference {
+    difference: f64,
+    se: f64,
+    /// Runs converged at both designs.
+    runs: usize,
+}
+
+impl PairedDifference {
+    fn of(
+        optimal: &MonteCarloCheck,
+        other: &MonteCarloCheck,
+        criterion: &jitterid_study::experiment::DesignCriterion,
+    ) -> Result<Option<Self>, jitterid_study::StudyError> {
+        Ok(
+            criterion_difference(optimal, other, criterion)?.map(|(difference, se, runs)| {
+                PairedDifference {
+                    difference,
+                    se,
+                    runs,
+                }
+            }),
+        )
+    }
 }
 
 fn study(
@@ -125,7 +158,12 @@ fn study(
         checks.push(monte_carlo(&plan, d, &criterion, runs, seed).map_err(text)?);
     }
     let (p_opt, _) = &predicted[0];
+    let paired_baseline = PairedDifference::of(&checks[0], &checks[1], &criterion).map_err(text)?;
+    let paired_jitter_blind =
+        PairedDifference::of(&checks[0], &checks[2], &criterion).map_err(text)?;
     Ok(Case {
+        paired_baseline,
+        paired_jitter_blind,
         case: case.into(),
         estimator: estimator.into(),
         names: p_opt.names.clone(),
@@ -239,14 +277,26 @@ fn table(c: &Case) -> String {
     };
     let (db, sb) = margin(c.criterion_baseline, c.criterion_baseline_se);
     let (dj, sj) = margin(c.criterion_jitter_blind, c.criterion_jitter_blind_se);
+    let paired = |p: &Option<PairedDifference>| match p {
+        Some(p) => format!(
+            "; paired by run, {:+.3} ± {:.3} ({:.1} se, {} runs)",
+            p.difference,
+            p.se,
+            p.difference / p.se,
+            p.runs
+        ),
+        None => String::new(),
+    };
     let _ = write!(
         s,
-        "\nBy Monte Carlo, the {baseline_name} minus the optimum: {db:+.3} ± {sb:.3} ({:.1} se; predicted {:+.3}, a factor {:.2} in det C); \
-         the jitter-blind design minus the optimum: {dj:+.3} ± {sj:.3} ({:.1} se; predicted {:+.3}). Wall time {:.1} s.\n",
+        "\nBy Monte Carlo, the {baseline_name} minus the optimum: {db:+.3} ± {sb:.3} ({:.1} se{}; predicted {:+.3}, a factor {:.2} in det C); \
+         the jitter-blind design minus the optimum: {dj:+.3} ± {sj:.3} ({:.1} se{}; predicted {:+.3}). Wall time {:.1} s.\n",
         db / sb,
+        paired(&c.paired_baseline),
         c.predicted_criterion_baseline - c.predicted_criterion_optimal,
         db.exp(),
         dj / sj,
+        paired(&c.paired_jitter_blind),
         c.predicted_criterion_jitter_blind - c.predicted_criterion_optimal,
         c.seconds
     );
@@ -286,7 +336,10 @@ fn design_for(
         "## Experiment design — `cargo xtask reproduce {name}`\n\n\
          {runs} realisations per design (seed {}); statistics over the converged runs; the \
          criterion's standard error by the jackknife over the realisations, a standard \
-         deviation's by the delta method with the sample kurtosis.\n",
+         deviation's by the delta method with the sample kurtosis; a difference's `±` as if \
+         the designs' studies were independent, and paired by run (the jackknife of the \
+         difference, each run left out of both designs: run `r` of every design shares its \
+         jitter and noise streams).\n",
         o.seed
     );
     let mut cases = Vec::new();

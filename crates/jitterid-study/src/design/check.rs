@@ -36,6 +36,67 @@ pub struct MonteCarloCheck {
     pub criterion_se: f64,
     /// Wall time of the realisations (s).
     pub seconds: f64,
+    /// The summarised realisations: each run's index and estimates, in run order (what
+    /// [`criterion_difference`] pairs by run).
+    pub estimates: Vec<(u64, Vec<f64>)>,
+}
+
+/// The rows `v` without row `k`.
+fn leave_one_out<'v>(v: &[&'v Vec<f64>], k: usize) -> Vec<&'v Vec<f64>> {
+    v.iter()
+        .enumerate()
+        .filter(|(j, _)| *j != k)
+        .map(|(_, x)| *x)
+        .collect()
+}
+
+/// The difference of the criterion between two Monte Carlo checks of the same study (the same
+/// seed and runs, two designs), `other − this`, over the runs summarised in both, with its
+/// jackknife standard error over those runs, each run left out of both at once. Run `r` of
+/// both designs shares its jitter and noise streams, so the two criteria are correlated and
+/// the paired error is the honest one: treating the studies as independent overstates it.
+/// `None` with fewer than `p + 3` common runs.
+///
+/// # Errors
+///
+/// A criterion that names no estimated parameter.
+pub fn criterion_difference(
+    this: &MonteCarloCheck,
+    other: &MonteCarloCheck,
+    criterion: &DesignCriterion,
+) -> StudyResult<Option<(f64, f64, usize)>> {
+    let mut a: Vec<&Vec<f64>> = Vec::new();
+    let mut b: Vec<&Vec<f64>> = Vec::new();
+    let mut j = 0;
+    for (run, x) in &this.estimates {
+        while j < other.estimates.len() && other.estimates[j].0 < *run {
+            j += 1;
+        }
+        if let Some((r, y)) = other.estimates.get(j) {
+            if r == run {
+                a.push(x);
+                b.push(y);
+            }
+        }
+    }
+    let n = a.len();
+    if n < this.names.len() + 3 {
+        return Ok(None);
+    }
+    let diff = |a: &[&Vec<f64>], b: &[&Vec<f64>]| -> StudyResult<f64> {
+        Ok(
+            covariance_criterion(criterion, &other.names, &sample_covariance(b))?
+                - covariance_criterion(criterion, &this.names, &sample_covariance(a))?,
+        )
+    };
+    let whole = diff(&a, &b)?;
+    let leave_out: Vec<f64> = (0..n)
+        .map(|k| diff(&leave_one_out(&a, k), &leave_one_out(&b, k)))
+        .collect::<StudyResult<_>>()?;
+    let r = n as f64;
+    let mean = leave_out.iter().sum::<f64>() / r;
+    let se = ((r - 1.0) / r * leave_out.iter().map(|v| (v - mean).powi(2)).sum::<f64>()).sqrt();
+    Ok(Some((whole, se, n)))
 }
 
 /// The sample covariance of the rows `x` (each a realisation's estimates).
@@ -89,12 +150,16 @@ pub fn monte_carlo(
     let t = Instant::now();
     let s = montecarlo_realizations(&exp, runs, seed, None)?;
     let seconds = t.elapsed().as_secs_f64();
-    let rows: Vec<Vec<f64>> = s
+    let estimates: Vec<(u64, Vec<f64>)> = s
         .runs
         .iter()
         .filter(|r| r.converged)
-        .filter_map(|r| r.values.iter().copied().collect::<Option<Vec<f64>>>())
+        .filter_map(|r| {
+            let v = r.values.iter().copied().collect::<Option<Vec<f64>>>()?;
+            Some((r.run, v))
+        })
         .collect();
+    let rows: Vec<&Vec<f64>> = estimates.iter().map(|(_, v)| v).collect();
     let p = s.names.len();
     if rows.len() < p + 2 {
         return Err(study_err!(
@@ -106,8 +171,7 @@ pub fn monte_carlo(
             design.samples
         ));
     }
-    let all: Vec<&Vec<f64>> = rows.iter().collect();
-    let covariance = sample_covariance(&all);
+    let covariance = sample_covariance(&rows);
     let r = rows.len() as f64;
     let std: Vec<f64> = (0..p).map(|i| covariance[i][i].sqrt()).collect();
     let std_se = (0..p)
@@ -122,13 +186,11 @@ pub fn monte_carlo(
     // Jackknife: the criterion with each realisation left out in turn.
     let leave_out: Vec<f64> = (0..rows.len())
         .map(|k| {
-            let rest: Vec<&Vec<f64>> = rows
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != k)
-                .map(|(_, v)| v)
-                .collect();
-            covariance_criterion(criterion, &s.names, &sample_covariance(&rest))
+            covariance_criterion(
+                criterion,
+                &s.names,
+                &sample_covariance(&leave_one_out(&rows, k)),
+            )
         })
         .collect::<StudyResult<_>>()?;
     let jack_mean = leave_out.iter().sum::<f64>() / r;
@@ -148,5 +210,85 @@ pub fn monte_carlo(
         criterion: criterion_value,
         criterion_se,
         seconds,
+        estimates,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{criterion_difference, sample_covariance, MonteCarloCheck};
+    use crate::design::covariance_criterion;
+    use crate::experiment::DesignCriterion;
+
+    /// A check holding `rows` as runs `runs` (only the fields the difference reads).
+    fn check(runs: &[u64], rows: &[Vec<f64>]) -> MonteCarloCheck {
+        MonteCarloCheck {
+            names: vec!["a".into(), "b".into()],
+            runs: 0,
+            used: rows.len(),
+            covariance: vec![],
+            std: vec![],
+            std_se: vec![],
+            criterion: 0.0,
+            criterion_se: 0.0,
+            seconds: 0.0,
+            estimates: runs.iter().copied().zip(rows.iter().cloned()).collect(),
+        }
+    }
+
+    /// Rows of a fixed, scrambled sequence (no random draws: deterministic).
+    fn rows(n: usize) -> Vec<Vec<f64>> {
+        (0..n)
+            .map(|i| {
+                let x = ((i * 7919) % 101) as f64 / 101.0;
+                let y = ((i * 104_729) % 97) as f64 / 97.0;
+                vec![x, x * 0.3 + y]
+            })
+            .collect()
+    }
+
+    /// A design whose every estimate is twice the other's, run by run, has `log det` larger
+    /// by exactly `p ln 4`, and every leave-one-out pair says the same, so the paired error is
+    /// 0; runs present in one check only are left out; too few common runs give `None`.
+    #[test]
+    fn a_paired_difference_pairs_runs_by_index() {
+        let a = rows(40);
+        let b: Vec<Vec<f64>> = a
+            .iter()
+            .map(|r| r.iter().map(|x| 2.0 * x).collect())
+            .collect();
+        let runs: Vec<u64> = (0..40).collect();
+        let d = DesignCriterion::D;
+        let (diff, se, n) = criterion_difference(&check(&runs, &a), &check(&runs, &b), &d)
+            .unwrap()
+            .unwrap();
+        assert!((diff - 2.0 * 4f64.ln()).abs() < 1e-12, "{diff}");
+        assert!(se < 1e-12, "{se}");
+        assert_eq!(n, 40);
+        // Run 5 missing from the second check: the first's run 5 is left out too, so the
+        // pairs still match exactly.
+        let keep: Vec<u64> = runs.iter().copied().filter(|&r| r != 5).collect();
+        let b_kept: Vec<Vec<f64>> = keep.iter().map(|&r| b[r as usize].clone()).collect();
+        let (diff, se, n) = criterion_difference(&check(&runs, &a), &check(&keep, &b_kept), &d)
+            .unwrap()
+            .unwrap();
+        assert!((diff - 2.0 * 4f64.ln()).abs() < 1e-12 && se < 1e-12 && n == 39);
+        // The difference itself is the criterion of each sample covariance, differenced.
+        let c: Vec<Vec<f64>> = rows(41)[1..].to_vec();
+        let (diff, se, _) = criterion_difference(&check(&runs, &a), &check(&runs, &c), &d)
+            .unwrap()
+            .unwrap();
+        let names = ["a".to_string(), "b".to_string()];
+        let crit = |r: &[Vec<f64>]| {
+            let refs: Vec<&Vec<f64>> = r.iter().collect();
+            covariance_criterion(&d, &names, &sample_covariance(&refs)).unwrap()
+        };
+        assert!((diff - (crit(&c) - crit(&a))).abs() < 1e-12);
+        assert!(se > 0.0);
+        assert!(
+            criterion_difference(&check(&runs[..4], &a[..4]), &check(&runs[..4], &b[..4]), &d)
+                .unwrap()
+                .is_none()
+        );
+    }
 }

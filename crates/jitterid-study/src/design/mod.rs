@@ -49,7 +49,7 @@ mod written;
 
 pub use blind::{evaluate, jitter_blind, JitterBlind};
 pub use candidate::Design;
-pub use check::{monte_carlo, MonteCarloCheck};
+pub use check::{criterion_difference, monte_carlo, MonteCarloCheck};
 pub use crest::{low_crest_phases, peak, rms, schroeder_phases};
 pub use criterion::{covariance_criterion, criterion_value};
 pub use dac::dac_samples;

@@ -132,8 +132,8 @@ section!(RawDesign, "table [design]" {
     tones: i64,
     power: f64,
     peak: f64,
-    dac_rate: f64,
     phases: String,
+    dac_rate: f64,
 });
 
 #[derive(Debug, Deserialize)]
