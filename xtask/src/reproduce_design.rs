@@ -149,8 +149,10 @@ fn study(
     let optimal = optimise(&plan, &criterion).map_err(text)?.design;
     let blind = jitter_blind(&plan, &criterion).map_err(text)?.design;
     let baseline = plan.baseline_design();
-    // Predictions on the Monte Carlo's own input draws (draw r is run r's input).
-    let matched = plan.with_draws(runs as usize, seed).map_err(text)?;
+    // Predictions on the Monte Carlo's own input draws (draw r is run r's input), the first
+    // MAX_DRAWS of them for a longer study.
+    let draws = (runs as usize).min(jitterid_study::experiment::MAX_DRAWS);
+    let matched = plan.with_draws(draws, seed).map_err(text)?;
     let mut predicted = Vec::new();
     let mut checks: Vec<MonteCarloCheck> = Vec::new();
     for d in [&optimal, &baseline, &blind] {
@@ -339,8 +341,16 @@ fn design_for(
          deviation's by the delta method with the sample kurtosis; a difference's `±` as if \
          the designs' studies were independent, and paired by run (the jackknife of the \
          difference, each run left out of both designs: run `r` of every design shares its \
-         jitter and noise streams).\n",
-        o.seed
+         jitter and noise streams).{}\n",
+        o.seed,
+        if runs as usize > jitterid_study::experiment::MAX_DRAWS {
+            format!(
+                " A random input's prediction averages the first {} runs' input draws.",
+                jitterid_study::experiment::MAX_DRAWS
+            )
+        } else {
+            String::new()
+        }
     );
     let mut cases = Vec::new();
     for (case, file, edits, what) in CASES.into_iter().filter(|c| wanted(c.0)) {
