@@ -37,6 +37,7 @@ mod criterion;
 mod dac;
 mod derived;
 mod derived_choice;
+mod jitter_scaling;
 mod multisine;
 mod plan;
 mod predict;

@@ -4,6 +4,7 @@
 use super::blind::without_jitter;
 use super::candidate::Design;
 use super::criterion::criterion_value;
+use super::jitter_scaling::at_interval;
 use super::predict::{predict, Prediction};
 use super::prior::{prior_draws, PriorDraw};
 use super::progress::{DesignObserver, DesignProgress};
@@ -250,6 +251,14 @@ impl Plan {
         if self.blind {
             without_jitter(exp)
         } else {
+            // The jitter at the design's interval, when it depends on the interval (the
+            // prediction checks the moved jitter's reach against the record).
+            let exp = at_interval(
+                exp,
+                &self.baseline.jitter.truth,
+                self.baseline.grid.interval(),
+                self.spec.jitter_exponent,
+            )?;
             Ok(exp)
         }
     }

@@ -88,6 +88,7 @@ pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResu
         .parse()
         .map_err(|e| study_err!("{}: the edited document: {e}", exp.file))?;
     doc.remove("design");
+    write_scaled_jitter(plan, &exp, &mut doc)?;
     let dwell = design
         .mean_dwell
         .map_or(String::new(), |m| format!(" with mean dwell {m} s"));
@@ -100,6 +101,48 @@ pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResu
         csv: input_to_csv(u),
         experiment: header + &doc.to_string(),
     })
+}
+
+/// Writes the jitter of `exp` (the design's experiment) into `doc` when it is not the file's:
+/// under `[design] jitter_exponent` a design at another interval has another jitter, and the
+/// experiment written for it must simulate that one. The family's keys are written as the
+/// registry states them.
+///
+/// # Errors
+///
+/// A jitter whose keys are not numbers (a family of terms), which the `[jitter]` table of
+/// the written file cannot take one key at a time; the message names the key.
+fn write_scaled_jitter(
+    plan: &Plan,
+    exp: &crate::experiment::Experiment,
+    doc: &mut toml_edit::DocumentMut,
+) -> StudyResult<()> {
+    if exp.jitter.truth == plan.baseline.jitter.truth {
+        return Ok(());
+    }
+    let Some(table) = doc.get_mut("jitter").and_then(|t| t.as_table_like_mut()) else {
+        return Err(study_err!(
+            "{}: [design] jitter_exponent: the file has no [jitter] table to write the jitter at the designed interval into",
+            exp.file
+        ));
+    };
+    for (key, value) in exp.jitter.truth.spec() {
+        if key == "family" {
+            continue;
+        }
+        let v: toml_edit::Value = match &value {
+            serde_json::Value::Number(n) if n.is_i64() => n.as_i64().unwrap_or_default().into(),
+            serde_json::Value::Number(n) => n.as_f64().unwrap_or(f64::NAN).into(),
+            _ => {
+                return Err(study_err!(
+                    "{}: [design] jitter_exponent: the jitter's key {key} is not a number; the designed interval's jitter cannot be written",
+                    exp.file
+                ))
+            }
+        };
+        table.insert(&key, toml_edit::Item::Value(v));
+    }
+    Ok(())
 }
 
 /// The designed multisine's experiment (the file with the design's sampling and tones, its

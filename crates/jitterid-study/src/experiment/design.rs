@@ -158,6 +158,11 @@ pub struct DesignSpec {
     /// The sampling interval's range `[min, max]` (s), when it is free; the part of the range
     /// where the held quantity allows a record (see [`Hold`]).
     pub interval: Option<(f64, f64)>,
+    /// How the jitter's spread follows the sampling interval (`jitter_exponent`, `α`): at
+    /// interval `T` the jitter is the file's family with standard deviation
+    /// `σ₀ (T / T₀)^α`, `σ₀` and `T₀` the file's (0, the default: the jitter does not depend
+    /// on `T`).
+    pub jitter_exponent: f64,
     /// What stays fixed when the interval changes.
     pub hold: Hold,
     /// The record every design has: `[design] duration` or `samples` when given (the budget),
@@ -514,10 +519,12 @@ pub(super) fn parse_design(
         crate::montecarlo::DEFAULT_SEED as i64,
     )? as u64;
     let prior = parse_prior(cx, r)?;
+    let jitter_exponent = parse_jitter_exponent(cx, r, prior.as_ref())?;
     let derived = parse_derived(cx, r)?;
     Ok(DesignSpec {
         mean_dwell,
         interval,
+        jitter_exponent,
         hold,
         budget,
         budget_key,
@@ -530,6 +537,52 @@ pub(super) fn parse_design(
         derived,
         multisine,
     })
+}
+
+/// Largest `[design] jitter_exponent`: a spread growing faster than `T²` is no timing
+/// mechanism (a clock's jitter is `T`-independent, a drifting oscillator's accumulates as
+/// `√T`, a rate-proportional one as `T`).
+pub const MAX_JITTER_EXPONENT: f64 = 2.0;
+
+/// `[design] jitter_exponent`: a number in `[0, MAX_JITTER_EXPONENT]`, meaningful only with
+/// the interval free and not beside a prior spread of the jitter (whose draws are spreads at
+/// the file's interval).
+fn parse_jitter_exponent(
+    cx: &Source,
+    r: &RawDesign,
+    prior: Option<&PriorSpread>,
+) -> StudyResult<f64> {
+    let Some(v) = &r.jitter_exponent else {
+        return Ok(0.0);
+    };
+    let alpha = *v.get_ref();
+    if !(alpha.is_finite() && (0.0..=MAX_JITTER_EXPONENT).contains(&alpha)) {
+        return Err(cx.err(
+            S,
+            "jitter_exponent",
+            &v.span(),
+            format!(
+                "expected an exponent in [0, {MAX_JITTER_EXPONENT}] (the jitter's σ at T is σ₀ (T/T₀)^α), found {alpha}"
+            ),
+        ));
+    }
+    if r.interval.is_none() {
+        return Err(cx.err(
+            S,
+            "jitter_exponent",
+            &v.span(),
+            "says how the jitter follows the sampling interval; expected interval = [min, max] beside it",
+        ));
+    }
+    if prior.is_some_and(|p| p.jitter > 0.0) {
+        return Err(cx.err(
+            S,
+            "jitter_exponent",
+            &v.span(),
+            "cannot be combined with prior_jitter_spread (its draws are spreads at the file's interval); leave one out",
+        ));
+    }
+    Ok(alpha)
 }
 
 /// `[design] derived`: each entry a quantity [`DerivedRequest::parse`] knows.

@@ -116,6 +116,7 @@ section!(RawSelect, "table [select]" {
 section!(RawDesign, "table [design]" {
     mean_dwell: Vec<f64>,
     interval: Vec<f64>,
+    jitter_exponent: f64,
     hold: String,
     duration: f64,
     samples: i64,
