@@ -39,6 +39,21 @@ pub struct Plan {
     observer: Option<DesignObserver>,
 }
 
+/// A design of the random binary input's levels with `low = high` is refused: such an input
+/// never changes level, so the switches that the design's other variables (the dwell) are
+/// about carry no excitation, and any information left comes from the one step at the
+/// record's start (an artefact of the input's history, which the file may not mean); with
+/// both levels 0 there is no signal at all. The search counts it as infeasible, like a
+/// singular information matrix.
+fn no_excitation(file: &str, design: &Design) -> StudyResult<()> {
+    match (design.low, design.high) {
+        (Some(low), Some(high)) if low == high => Err(study_err!(
+            "{file}: [design] low = {low}, high = {high}: the random binary input never switches (low = high): no excitation, the information matrix is singular"
+        )),
+        _ => Ok(()),
+    }
+}
+
 impl Plan {
     /// Reads the experiment file at `path`, edited as `options` says.
     ///
@@ -170,8 +185,10 @@ impl Plan {
     ///
     /// # Errors
     ///
-    /// Those of [`Plan::experiment`] and [`predict`].
+    /// Those of [`Plan::experiment`] and [`predict`]; a design of the levels with `low =
+    /// high` (an input that never switches: no excitation).
     pub fn predict(&self, design: &Design) -> StudyResult<Prediction> {
+        no_excitation(&self.file, design)?;
         let exp = self.experiment(design)?;
         predict(&exp, self.spec.estimator, self.spec.draws, self.spec.seed)
     }
@@ -221,6 +238,14 @@ impl Plan {
     /// The baseline's design.
     pub fn baseline_design(&self) -> Design {
         let mut d = Design::of(&self.baseline);
+        // Under a design of the levels the file's own pair is part of the baseline's design
+        // (both, so that the fixed one is shown beside the free one).
+        if self.spec.low.is_some() || self.spec.high.is_some() {
+            if let Some((low, high)) = super::realization::levels_of(&self.baseline) {
+                d.low = Some(low);
+                d.high = Some(high);
+            }
+        }
         // Under a multisine design the file's own tones are part of the baseline's design.
         if self.spec.multisine.is_some() {
             let start = self.baseline.grid.start();
