@@ -43,7 +43,10 @@ fn designed_levels_are_reported_and_written() {
         v["design"]["low"].as_f64().unwrap(),
         v["design"]["high"].as_f64().unwrap(),
     );
-    assert!((-1.0..=0.0).contains(&low) && (0.5..=1.5).contains(&high), "{v}");
+    assert!(
+        (-1.0..=0.0).contains(&low) && (0.5..=1.5).contains(&high),
+        "{v}"
+    );
     assert_eq!(v["baseline"]["design"]["low"], 0.0);
     assert_eq!(v["baseline"]["design"]["high"], 1.0);
     let input = std::fs::read_to_string(&csv).unwrap();
@@ -55,7 +58,10 @@ fn designed_levels_are_reported_and_written() {
         .map(|r| r.split(',').nth(1).unwrap().parse().unwrap())
         .collect();
     assert!(values.iter().all(|&u| u == low || u == high), "{values:?}");
-    assert!(values.contains(&low) && values.contains(&high), "{values:?}");
+    assert!(
+        values.contains(&low) && values.contains(&high),
+        "{values:?}"
+    );
     let exp = d.join("designed.toml");
     let text = std::fs::read_to_string(&exp).unwrap();
     assert!(

@@ -99,10 +99,9 @@ fn level_ranges_are_read_and_refused_naming_the_key() {
 /// infeasible and skipped; the search does not choose it.
 #[test]
 fn level_search_finds_the_scan_s_minimum() {
-    let text = table2(
-        "[design]\nlow = [-1.0, 1.0]\nhigh = [-1.0, 1.0]\ndraws = 4\ngrid = 5\nseed = 3",
-    )
-    .replace("samples = 200", "samples = 120");
+    let text =
+        table2("[design]\nlow = [-1.0, 1.0]\nhigh = [-1.0, 1.0]\ndraws = 4\ngrid = 5\nseed = 3")
+            .replace("samples = 200", "samples = 120");
     let plan = plan(&text).unwrap();
     let crit = DesignCriterion::D;
     let opt = optimise(&plan, &crit).unwrap();
@@ -181,11 +180,22 @@ fn one_free_level_search_finds_the_scan_s_minimum() {
     let best = (0..n)
         .map(|i| -1.0 + 1.8 * i as f64 / (n - 1) as f64)
         .map(|l| (l, scan_value(l)))
-        .fold((f64::NAN, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+        .fold(
+            (f64::NAN, f64::INFINITY),
+            |a, b| if b.1 < a.1 { b } else { a },
+        );
     let low = opt.design.low.unwrap();
     eprintln!("optimum low {low}: {}; scan best {best:?}", opt.value);
-    assert!(opt.value <= best.1 + 1e-12 * best.1.abs(), "{} against {}", opt.value, best.1);
-    assert!((low - best.0).abs() <= 1.8 / (n - 1) as f64, "{low} against {best:?}");
+    assert!(
+        opt.value <= best.1 + 1e-12 * best.1.abs(),
+        "{} against {}",
+        opt.value,
+        best.1
+    );
+    assert!(
+        (low - best.0).abs() <= 1.8 / (n - 1) as f64,
+        "{low} against {best:?}"
+    );
 }
 
 /// Levels that never switch (`low = high`) are infeasible, not a crash: a search whose every
@@ -220,10 +230,9 @@ fn equal_levels_are_infeasible() {
 /// levels has no `low`/`high` in its JSON.
 #[test]
 fn designed_levels_round_trip() {
-    let text = table2(
-        "[design]\nlow = [-1.0, 0.0]\nhigh = [0.5, 2.0]\ndraws = 2\ngrid = 3\nseed = 3",
-    )
-    .replace("samples = 200", "samples = 100");
+    let text =
+        table2("[design]\nlow = [-1.0, 0.0]\nhigh = [0.5, 2.0]\ndraws = 2\ngrid = 3\nseed = 3")
+            .replace("samples = 200", "samples = 100");
     let p = plan(&text).unwrap();
     let base = p.baseline_design();
     assert_eq!((base.low, base.high), (Some(0.0), Some(1.0)));
@@ -252,8 +261,7 @@ fn designed_levels_round_trip() {
         Purpose::Simulate,
     )
     .unwrap();
-    let Some(InputSpec::Known(Input::Piecewise(u))) = back.inputs.first().map(|c| &c.spec)
-    else {
+    let Some(InputSpec::Known(Input::Piecewise(u))) = back.inputs.first().map(|c| &c.spec) else {
         panic!("not a piecewise input: {:?}", back.inputs);
     };
     let levels = u.levels();
@@ -271,7 +279,10 @@ fn designed_levels_round_trip() {
         json["design"]["low"].as_f64().unwrap(),
         json["design"]["high"].as_f64().unwrap(),
     );
-    assert!((-1.0..=0.0).contains(&low) && (0.5..=2.0).contains(&high), "{json}");
+    assert!(
+        (-1.0..=0.0).contains(&low) && (0.5..=2.0).contains(&high),
+        "{json}"
+    );
     assert_eq!(json["baseline"]["design"]["low"], 0.0);
     assert_eq!(json["baseline"]["design"]["high"], 1.0);
     assert_eq!(levels_in(&p, &report.design), (low, high));
@@ -280,15 +291,15 @@ fn designed_levels_round_trip() {
     let (bl, bh) = (blind.design.low.unwrap(), blind.design.high.unwrap());
     assert!((-1.0..=0.0).contains(&bl) && (0.5..=2.0).contains(&bh));
     // A robust design over the levels runs, and reports the averaged criterion.
-    let robust = plan(&text.replace(
-        "seed = 3",
-        "seed = 3\nprior_spread = 0.1\nprior_draws = 2",
-    ))
-    .unwrap();
+    let robust =
+        plan(&text.replace("seed = 3", "seed = 3\nprior_spread = 0.1\nprior_draws = 2")).unwrap();
     let r = design(&robust, None).unwrap();
     assert!(r.design.low.is_some() && r.json().robust.is_some());
     // Without free levels the JSON has no levels (the existing designs' JSON is unchanged).
-    let dwell = plan(&table2("[design]\nmean_dwell = [4.0, 16.0]\ndraws = 1\ngrid = 3")).unwrap();
+    let dwell = plan(&table2(
+        "[design]\nmean_dwell = [4.0, 16.0]\ndraws = 1\ngrid = 3",
+    ))
+    .unwrap();
     let json = serde_json::to_value(design(&dwell, None).unwrap().json()).unwrap();
     for d in [&json["design"], &json["baseline"]["design"]] {
         assert!(d.get("low").is_none() && d.get("high").is_none(), "{d}");
