@@ -40,15 +40,15 @@ pub struct Plan {
 }
 
 /// A design of the random binary input's levels with `low = high` is refused: such an input
-/// never changes level, so the switches that the design's other variables (the dwell) are
-/// about carry no excitation, and any information left comes from the one step at the
-/// record's start (an artefact of the input's history, which the file may not mean); with
-/// both levels 0 there is no signal at all. The search counts it as infeasible, like a
-/// singular information matrix.
+/// never changes level, so its switches, which the design is about, excite nothing. Any
+/// information left comes from the one step at the record's start where the system was at
+/// rest before it (an artefact of the input's history that no random binary design means),
+/// and with both levels 0 there is no signal and the information matrix is singular. The
+/// search counts it as infeasible, like a singular information matrix.
 fn no_excitation(file: &str, design: &Design) -> StudyResult<()> {
     match (design.low, design.high) {
         (Some(low), Some(high)) if low == high => Err(study_err!(
-            "{file}: [design] low = {low}, high = {high}: the random binary input never switches (low = high): no excitation, the information matrix is singular"
+            "{file}: [design] low = {low}, high = {high}: the random binary input never switches (low = high): no excitation; a design of the levels needs low != high"
         )),
         _ => Ok(()),
     }
