@@ -143,8 +143,8 @@ fn level_search_finds_the_scan_s_minimum() {
     );
     // The search's value is the criterion at its design, recomputed here.
     assert!((scan_value(low, high) - opt.value).abs() <= 1e-12 * opt.value.abs());
-    // At the scan's minimum (or its mirror image) to the refinement's tolerance, 10⁻³ of the
-    // range's width.
+    // At the scan's minimum (or its mirror image) to twice the refinement's tolerance (10⁻³ of
+    // the range's width).
     let tol = 2.0 * 2e-3;
     let at = |a: f64, b: f64| (a - best.0).abs() <= tol && (b - best.1).abs() <= tol;
     assert!(
@@ -247,8 +247,8 @@ fn equal_levels_are_infeasible() {
 }
 
 /// The designed levels reach every product of a design: the design's experiment, the written
-/// experiment and its CSV input (read back, its values are the designed levels, draw 0's
-/// switch times those of the design's own realisation), the report's JSON beside the
+/// experiment and its CSV input (read back, its values are the designed levels, both of
+/// them, and nothing else), the report's JSON beside the
 /// baseline's levels, the jitter-blind design and a robust design; a design without free
 /// levels has no `low`/`high` in its JSON.
 #[test]
