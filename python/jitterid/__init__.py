@@ -253,6 +253,10 @@ def design(experiment: Experiment, criterion: Optional[str] = None, *, budget: O
       ``"pole_frequency"`` (every pole's ``|p|/2π``, named ``pole1.frequency``, … in increasing
       order), ``"poleK.frequency"``, ``"gain@F"`` (``|G|`` at ``F`` Hz), ``"jitter.sigma"``.
 
+    With ``[design] low`` or ``high`` (the random binary input's levels free), ``result.design``
+    and ``result.baseline`` carry both levels, ``"low"`` and ``"high"``, and the written input
+    takes the designed ones.
+
     The search runs without the GIL. A ``[design]`` without a feasible point, a budget that
     cannot be met, an unknown criterion or an unknown or undefined derived quantity raise
     ``ValueError`` naming the key."""

@@ -327,7 +327,8 @@ class SelectionResult(_CommandJson):
 
 class DesignResult(_CommandJson):
     """An experiment design, equal to ``jitterid design --json``: the designed experiment
-    (``design``: the free variables' values, ``interval``, ``samples``), its predicted standard
+    (``design``: the free variables' values, ``interval``, ``samples``; ``low`` and ``high``, the
+    random binary input's levels, when ``[design] low`` or ``high`` frees them), its predicted standard
     deviations (``predicted``, a dict by parameter name; ``derived`` for derived quantities such
     as the static gain), the same for the experiment file's own design (``baseline``,
     ``baseline_predicted``), and with ``jitter_blind=True`` the design that ignores the jitter

@@ -332,6 +332,16 @@ impl RandomBinary {
         self.mean_dwell
     }
 
+    /// The level of the input's "low" state.
+    pub fn low(&self) -> f64 {
+        self.low
+    }
+
+    /// The level of the input's "high" state.
+    pub fn high(&self) -> f64 {
+        self.high
+    }
+
     /// One realisation on `[start, end)`: the first level is `low` or `high` with equal
     /// probability, then levels alternate. Needs `end > start` and at most [`MAX_SWITCHES`]
     /// expected switches (`(end − start)/mean_dwell`).

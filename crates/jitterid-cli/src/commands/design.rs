@@ -51,6 +51,9 @@ fn design_text(d: &Design) -> String {
     if let Some(m) = d.mean_dwell {
         let _ = write!(s, "mean_dwell = {} s, ", fmt_num(m));
     }
+    if let (Some(low), Some(high)) = (d.low, d.high) {
+        let _ = write!(s, "low = {}, high = {}, ", fmt_num(low), fmt_num(high));
+    }
     let _ = write!(
         s,
         "interval = {} s, samples = {}",

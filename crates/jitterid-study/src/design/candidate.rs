@@ -2,8 +2,9 @@
 //! the experiment file that make it.
 //!
 //! A design is applied as edits of the experiment's document (`input.mean_dwell`,
-//! `sampling.interval`, `sampling.samples`, a multisine's `input.frequencies`,
-//! `input.amplitudes` and `input.phases`), which is then read again: every candidate meets
+//! `input.low`, `input.high`, `sampling.interval`, `sampling.samples`, a multisine's
+//! `input.frequencies`, `input.amplitudes` and `input.phases`), which is then read again:
+//! every candidate meets
 //! the same validation as a file written by hand (the jitter's reach within the record, the
 //! input's switch limit), and nothing in the design layer has to know how an experiment holds
 //! its input or grid.
@@ -18,6 +19,14 @@ pub struct Design {
     /// The random binary input's mean dwell (s), for such an input.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_dwell: Option<f64>,
+    /// The random binary input's `low` level, when the levels are designed (`[design] low` or
+    /// `high`; both levels are then given, the fixed one at the file's value, so that a
+    /// report shows the pair). Absent otherwise, so that other designs' JSON is unchanged.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub low: Option<f64>,
+    /// The random binary input's `high` level, as `low`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub high: Option<f64>,
     /// The sampling interval `T` (s).
     pub interval: f64,
     /// The number of samples `N`.
@@ -32,6 +41,8 @@ impl Design {
     pub fn of(exp: &Experiment) -> Self {
         Design {
             mean_dwell: super::realization::mean_dwell_of(exp),
+            low: None,
+            high: None,
             interval: exp.grid.interval(),
             samples: exp.grid.len(),
             multisine: None,
@@ -45,9 +56,15 @@ impl Design {
             let origin = format!("[design] {} = {v}", path[path.len() - 1]);
             Override::from_source(path, v, origin)
         };
-        let mut out = Vec::with_capacity(3);
+        let mut out = Vec::with_capacity(5);
         if let Some(d) = self.mean_dwell {
             out.push(edit(&["input", "mean_dwell"], d.into()));
+        }
+        if let Some(l) = self.low {
+            out.push(edit(&["input", "low"], l.into()));
+        }
+        if let Some(h) = self.high {
+            out.push(edit(&["input", "high"], h.into()));
         }
         out.push(edit(&["sampling", "interval"], self.interval.into()));
         out.push(edit(&["sampling", "samples"], (self.samples as i64).into()));

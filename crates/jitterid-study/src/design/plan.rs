@@ -40,6 +40,21 @@ pub struct Plan {
     observer: Option<DesignObserver>,
 }
 
+/// A design of the random binary input's levels with `low = high` is refused: such an input
+/// never changes level, so its switches, which the design is about, excite nothing. Any
+/// information left comes from the one step at the record's start where the system was at
+/// rest before it (an artefact of the input's history that no random binary design means),
+/// and with both levels 0 there is no signal and the information matrix is singular. The
+/// search counts it as infeasible, like a singular information matrix.
+fn no_excitation(file: &str, design: &Design) -> StudyResult<()> {
+    match (design.low, design.high) {
+        (Some(low), Some(high)) if low == high => Err(study_err!(
+            "{file}: [design] low = {low}, high = {high}: the random binary input never switches (low = high): no excitation; a design of the levels needs low != high"
+        )),
+        _ => Ok(()),
+    }
+}
+
 impl Plan {
     /// Reads the experiment file at `path`, edited as `options` says.
     ///
@@ -171,8 +186,10 @@ impl Plan {
     ///
     /// # Errors
     ///
-    /// Those of [`Plan::experiment`] and [`predict`].
+    /// Those of [`Plan::experiment`] and [`predict`]; a design of the levels with `low =
+    /// high` (an input that never switches: no excitation).
     pub fn predict(&self, design: &Design) -> StudyResult<Prediction> {
+        no_excitation(&self.file, design)?;
         let exp = self.experiment(design)?;
         predict(&exp, self.spec.estimator, self.spec.draws, self.spec.seed)
     }
@@ -222,6 +239,14 @@ impl Plan {
     /// The baseline's design.
     pub fn baseline_design(&self) -> Design {
         let mut d = Design::of(&self.baseline);
+        // Under a design of the levels the file's own pair is part of the baseline's design
+        // (both, so that the fixed one is shown beside the free one).
+        if self.spec.low.is_some() || self.spec.high.is_some() {
+            if let Some((low, high)) = super::realization::levels_of(&self.baseline) {
+                d.low = Some(low);
+                d.high = Some(high);
+            }
+        }
         // Under a multisine design the file's own tones are part of the baseline's design.
         if self.spec.multisine.is_some() {
             let start = self.baseline.grid.start();

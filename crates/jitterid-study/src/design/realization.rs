@@ -38,6 +38,18 @@ pub(crate) fn mean_dwell_of(exp: &Experiment) -> Option<f64> {
     }
 }
 
+/// The random binary input's levels `(low, high)`, `None` for another input or several
+/// inputs.
+pub(crate) fn levels_of(exp: &Experiment) -> Option<(f64, f64)> {
+    match exp.inputs.as_slice() {
+        [c] => match &c.spec {
+            InputSpec::RandomBinary(rb) => Some((rb.low(), rb.high())),
+            InputSpec::Known(_) => None,
+        },
+        _ => None,
+    }
+}
+
 /// The multisine input's tones, `None` for another input or several inputs.
 pub(crate) fn tones_of(exp: &Experiment) -> Option<Vec<jitterid::signal::Tone>> {
     match exp.inputs.as_slice() {

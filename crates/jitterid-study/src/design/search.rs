@@ -3,13 +3,16 @@
 //!
 //! The criterion of a random input is an average over a fixed set of seeded draws, so it is a
 //! deterministic, piecewise smooth function of the design; it can have several minima (a dwell
-//! that excites one mode against one that excites another). A log-spaced grid over every free
-//! variable finds the basin, and Brent's method ([`Brent`], the solvers' own) then refines each
-//! variable in turn between the best grid point's neighbours, on a log scale because the
-//! variables are scales (seconds) whose useful ranges span decades; the file's own design, when
-//! inside the ranges, is a candidate beside the refined point. A design that cannot be
-//! evaluated (a dwell with too many switches, a singular information matrix) counts as
-//! infinitely bad; only a range without any evaluable design is an error.
+//! that excites one mode against one that excites another). A grid over every free variable
+//! finds the basin, and Brent's method ([`Brent`], the solvers' own) then refines each variable
+//! in turn between the best grid point's neighbours. The dwell and the interval are scales
+//! (seconds) whose useful ranges span decades, so they are gridded and refined on a log scale;
+//! the random binary input's levels may be 0 or negative and are searched on a linear one (a
+//! level's draws share their switch times, since a level does not enter the input's random
+//! stream, so the criterion is smooth in it). The file's own design, when inside the ranges,
+//! is a candidate beside the refined point. A design that cannot be evaluated (a dwell with too
+//! many switches, a singular information matrix, levels `low = high` that never switch) counts
+//! as infinitely bad; only a range without any evaluable design is an error.
 
 use super::candidate::Design;
 use super::criterion::criterion_value;
@@ -22,7 +25,8 @@ use crate::study_err;
 use jitterid::estimate::solver::{Brent, Objective, Solver};
 use std::sync::Mutex;
 
-/// Relative tolerance of the refinement on each variable (in its logarithm).
+/// Tolerance of the refinement on each variable: absolute in a scale's logarithm (a relative
+/// tolerance on the scale), and relative to the range's width for a level.
 const REFINE_TOLERANCE: f64 = 1e-3;
 
 /// Iteration limit of each refinement.
@@ -41,11 +45,60 @@ pub struct Optimum {
     pub evaluations: usize,
 }
 
-/// A free variable: which, and its range's logarithm.
+/// A free variable.
 #[derive(Debug, Clone, Copy)]
 enum Var {
     MeanDwell,
+    Low,
+    High,
     Interval,
+}
+
+impl Var {
+    /// The `[design]` key that frees it.
+    fn key(self) -> &'static str {
+        match self {
+            Var::MeanDwell => "mean_dwell",
+            Var::Low => "low",
+            Var::High => "high",
+            Var::Interval => "interval",
+        }
+    }
+
+    /// Whether the search's coordinate is the variable's logarithm (a scale) rather than the
+    /// variable itself (a level, which may be 0 or negative).
+    fn is_log(self) -> bool {
+        matches!(self, Var::MeanDwell | Var::Interval)
+    }
+
+    /// The search's coordinate of the value `x`.
+    fn coordinate(self, x: f64) -> f64 {
+        if self.is_log() {
+            x.ln()
+        } else {
+            x
+        }
+    }
+
+    /// The value at the search's coordinate `u`.
+    fn value(self, u: f64) -> f64 {
+        if self.is_log() {
+            u.exp()
+        } else {
+            u
+        }
+    }
+
+    /// The variable's value in `d` (NaN where `d` has none, which no range holds).
+    fn of(self, d: &Design) -> f64 {
+        match self {
+            Var::MeanDwell => d.mean_dwell,
+            Var::Low => d.low,
+            Var::High => d.high,
+            Var::Interval => Some(d.interval),
+        }
+        .unwrap_or(f64::NAN)
+    }
 }
 
 /// What one evaluation gave: a value, or why the design is not feasible.
@@ -63,14 +116,18 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
-    /// The design at log-coordinates `u` of `vars`, the other variables at `base`.
+    /// The design at the search's coordinates `u` of `vars` ([`Var::coordinate`]), the other
+    /// variables at `base`.
     fn design(&self, base: &Design, vars: &[Var], u: &[f64]) -> Design {
         let mut d = base.clone();
-        for (v, &x) in vars.iter().zip(u) {
+        for (&v, &x) in vars.iter().zip(u) {
+            let x = v.value(x);
             match v {
-                Var::MeanDwell => d.mean_dwell = Some(x.exp()),
+                Var::MeanDwell => d.mean_dwell = Some(x),
+                Var::Low => d.low = Some(x),
+                Var::High => d.high = Some(x),
                 Var::Interval => {
-                    d.interval = x.exp();
+                    d.interval = x;
                     d.samples = self.plan.spec.budget.samples_at(d.interval);
                 }
             }
@@ -122,7 +179,7 @@ impl Search<'_> {
     }
 }
 
-/// One variable of the search as an objective of its logarithm, infinite outside `[lo, hi]`.
+/// One variable of the search as an objective of its coordinate, infinite outside `[lo, hi]`.
 struct Line<'s, 'a> {
     search: &'s Search<'a>,
     base: Design,
@@ -158,18 +215,19 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
         return super::multisine::optimise_tones(plan, criterion, tones);
     }
     let spec = &plan.spec;
-    let mut vars = Vec::new();
-    let mut ranges = Vec::new();
-    if let Some((lo, hi)) = spec.mean_dwell {
-        vars.push(Var::MeanDwell);
-        ranges.push((lo.ln(), hi.ln()));
-    }
-    if let Some((lo, hi)) = spec.interval {
-        vars.push(Var::Interval);
-        ranges.push((lo.ln(), hi.ln()));
-    }
+    let free = [
+        (Var::MeanDwell, spec.mean_dwell),
+        (Var::Low, spec.low),
+        (Var::High, spec.high),
+        (Var::Interval, spec.interval),
+    ];
+    let (vars, ranges): (Vec<Var>, Vec<(f64, f64)>) = free
+        .into_iter()
+        .filter_map(|(v, r)| r.map(|(lo, hi)| (v, (v.coordinate(lo), v.coordinate(hi)))))
+        .unzip();
     let base = plan.budget_design();
-    // The grid: every combination of `spec.grid` log-spaced points per variable.
+    // The grid: every combination of `spec.grid` points per variable, evenly spaced in its
+    // coordinate (log-spaced for a scale).
     let g = spec.grid;
     let axis = |(lo, hi): (f64, f64)| -> Vec<f64> {
         (0..g)
@@ -236,8 +294,15 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
             lo: (u[k] - step).max(lo),
             hi: (u[k] + step).min(hi),
         };
+        // A level's tolerance is relative to its range (its coordinate has no natural unit).
+        let tolerance = if var.is_log() {
+            REFINE_TOLERANCE
+        } else {
+            REFINE_TOLERANCE * (hi - lo)
+        };
         let brent = Brent {
             bracket_step: step / 2.0,
+            tolerance,
             ..brent.clone()
         };
         // A refinement that fails leaves the grid's point, which is already evaluated.
@@ -253,13 +318,7 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
     // the refinement: the criterion of a random input is bumpy on a small scale, and the
     // grid's basin is the better start): the result is then never worse than the baseline it
     // is compared with, whatever the grid's spacing.
-    let own: Vec<f64> = vars
-        .iter()
-        .map(|v| match v {
-            Var::MeanDwell => base.mean_dwell.unwrap_or(f64::NAN).ln(),
-            Var::Interval => base.interval.ln(),
-        })
-        .collect();
+    let own: Vec<f64> = vars.iter().map(|v| v.coordinate(v.of(&base))).collect();
     if own
         .iter()
         .zip(&ranges)
@@ -295,13 +354,7 @@ pub fn optimise(plan: &Plan, criterion: &DesignCriterion) -> StudyResult<Optimum
 
 /// The error of a search without one feasible design: the first reason, and the keys.
 fn infeasible(search: &Search, vars: &[Var]) -> StudyError {
-    let mut keys: Vec<&str> = vars
-        .iter()
-        .map(|v| match v {
-            Var::MeanDwell => "mean_dwell",
-            Var::Interval => "interval",
-        })
-        .collect();
+    let mut keys: Vec<&str> = vars.iter().map(|v| v.key()).collect();
     // A budget narrows every design's record: it may be why none is feasible.
     keys.extend(search.plan.spec.budget_key);
     let memo = search.memo.lock().unwrap_or_else(|e| e.into_inner());

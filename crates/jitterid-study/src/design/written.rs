@@ -5,7 +5,9 @@
 //! of it. The realisation written is draw 0 of the `[design]` seed (the input Monte Carlo run
 //! 0 sees), and the experiment written beside it is the planned one with the design's sampling
 //! and `[input] kind = "csv"` reading that file, so `jitterid simulate` and `jitterid fit` take
-//! the designed experiment as they take any other.
+//! the designed experiment as they take any other. The designed dwell and levels live on in the
+//! realisation (its switch times and values) and in the written file's header, not as keys,
+//! since a CSV input has none of them.
 //!
 //! A designed multisine is a signal the experiment file states exactly: the experiment
 //! written keeps `[input] kind = "multisine"` with the designed frequencies, amplitudes and
@@ -66,13 +68,14 @@ pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResu
     };
     let origin = |what: &str| format!("[design] {what}");
     let mut edits = plan.edits().to_vec();
-    // The design's sampling; its dwell lives on in the realisation, not as a key.
-    edits.extend(
-        design
-            .edits()
-            .into_iter()
-            .filter(|e| e.key() != "input.mean_dwell"),
-    );
+    // The design's sampling; its dwell and levels live on in the realisation, not as keys (a
+    // CSV input has none, and an edit of them would keep the random binary's keys).
+    edits.extend(design.edits().into_iter().filter(|e| {
+        !matches!(
+            e.key().as_str(),
+            "input.mean_dwell" | "input.low" | "input.high"
+        )
+    }));
     edits.push(Override::from_source(
         &["input", "kind"],
         "csv".into(),
@@ -92,9 +95,16 @@ pub fn designed_input(plan: &Plan, design: &Design, csv_name: &str) -> StudyResu
     let dwell = design
         .mean_dwell
         .map_or(String::new(), |m| format!(" with mean dwell {m} s"));
+    // The designed levels, which the realisation takes; the file's own when not designed.
+    let levels = match super::realization::levels_of(&exp) {
+        Some((low, high)) if design.low.is_some() || design.high.is_some() => {
+            format!(" between the designed levels low = {low} and high = {high}")
+        }
+        _ => String::new(),
+    };
     let header = format!(
         "# Designed by `jitterid design` from {}: the input is realisation 0 of seed {seed} of the\n\
-         # random binary input{dwell}, in {csv_name}.\n",
+         # random binary input{dwell}{levels}, in {csv_name}.\n",
         exp.file
     );
     Ok(DesignedInput {

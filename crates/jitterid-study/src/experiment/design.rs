@@ -1,12 +1,12 @@
 //! `[design]`: the experiment's free design variables and their ranges, for `jitterid design`.
 //!
 //! The section names what the user may still choose before the experiment is run (the random
-//! binary input's mean dwell, the sampling interval) and how a design is judged. Ranges are
+//! binary input's mean dwell and levels, the sampling interval) and how a design is judged. Ranges are
 //! checked here against what the rest of the file fixes, so that a range without one feasible
 //! point is refused at the door, naming its key, rather than found empty by the optimiser.
 
 use super::diagnostics::Source;
-use super::range::{MAX_INTERVAL, MIN_INTERVAL};
+use super::range::{self as limits, MAX_INTERVAL, MIN_INTERVAL};
 use super::raw::RawDesign;
 use super::sampling::MAX_SAMPLES;
 use super::tone_design::{parse_tone_design, ToneDesignSpec};
@@ -155,6 +155,10 @@ pub fn dac_rate_edit(rate: f64) -> super::Override {
 pub struct DesignSpec {
     /// The random binary input's mean dwell range `[min, max]` (s), when it is free.
     pub mean_dwell: Option<(f64, f64)>,
+    /// The random binary input's `low` level's range `[min, max]`, when it is free.
+    pub low: Option<(f64, f64)>,
+    /// The random binary input's `high` level's range `[min, max]`, when it is free.
+    pub high: Option<(f64, f64)>,
     /// The sampling interval's range `[min, max]` (s), when it is free; the part of the range
     /// where the held quantity allows a record (see [`Hold`]).
     pub interval: Option<(f64, f64)>,
@@ -270,6 +274,45 @@ fn range(cx: &Source, key: &str, v: &Spanned<Vec<f64>>) -> StudyResult<(f64, f64
     }
 }
 
+/// `[min, max]` of a random binary input's level: two finite numbers with `min ≤ max`, each
+/// within the magnitude the input's own `low` and `high` may have ([`limits::level`]). Unlike
+/// a time scale, a level may be 0 or negative.
+fn level_range(cx: &Source, key: &str, v: &Spanned<Vec<f64>>) -> StudyResult<(f64, f64)> {
+    let bad = |why: String| cx.err(S, key, &v.span(), why);
+    match v.get_ref().as_slice() {
+        &[lo, hi] if lo.is_finite() && hi.is_finite() && lo <= hi => {
+            limits::level(lo).map_err(|m| bad(format!("min: {m}")))?;
+            limits::level(hi).map_err(|m| bad(format!("max: {m}")))?;
+            Ok((lo, hi))
+        }
+        other => Err(bad(format!(
+            "expected [min, max] of two finite levels with min <= max, found {other:?}"
+        ))),
+    }
+}
+
+/// A free level of the random binary input (`[design] low` or `high`), refused for any other
+/// input since only a random binary input has the keys it edits.
+fn free_level(
+    cx: &Source,
+    key: &str,
+    v: &Option<Spanned<Vec<f64>>>,
+    input_kind: Option<&str>,
+) -> StudyResult<Option<(f64, f64)>> {
+    let Some(v) = v else {
+        return Ok(None);
+    };
+    if input_kind != Some("random-binary") {
+        return Err(cx.err(
+            S,
+            key,
+            &v.span(),
+            "is a design variable of a random binary input; expected [input] kind = \"random-binary\"",
+        ));
+    }
+    level_range(cx, key, v).map(Some)
+}
+
 /// A whole number in `[lo, hi]`, or `default` when absent.
 fn whole(
     cx: &Source,
@@ -372,6 +415,8 @@ pub(super) fn parse_design(
         }
         None => None,
     };
+    let low = free_level(cx, "low", &r.low, input_kind)?;
+    let high = free_level(cx, "high", &r.high, input_kind)?;
     let n = grid.len() as f64;
     let (budget, budget_key) = parse_budget(cx, r, grid)?;
     let hold = match (&r.hold, budget) {
@@ -481,11 +526,16 @@ pub(super) fn parse_design(
         budget.samples_at(grid.interval()),
         r.interval.is_some(),
     )?;
-    if mean_dwell.is_none() && interval.is_none() && multisine.is_none() {
+    if mean_dwell.is_none()
+        && low.is_none()
+        && high.is_none()
+        && interval.is_none()
+        && multisine.is_none()
+    {
         return Err(cx.err_section(
             S,
             "mean_dwell",
-            "the section names no free variable; expected mean_dwell = [min, max], interval = [min, max] or band = [fmin, fmax]",
+            "the section names no free variable; expected mean_dwell = [min, max], low = [min, max], high = [min, max], interval = [min, max] or band = [fmin, fmax]",
         ));
     }
     let criterion = match &r.criterion {
@@ -523,6 +573,8 @@ pub(super) fn parse_design(
     let derived = parse_derived(cx, r)?;
     Ok(DesignSpec {
         mean_dwell,
+        low,
+        high,
         interval,
         jitter_exponent,
         hold,

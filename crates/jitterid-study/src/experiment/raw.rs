@@ -115,6 +115,8 @@ section!(RawSelect, "table [select]" {
 
 section!(RawDesign, "table [design]" {
     mean_dwell: Vec<f64>,
+    low: Vec<f64>,
+    high: Vec<f64>,
     interval: Vec<f64>,
     jitter_exponent: f64,
     hold: String,
