@@ -26,17 +26,7 @@ fn cheap_table2(extra: &[&str]) -> std::process::Output {
     run(&args)
 }
 
-/// `jitterid design` of Table 2 with `args` exits 2 with one line that contains `want`.
-fn refused(args: &[&str], want: &str) {
-    let table2 = example("table2.toml");
-    let mut all = vec!["design", table2.as_str()];
-    all.extend_from_slice(args);
-    let o = run(&all);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    assert!(err.contains(want), "{args:?}: expected {want:?} in {err}");
-}
+use common::design_refused as refused;
 
 #[test]
 fn design_json_has_the_contract_s_keys_and_improves_on_the_baseline() {

@@ -133,6 +133,18 @@ pub fn simulate_and_fit_in(
     serde_json::from_str(&stdout(&o)).unwrap()
 }
 
+/// `jitterid design` of Table 2 with `args` exits 2 with one line that contains `want`.
+pub fn design_refused(args: &[&str], want: &str) {
+    let table2 = example("table2.toml");
+    let mut all = vec!["design", table2.as_str()];
+    all.extend_from_slice(args);
+    let o = run(&all);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains(want), "{args:?}: expected {want:?} in {err}");
+}
+
 /// `simulate` of the experiment `text` (in scratch directory `name` of `group`): exit 2, one
 /// line holding every one of `expect`, no data written.
 pub fn refused_text(group: &str, name: &str, text: &str, expect: &[&str]) {
