@@ -4,10 +4,9 @@
 //! A design is applied as edits of the experiment's document (`input.mean_dwell`,
 //! `input.low`, `input.high`, `sampling.interval`, `sampling.samples`, a multisine's
 //! `input.frequencies`, `input.amplitudes` and `input.phases`), which is then read again:
-//! every candidate meets
-//! the same validation as a file written by hand (the jitter's reach within the record, the
-//! input's switch limit), and nothing in the design layer has to know how an experiment holds
-//! its input or grid.
+//! every candidate meets the same validation as a file written by hand (the jitter's reach
+//! within the record, the input's switch limit), and nothing in the design layer has to know
+//! how an experiment holds its input or grid.
 
 use super::multisine::MultisineDesign;
 use crate::experiment::{Experiment, Override};
