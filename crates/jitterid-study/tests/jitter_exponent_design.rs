@@ -152,3 +152,44 @@ fn the_written_experiment_carries_the_scaled_jitter() {
     assert_eq!(j["n"].as_integer(), Some(2));
     assert_eq!(jitter_of(1.0)["a"].as_float(), Some(A));
 }
+
+/// The report gives the jitter's σ at each design's interval under `jitter_exponent` (the
+/// designed one's is the baseline's times `(T/T₀)^α`), and leaves the key out otherwise.
+#[test]
+fn the_report_gives_the_jitter_at_each_design() {
+    let text = |alpha: f64| {
+        setup(
+            100,
+            RANDOM_BINARY,
+            &format!(
+                "[design]\ninterval = [0.25, 4.0]\nhold = \"samples\"\njitter_exponent = {alpha}\ndraws = 4\ngrid = 5"
+            ),
+        )
+    };
+    let p = plan(&text(0.5)).unwrap();
+    let mut report = jitterid_study::design::design(&p, None).unwrap();
+    report.jitter_blind =
+        Some(jitterid_study::design::jitter_blind(&p, &DesignCriterion::D).unwrap());
+    let json = report.json();
+    let designed = json.jitter_std.unwrap();
+    let baseline = json.baseline.jitter_std.unwrap();
+    let t = json.design.interval;
+    assert!(
+        (designed / baseline - t.sqrt()).abs() < 1e-12,
+        "{designed} {baseline} at {t}"
+    );
+    let blind = json.jitter_blind.as_ref().unwrap();
+    let tb = blind.design.interval;
+    assert!((blind.jitter_std.unwrap() / baseline - tb.sqrt()).abs() < 1e-12);
+    // Without the exponent the key is absent from every design.
+    let v = serde_json::to_value(
+        jitterid_study::design::design(&plan(&text(0.0)).unwrap(), None)
+            .unwrap()
+            .json(),
+    )
+    .unwrap();
+    assert!(
+        v.get("jitter_std").is_none() && v["baseline"].get("jitter_std").is_none(),
+        "{v}"
+    );
+}

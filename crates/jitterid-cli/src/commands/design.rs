@@ -195,6 +195,28 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
             design_text(&b.design)
         );
     }
+    // Under [design] jitter_exponent each design has its own jitter: say which.
+    if let Some(designed) = report.jitter_std_of(p) {
+        let at = |x: Option<f64>| x.map_or("–".into(), fmt_num);
+        let base = report
+            .baseline_prediction
+            .as_ref()
+            .ok()
+            .and_then(|(bp, _)| report.jitter_std_of(bp));
+        let blind_std = blind.map_or(String::new(), |b| {
+            format!(
+                ", jitter-blind {} s",
+                at(report.jitter_std_of(&b.prediction))
+            )
+        });
+        let _ = writeln!(
+            out,
+            "jitter σ at each design's interval (jitter_exponent {}): designed {} s, baseline {} s{blind_std}",
+            report.jitter_exponent,
+            fmt_num(designed),
+            at(base)
+        );
+    }
     let derived_names: Vec<String> = report.derived_of(p).into_iter().map(|d| d.name).collect();
     let w = name_width(p.names.iter().chain(&derived_names).map(String::as_str));
     let blind_head = if blind.is_some() {

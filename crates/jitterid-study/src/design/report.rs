@@ -11,6 +11,7 @@ use super::predict::{predict, prior_model, Prediction};
 use super::search::optimise;
 use crate::error::StudyResult;
 use crate::experiment::{DesignCriterion, DesignEstimator, PriorSpread};
+use jitterid::jitter::JitterModel;
 use serde::Serialize;
 
 /// One predicted standard deviation.
@@ -32,6 +33,10 @@ pub struct PredictedDesign {
     /// Derived quantities' predicted standard deviations (see [`derived_stds`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derived: Vec<PredictedStd>,
+    /// The jitter's standard deviation at this design's interval (s), under `[design]
+    /// jitter_exponent` (absent otherwise, and where the design could not be predicted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jitter_std: Option<f64>,
 }
 
 /// The JSON of `jitterid design --json`.
@@ -46,6 +51,10 @@ pub struct DesignJson {
     /// Derived quantities' predicted standard deviations (see [`derived_stds`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derived: Vec<PredictedStd>,
+    /// The jitter's standard deviation at the designed interval (s), under `[design]
+    /// jitter_exponent` (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jitter_std: Option<f64>,
     /// The experiment file's own design, for comparison.
     pub baseline: PredictedDesign,
     /// The jitter-blind design (`--jitter-blind`), when asked for.
@@ -89,6 +98,10 @@ pub struct BlindJson {
     pub predicted_blind: Vec<PredictedStd>,
     /// The criterion under the jitter-blind prior.
     pub criterion_value_blind: f64,
+    /// The jitter's standard deviation at this design's interval under the true prior (s),
+    /// under `[design] jitter_exponent` (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jitter_std: Option<f64>,
 }
 
 /// The outcome of a design search, with what the text report adds to the JSON.
@@ -120,6 +133,9 @@ pub struct DesignReport {
     pub prior: Option<PriorSpread>,
     /// The derived quantities asked for (`[design] derived`), `None` for [`derived_stds`]'s.
     pub derived: Option<Vec<DerivedRequest>>,
+    /// `[design] jitter_exponent`: when not 0, the jitter depends on the interval and the
+    /// report gives its standard deviation at each design ([`DesignReport::jitter_std_of`]).
+    pub jitter_exponent: f64,
 }
 
 /// The derived quantities a design report gives beside the parameters, by the delta method:
@@ -160,6 +176,13 @@ impl DesignReport {
         }
     }
 
+    /// The jitter's standard deviation of prediction `p` (its model's, at its design's
+    /// interval) when the jitter depends on the interval (`[design] jitter_exponent`), `None`
+    /// otherwise.
+    pub fn jitter_std_of(&self, p: &Prediction) -> Option<f64> {
+        (self.jitter_exponent != 0.0).then(|| p.model().jitter.std_dev())
+    }
+
     /// The command's JSON.
     pub fn json(&self) -> DesignJson {
         let baseline_derived = match &self.baseline_prediction {
@@ -183,10 +206,16 @@ impl DesignReport {
             design: self.design.clone(),
             predicted: stds(&self.prediction),
             derived: self.derived_of(&self.prediction),
+            jitter_std: self.jitter_std_of(&self.prediction),
             baseline: PredictedDesign {
                 design: self.baseline.clone(),
                 predicted: baseline,
                 derived: baseline_derived,
+                jitter_std: self
+                    .baseline_prediction
+                    .as_ref()
+                    .ok()
+                    .and_then(|(p, _)| self.jitter_std_of(p)),
             },
             jitter_blind: self.jitter_blind.as_ref().map(|b| BlindJson {
                 design: b.design.clone(),
@@ -194,6 +223,7 @@ impl DesignReport {
                 criterion_value: b.value,
                 predicted_blind: stds(&b.blind_prediction),
                 criterion_value_blind: b.blind_value,
+                jitter_std: self.jitter_std_of(&b.prediction),
             }),
             robust: self.prior.map(|p| RobustJson {
                 prior_spread: p.system,
@@ -243,5 +273,6 @@ pub fn design(plan: &Plan, criterion: Option<&DesignCriterion>) -> StudyResult<D
         jitter_blind: None,
         prior: spec.prior,
         derived: spec.derived.clone(),
+        jitter_exponent: spec.jitter_exponent,
     })
 }
