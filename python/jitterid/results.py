@@ -335,7 +335,10 @@ class DesignResult(_CommandJson):
     (``jitter_blind``: its design and its standard deviations under the true, jittered prior).
     A designed multisine (``[design] band``) is ``multisine`` (``frequencies``, ``amplitudes``,
     ``phases``, ``crest_factor``, ``power``; also ``design["multisine"]``) beside the file's own,
-    ``baseline_multisine``; both are ``None`` for other designs.
+    ``baseline_multisine``; both are ``None`` for other designs. Under ``[design]
+    jitter_exponent`` (a jitter that follows the sampling interval) ``jitter_std`` and
+    ``baseline_jitter_std`` are the jitter's σ at the designed and the file's interval (s);
+    ``None`` otherwise.
     """
 
     def __init__(self, data: Dict[str, Any]) -> None:
@@ -351,6 +354,8 @@ class DesignResult(_CommandJson):
         self.jitter_blind: Optional[Dict[str, Any]] = data.get("jitter_blind")
         self.multisine: Optional[Dict[str, Any]] = self.design.get("multisine")
         self.baseline_multisine: Optional[Dict[str, Any]] = (self.baseline or {}).get("multisine")
+        self.jitter_std: Optional[float] = data.get("jitter_std")
+        self.baseline_jitter_std: Optional[float] = base.get("jitter_std")
 
 
     def __repr__(self) -> str:

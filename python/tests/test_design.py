@@ -138,3 +138,22 @@ def test_bad_multisine_keys_raise_value_error(tmp_path, extra, kwargs, words):
         kwargs = dict(kwargs, write_input=tmp_path / kwargs["write_input"])
     with pytest.raises(ValueError, match=words):
         jitterid.design(jitterid.Experiment.from_toml(str(path)), **kwargs)
+
+
+def test_a_jitter_that_follows_the_interval_is_reported_at_each_design(tmp_path):
+    """``[design] jitter_exponent = 1``: the jitter's σ at the designed interval is the file's
+    times ``T / T0`` (``T0 = 1 s``), as the command line's JSON says; a bad exponent raises
+    ``ValueError`` naming the key."""
+    text = (REPO / "examples/experiments/table2.toml").read_text()
+    section = '\n[design]\ninterval = [0.25, 4.0]\nhold = "samples"\ndraws = 4\ngrid = 5\n'
+    path = tmp_path / "t.toml"
+    path.write_text(text + section + "jitter_exponent = 1.0\n")
+    result = jitterid.design(jitterid.Experiment.from_toml(str(path)))
+    d = result.to_dict()
+    assert result.jitter_std == d["jitter_std"] and result.baseline_jitter_std == d["baseline"]["jitter_std"]
+    assert abs(result.jitter_std / result.baseline_jitter_std - result.design["interval"]) < 1e-12
+    path.write_text(text + section)
+    assert jitterid.design(jitterid.Experiment.from_toml(str(path))).jitter_std is None
+    path.write_text(text + section + "jitter_exponent = 3.0\n")
+    with pytest.raises(ValueError, match=r"\[design\] jitter_exponent"):
+        jitterid.design(jitterid.Experiment.from_toml(str(path)))
