@@ -123,31 +123,16 @@ fn select_carries_the_level_into_every_candidate() {
 
 #[test]
 fn init_auto_fits_the_deviation_and_reaches_the_same_optimum() {
-    let dir = scratch_in("jitterid-level", "init-auto");
-    let truth = example("input-level.toml");
-    let wrong = std::fs::read_to_string(&truth)
-        .unwrap()
-        .replace("num = [1.0]", "num = [0.05]")
-        .replace("den = [1.0, 1.0, 0.0]", "den = [1.0, 8.0, 0.0]")
-        .replace("level = 0.5 ", "level = 0.3 ");
-    let wrong_path = dir.join("wrong.toml");
-    std::fs::write(&wrong_path, wrong).unwrap();
-    let from_truth = simulate_and_fit(&dir, &truth, "2", &[]);
-    let o = run(&[
-        "fit",
-        s(&wrong_path),
-        "--data",
-        s(&dir.join("d.csv")),
-        "--init",
-        "auto",
-        "--json",
-    ]);
-    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
-    let auto: Value = serde_json::from_str(&stdout(&o)).unwrap();
-    for name in ["b0", "a1", "level", "offset"] {
-        let ((a, se), (b, _)) = (param(&from_truth, name), param(&auto, name));
-        assert!((a - b).abs() < 1e-3 * se, "{name}: {a} vs {b} (± {se})");
-    }
+    common::init_auto_reaches_the_truth_s_optimum(
+        "jitterid-level",
+        "input-level.toml",
+        &[
+            ("num = [1.0]", "num = [0.05]"),
+            ("den = [1.0, 1.0, 0.0]", "den = [1.0, 8.0, 0.0]"),
+            ("level = 0.5 ", "level = 0.3 "),
+        ],
+        &["b0", "a1", "level", "offset"],
+    );
 }
 
 /// `simulate` of `text`: exit 2, one line holding every one of `expect`, no data written.

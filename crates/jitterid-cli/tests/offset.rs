@@ -195,34 +195,17 @@ fn init_auto_starts_the_offset_from_the_record() {
     // Every start badly wrong, the offset at 0 against a truth of 1.5: the data-driven start
     // (the initializer's system, then mean(y) − mean(m_k) for the offset) reaches the fit
     // from the truth.
-    let dir = scratch_in("jitterid-offset", "init-auto");
-    let truth = example("offset.toml");
-    let wrong = std::fs::read_to_string(&truth)
-        .unwrap()
-        .replace("gain = 0.2", "gain = 0.001")
-        .replace("zeros = [-0.5]", "zeros = [-0.01]")
-        .replace("poles = [[-0.25, 0.3]]", "poles = [[-3.0, 0.01]]")
-        .replace("offset = 1.5 ", "offset = 0.0 ");
-    let wrong_path = dir.join("wrong.toml");
-    std::fs::write(&wrong_path, wrong).unwrap();
-    let from_truth = simulate_and_fit(&dir, &truth, "2", &[]);
-    let data = dir.join("d.csv");
-    let o = run(&[
-        "fit",
-        s(&wrong_path),
-        "--data",
-        s(&data),
-        "--init",
-        "auto",
-        "--json",
-    ]);
-    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
-    let auto: Value = serde_json::from_str(&stdout(&o)).unwrap();
-    for name in ["gain", "zero0", "pole0.re", "pole0.im", "offset"] {
-        let ((a, se), (b, _)) = (param(&from_truth, name), param(&auto, name));
-        // The same optimum: far within its standard error.
-        assert!((a - b).abs() < 1e-3 * se, "{name}: {a} vs {b} (± {se})");
-    }
+    common::init_auto_reaches_the_truth_s_optimum(
+        "jitterid-offset",
+        "offset.toml",
+        &[
+            ("gain = 0.2", "gain = 0.001"),
+            ("zeros = [-0.5]", "zeros = [-0.01]"),
+            ("poles = [[-0.25, 0.3]]", "poles = [[-3.0, 0.01]]"),
+            ("offset = 1.5 ", "offset = 0.0 "),
+        ],
+        &["gain", "zero0", "pole0.re", "pole0.im", "offset"],
+    );
 }
 
 /// `select` carries the estimated offset into every candidate: on a record of `offset.toml`

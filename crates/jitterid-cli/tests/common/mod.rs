@@ -133,6 +133,44 @@ pub fn simulate_and_fit_in(
     serde_json::from_str(&stdout(&o)).unwrap()
 }
 
+/// `fit --init auto` of the example experiment `name` with every start made wrong by
+/// `replacements` (each `(from, to)` in its text) reaches the fit from the truth on run 2 of
+/// the example (in scratch directory `init-auto` of `group`): each of `names` within `1e-3` of
+/// its standard error, far within it.
+pub fn init_auto_reaches_the_truth_s_optimum(
+    group: &str,
+    name: &str,
+    replacements: &[(&str, &str)],
+    names: &[&str],
+) {
+    let dir = scratch_in(group, "init-auto");
+    let truth = example(name);
+    let wrong = replacements
+        .iter()
+        .fold(std::fs::read_to_string(&truth).unwrap(), |t, (from, to)| {
+            t.replace(from, to)
+        });
+    let wrong_path = dir.join("wrong.toml");
+    std::fs::write(&wrong_path, wrong).unwrap();
+    let from_truth = simulate_and_fit_in(&dir, &truth, "2", &[]);
+    let data = dir.join("d.csv");
+    let o = run(&[
+        "fit",
+        s(&wrong_path),
+        "--data",
+        s(&data),
+        "--init",
+        "auto",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}{}", stdout(&o), stderr(&o));
+    let auto: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    for name in names {
+        let ((a, se), (b, _)) = (param(&from_truth, name), param(&auto, name));
+        assert!((a - b).abs() < 1e-3 * se, "{name}: {a} vs {b} (± {se})");
+    }
+}
+
 /// `jitterid design` of Table 2 with `args` exits 2 with one line that contains `want`.
 pub fn design_refused(args: &[&str], want: &str) {
     let table2 = example("table2.toml");
