@@ -82,14 +82,8 @@ impl<M: RationalModel> Signal for Delayed<M> {
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        let n = self.inner.num_params();
-        if params.len() != n + 1 {
-            return Err(SignalError::WrongParamCount {
-                expected: n + 1,
-                got: params.len(),
-            });
-        }
-        Self::new(self.inner.with_params(&params[..n])?, params[n])
+        let (inner, delay) = crate::error::split_trailing(params, self.inner.num_params(), true)?;
+        Self::new(self.inner.with_params(inner)?, delay.unwrap_or(self.delay))
     }
 
     fn value(&self, t: f64) -> f64 {

@@ -245,6 +245,25 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, SignalErro
     Ok(jitterid_numeric::validate::positive(name, value)?)
 }
 
+/// The parameters of a wrapper that appends at most one parameter of its own to a wrapped
+/// signal's `inner` ones (a delay, an output offset, an input level): the wrapped signal's,
+/// and the wrapper's own when `own` says it is estimated; a count other than `inner + own` is
+/// [`SignalError::WrongParamCount`].
+pub(crate) fn split_trailing(
+    params: &[f64],
+    inner: usize,
+    own: bool,
+) -> Result<(&[f64], Option<f64>), SignalError> {
+    let expected = inner + usize::from(own);
+    if params.len() != expected {
+        return Err(SignalError::WrongParamCount {
+            expected,
+            got: params.len(),
+        });
+    }
+    Ok((&params[..inner], own.then(|| params[inner])))
+}
+
 pub(crate) fn all_finite(name: &'static str, values: &[f64]) -> Result<(), SignalError> {
     values.iter().try_for_each(|&v| finite(name, v).map(|_| ()))
 }

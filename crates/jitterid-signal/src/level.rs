@@ -177,21 +177,13 @@ impl<S: DrivenSignal + ModalSignal + Clone> Signal for InputLevel<S> {
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        let n = self.shifted.num_params();
-        let expected = n + usize::from(self.estimated);
-        if params.len() != expected {
-            return Err(SignalError::WrongParamCount {
-                expected,
-                got: params.len(),
-            });
-        }
-        let level = if self.estimated {
-            crate::error::finite(LEVEL_PARAM, params[n])?;
-            params[n]
-        } else {
-            self.level
+        let (inner, own) =
+            crate::error::split_trailing(params, self.shifted.num_params(), self.estimated)?;
+        let level = match own {
+            Some(level) => crate::error::finite(LEVEL_PARAM, level)?,
+            None => self.level,
         };
-        let system = self.shifted.with_params(&params[..n])?;
+        let system = self.shifted.with_params(inner)?;
         // The unit input does not move with the level: only the shifted input is rebuilt.
         Ok(Self {
             unit: system.driven_by(self.unit.input().clone())?,

@@ -86,22 +86,11 @@ impl<S: Signal + Clone> Signal for Offset<S> {
     }
 
     fn with_params(&self, params: &[f64]) -> Result<Self, SignalError> {
-        let n = self.inner.num_params();
-        let expected = n + usize::from(self.estimated);
-        if params.len() != expected {
-            return Err(SignalError::WrongParamCount {
-                expected,
-                got: params.len(),
-            });
-        }
-        let offset = if self.estimated {
-            params[n]
-        } else {
-            self.offset
-        };
+        let (inner, own) =
+            crate::error::split_trailing(params, self.inner.num_params(), self.estimated)?;
         Self::new(
-            self.inner.with_params(&params[..n])?,
-            offset,
+            self.inner.with_params(inner)?,
+            own.unwrap_or(self.offset),
             self.estimated,
         )
     }
