@@ -198,11 +198,7 @@ fn table(plan: &Plan, report: &DesignReport) -> String {
     // Under [design] jitter_exponent each design has its own jitter: say which.
     if let Some(designed) = report.jitter_std_of(p) {
         let at = |x: Option<f64>| x.map_or("–".into(), fmt_num);
-        let base = report
-            .baseline_prediction
-            .as_ref()
-            .ok()
-            .and_then(|(bp, _)| report.jitter_std_of(bp));
+        let base = report.baseline_jitter_std();
         let blind_std = blind.map_or(String::new(), |b| {
             format!(
                 ", jitter-blind {} s",

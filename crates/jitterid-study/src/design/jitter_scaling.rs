@@ -13,53 +13,37 @@ use crate::experiment::Experiment;
 use crate::study_err;
 use jitterid::jitter::{AnyJitter, JitterModel};
 
-/// The jitter of `exp` at its own interval, for a file whose jitter `file_jitter` was stated at
-/// interval `file_interval`, under exponent `alpha`; `None` when nothing moves (`α = 0`, the
-/// file's interval, or a jitter without spread).
+/// `exp` with its jitter (truth and fitted model) at its own interval, for a file whose jitter
+/// `file_jitter` was stated at interval `file_interval`, under exponent `alpha`; unchanged
+/// when nothing moves (`α = 0`, the file's interval, or a jitter without spread).
 ///
 /// # Errors
 ///
 /// The moved jitter is invalid (its spread not representable); the message names
 /// `[design] jitter_exponent` and the interval.
-pub(crate) fn jitter_at_interval(
-    exp: &Experiment,
-    file_jitter: &AnyJitter,
-    file_interval: f64,
-    alpha: f64,
-) -> StudyResult<Option<AnyJitter>> {
-    let interval = exp.grid.interval();
-    let sigma = file_jitter.std_dev();
-    if alpha == 0.0 || interval == file_interval || !(sigma > 0.0) {
-        return Ok(None);
-    }
-    let scaled = sigma * (interval / file_interval).powf(alpha);
-    exp.registries
-        .jitter
-        .from_std_dev(file_jitter.family(), scaled, &file_jitter.spec())
-        .map(Some)
-        .map_err(|e| {
-            study_err!(
-                "{}: [design] jitter_exponent: the jitter at the interval {interval} s (σ = {scaled} s): {e}",
-                exp.file
-            )
-        })
-}
-
-/// `exp` with its jitter (truth and fitted model) at its own interval (see
-/// [`jitter_at_interval`]).
-///
-/// # Errors
-///
-/// Those of [`jitter_at_interval`].
 pub(crate) fn at_interval(
     mut exp: Experiment,
     file_jitter: &AnyJitter,
     file_interval: f64,
     alpha: f64,
 ) -> StudyResult<Experiment> {
-    if let Some(j) = jitter_at_interval(&exp, file_jitter, file_interval, alpha)? {
-        exp.jitter.truth = j.clone();
-        exp.jitter.model = j;
+    let interval = exp.grid.interval();
+    let sigma = file_jitter.std_dev();
+    if alpha == 0.0 || interval == file_interval || !(sigma > 0.0) {
+        return Ok(exp);
     }
+    let scaled = sigma * (interval / file_interval).powf(alpha);
+    let moved = exp
+        .registries
+        .jitter
+        .from_std_dev(file_jitter.family(), scaled, &file_jitter.spec())
+        .map_err(|e| {
+            study_err!(
+                "{}: [design] jitter_exponent: the jitter at the interval {interval} s (σ = {scaled} s): {e}",
+                exp.file
+            )
+        })?;
+    exp.jitter.truth = moved.clone();
+    exp.jitter.model = moved;
     Ok(exp)
 }

@@ -278,13 +278,12 @@ impl Plan {
         } else {
             // The jitter at the design's interval, when it depends on the interval (the
             // prediction checks the moved jitter's reach against the record).
-            let exp = at_interval(
+            at_interval(
                 exp,
                 &self.baseline.jitter.truth,
                 self.baseline.grid.interval(),
                 self.spec.jitter_exponent,
-            )?;
-            Ok(exp)
+            )
         }
     }
 }

@@ -183,6 +183,15 @@ impl DesignReport {
         (self.jitter_exponent != 0.0).then(|| p.model().jitter.std_dev())
     }
 
+    /// The jitter's standard deviation at the baseline's interval ([`Self::jitter_std_of`] of
+    /// the baseline's prediction), `None` also where the baseline could not be predicted.
+    pub fn baseline_jitter_std(&self) -> Option<f64> {
+        self.baseline_prediction
+            .as_ref()
+            .ok()
+            .and_then(|(p, _)| self.jitter_std_of(p))
+    }
+
     /// The command's JSON.
     pub fn json(&self) -> DesignJson {
         let baseline_derived = match &self.baseline_prediction {
@@ -211,11 +220,7 @@ impl DesignReport {
                 design: self.baseline.clone(),
                 predicted: baseline,
                 derived: baseline_derived,
-                jitter_std: self
-                    .baseline_prediction
-                    .as_ref()
-                    .ok()
-                    .and_then(|(p, _)| self.jitter_std_of(p)),
+                jitter_std: self.baseline_jitter_std(),
             },
             jitter_blind: self.jitter_blind.as_ref().map(|b| BlindJson {
                 design: b.design.clone(),
