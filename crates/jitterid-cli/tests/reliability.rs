@@ -129,7 +129,9 @@ fn a_fifo_given_to_out_is_written_through_not_replaced() {
 }
 
 /// A FIFO that no process reads does not block the command for ever: after a short wait it is
-/// an error (status 2, one line), and the FIFO stays.
+/// an error (status 2, one line), and the FIFO stays. The result says the wait ended: the
+/// message is the one the command gives when its wait for a reader runs out (a command that
+/// blocked would never exit, and the harness, not a clock in the test, would stop it).
 #[cfg(unix)]
 #[test]
 fn a_fifo_without_a_reader_is_refused_not_waited_for_ever() {
@@ -137,15 +139,9 @@ fn a_fifo_without_a_reader_is_refused_not_waited_for_ever() {
     let exp = small(&dir);
     let fifo = dir.join("pipe.csv");
     mkfifo(&fifo);
-    let start = std::time::Instant::now();
     refused(
         &["simulate", s(&exp), "--out", s(&fifo)],
         &["pipe.csv", "no process is reading"],
-    );
-    assert!(
-        start.elapsed() < std::time::Duration::from_secs(30),
-        "{:?}",
-        start.elapsed()
     );
     assert!(is_fifo(&fifo));
     assert_eq!(names_in(&dir), ["pipe.csv", "small.toml"]);
